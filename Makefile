@@ -1,0 +1,39 @@
+# The README's two commands: `make demo` and `make test`. Each creates or refreshes
+# .venv, installs the project with its test extra, builds the FMUs and runs.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+
+.PHONY: demo test build lint format clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+build: $(STAMP)
+	$(BIN)/arcosim build
+	$(BIN)/arcosim build --masses 1
+	$(BIN)/arcosim build --masses 5
+	$(BIN)/arcosim build --masses 20
+
+demo: $(STAMP)
+	$(BIN)/arcosim demo
+
+test: build
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/python -m pytest
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+format: $(STAMP)
+	$(BIN)/ruff format .
+	$(BIN)/ruff check --fix .
+
+clean:
+	rm -rf dist reports build *.egg-info .pytest_cache .ruff_cache

@@ -1,0 +1,160 @@
+"""One FMU instance driven through fmpy's low-level FMI 2.0 calls.
+
+:class:`FmuInstance` sets and gets variables by name (typed from the model
+description), collects the FMU's log lines, and reports a refused step as a
+status instead of an exception, so a master can carry on or stop cleanly.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import shutil
+from collections.abc import Iterable, Mapping, Sequence
+from ctypes import c_char_p
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+
+from cosim.errors import UserError
+
+STATUS_NAMES = ("ok", "warning", "discard", "error", "fatal", "pending")
+
+
+class FmuInstance:
+    """An instantiated co-simulation FMU.
+
+    Args:
+        path: the ``.fmu`` file.
+        instance_name: name given to ``fmi2Instantiate`` (appears in log lines).
+        echo_log: also print every log line to stdout.
+
+    Attributes:
+        messages: log lines received, as ``"status: message"``.
+        variables: model variables by name (fmpy ``ScalarVariable``).
+    """
+
+    def __init__(self, path: str | Path, instance_name: str = "instance", echo_log: bool = False):
+        path = Path(path)
+        if not path.is_file():
+            raise UserError(f"FMU not found: {path} (run `arcosim build` first)")
+        self.path = path
+        self.description = read_model_description(str(path))
+        self.variables = {v.name: v for v in self.description.modelVariables}
+        self.messages: list[str] = []
+        self._echo = echo_log
+        self._unzipped = extract(str(path))
+        self._callbacks = self._make_callbacks()
+        self.slave = FMU2Slave(
+            guid=self.description.guid,
+            unzipDirectory=self._unzipped,
+            modelIdentifier=self.description.coSimulation.modelIdentifier,
+            instanceName=instance_name,
+        )
+        self.slave.instantiate(callbacks=self._callbacks, loggingOn=True)
+        self.slave.setDebugLogging(True, [])
+        self.time = 0.0
+
+    # -- life cycle -------------------------------------------------------------------
+
+    def initialize(
+        self, parameters: Mapping[str, float | int | bool] | None = None, start_time: float = 0.0
+    ) -> None:
+        """Set parameters by name, then run initialization mode at ``start_time`` (s)."""
+        self.slave.setupExperiment(startTime=start_time)
+        self.set(parameters or {})
+        self.slave.enterInitializationMode()
+        self.slave.exitInitializationMode()
+        self.time = start_time
+
+    def do_step(self, t: float, h: float) -> int:
+        """``fmi2DoStep(t, h)``; returns the FMI status (0 ok, 1 warning, 2 discard, …)."""
+        try:
+            self.slave.doStep(t, h)
+        except FMICallException as error:
+            return error.status
+        self.time = t + h
+        return 0
+
+    def close(self) -> None:
+        """Terminate, free the instance and remove the unzipped FMU."""
+        if self.slave is None:
+            return
+        with contextlib.suppress(FMICallException):
+            self.slave.terminate()
+        self.slave.freeInstance()
+        self.slave = None
+        shutil.rmtree(self._unzipped, ignore_errors=True)
+
+    def __enter__(self) -> FmuInstance:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- values -----------------------------------------------------------------------
+
+    def vrs(self, names: Iterable[str]) -> list[int]:
+        """Value references of ``names``; unknown names raise :class:`UserError`."""
+        return [self._variable(n).valueReference for n in names]
+
+    def set(self, values: Mapping[str, float | int | bool]) -> None:
+        """Set variables by name, each with the FMI call of its type."""
+        for name, value in values.items():
+            var = self._variable(name)
+            if var.type == "Real":
+                self.slave.setReal([var.valueReference], [float(value)])
+            elif var.type == "Integer":
+                self.slave.setInteger([var.valueReference], [int(value)])
+            elif var.type == "Boolean":
+                self.slave.setBoolean([var.valueReference], [bool(value)])
+            else:
+                raise UserError(f"{name}: variables of type {var.type} cannot be set here")
+
+    def get(self, names: Sequence[str]) -> list[float]:
+        """Values of ``names`` (Booleans and Integers converted to float)."""
+        out = []
+        for name in names:
+            var = self._variable(name)
+            if var.type == "Real":
+                out.append(self.slave.getReal([var.valueReference])[0])
+            elif var.type == "Integer":
+                out.append(float(self.slave.getInteger([var.valueReference])[0]))
+            else:
+                out.append(float(self.slave.getBoolean([var.valueReference])[0]))
+        return out
+
+    def _variable(self, name: str):
+        try:
+            return self.variables[name]
+        except KeyError:
+            raise UserError(
+                f"{self.path.name} has no variable {name!r} "
+                f"(it has: {', '.join(sorted(self.variables)[:12])}, …)"
+            ) from None
+
+    def _make_callbacks(self) -> fmi2CallbackFunctions:
+        from fmpy import calloc, free
+
+        def logger(env, instance, status, category, message):
+            text = (
+                message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+            )
+            line = f"{STATUS_NAMES[status] if 0 <= status < 6 else status}: {text}"
+            self.messages.append(line)
+            if self._echo:
+                print(line)
+
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self._keep_alive = (logger, c_char_p)
+        return callbacks

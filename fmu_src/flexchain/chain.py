@@ -1,0 +1,46 @@
+"""The motor–spring–mass chain as a linear model.
+
+Bodies 0 … n: body 0 is the motor (inertia ``J_m``), bodies 1 … n the load masses.
+Spring i (1-based) joins body i−1 and body i with stiffness ``k[i-1]`` (N·m/rad)
+and damping ``B[i-1]`` (N·m·s/rad). Sign convention of shared/METHOD.md: the
+torque of spring i is ``τ_i = k_i (θ_{i−1} − θ_i) + B_i (θ̇_{i−1} − θ̇_i)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from flexchain.linalg import Matrix, zeros
+
+
+def spring_matrix(gains: Sequence[float]) -> Matrix:
+    """The ``(n+1) × (n+1)`` Laplacian of a chain of n springs.
+
+    For stiffnesses it is the stiffness matrix K, for dampings the damping matrix:
+    the torque on the bodies is ``−K θ − C θ̇``.
+
+    Args:
+        gains: ``k_1 … k_n`` (or ``B_1 … B_n``), one per spring.
+    """
+    n = len(gains)
+    m = zeros(n + 1, n + 1)
+    for i, g in enumerate(gains, start=1):
+        m[i - 1][i - 1] += g
+        m[i][i] += g
+        m[i - 1][i] -= g
+        m[i][i - 1] -= g
+    return m
+
+
+def spring_torques(
+    k: Sequence[float], B: Sequence[float], theta: Sequence[float], omega: Sequence[float]
+) -> list[float]:
+    """Torques ``τ_1 … τ_n`` (N·m) carried by the springs.
+
+    Args:
+        k, B: per-spring stiffness (N·m/rad) and damping (N·m·s/rad), length n.
+        theta, omega: angles (rad) and velocities (rad/s) of bodies 0 … n.
+    """
+    return [
+        k[i] * (theta[i] - theta[i + 1]) + B[i] * (omega[i] - omega[i + 1]) for i in range(len(k))
+    ]

@@ -1,0 +1,224 @@
+"""Base class of every FMU of the project.
+
+Conventions it settles (see README, "FMU conventions"):
+
+* Values live in one list indexed by value reference; ``get_*``/``set_*`` read and
+  write it directly (no per-variable Python objects on the hot path).
+* A failure is never a Python exception escaping to pythonfmu (that becomes
+  fmi2Fatal). Invalid parameters are found at ``exitInitializationMode``, logged,
+  and every later ``doStep`` answers fmi2Discard with the same message. A bad
+  step (non-finite input, step size ≤ 0, communication point that is not the
+  current time) is refused with fmi2Discard and a log line naming the problem,
+  and leaves the state untouched.
+* Algorithm state is kept in plain JSON-serializable values (floats, ints, lists).
+* Timing contract (shared/METHOD.md): after ``doStep(t, h)`` the outputs are the
+  sample at ``t + h``.
+"""
+
+from __future__ import annotations
+
+import math
+import traceback
+from collections.abc import Sequence
+from typing import ClassVar
+from xml.etree.ElementTree import Element
+
+from pythonfmu import Fmi2Slave
+from pythonfmu.enums import Fmi2Status
+
+from fmukit.model_description import ModelInfo, model_description
+from fmukit.variables import Value, Variable
+
+
+class StepRefusedError(Exception):
+    """Raised by :meth:`FmuSlave.step` to refuse a step with fmi2Discard."""
+
+
+class FmuSlave(Fmi2Slave):
+    """Values by value reference, parameter checks, and failure reporting.
+
+    Subclasses define :meth:`declare`, :meth:`check_parameters`,
+    :meth:`initialize` and :meth:`step`; the FMI plumbing stays here.
+    """
+
+    model_text: ClassVar[str] = ""
+    project_version: ClassVar[str] = "0.0.0"
+    experiment: ClassVar[tuple[float, float, float]] = (0.0, 10.0, 1e-3)
+
+    @classmethod
+    def declare(cls) -> list[Variable]:
+        """Every variable of the FMU, in value-reference order."""
+        raise NotImplementedError
+
+    def check_parameters(self) -> list[str]:
+        """Problems with the parameter values, one sentence each (empty if none)."""
+        return []
+
+    def initialize(self) -> None:
+        """Build the algorithm state from the parameters and set the outputs at t0."""
+
+    def step(self, t: float, h: float) -> None:
+        """Advance from ``t`` to ``t + h`` (s): read inputs, write outputs."""
+        raise NotImplementedError
+
+    # -- construction -------------------------------------------------------------
+
+    def __init__(self, **kwargs: object) -> None:
+        super().__init__(**kwargs)
+        cls = type(self)
+        self.modelName = cls.__name__
+        self.variables: list[Variable] = cls.declare()
+        self.vr: dict[str, int] = {v.name: i for i, v in enumerate(self.variables)}
+        if len(self.vr) != len(self.variables):
+            raise ValueError(f"{cls.__name__}: duplicate variable names")
+        self.v: list[Value] = [var.initial_value for var in self.variables]
+        by_type: dict[str, set[int]] = {"Real": set(), "Integer": set(), "Boolean": set()}
+        for i, var in enumerate(self.variables):
+            by_type[var.type].add(i)
+        self._vrs_of_type = {k: frozenset(s) for k, s in by_type.items()}
+        self._parameters = frozenset(
+            i for i, v in enumerate(self.variables) if v.causality == "parameter"
+        )
+        self._outputs = frozenset(
+            i for i, v in enumerate(self.variables) if v.causality == "output"
+        )
+        self._real_inputs = [
+            i for i, v in enumerate(self.variables) if v.causality == "input" and v.type == "Real"
+        ]
+        self.time: float | None = None
+        self.initialized = False
+        self.problems: list[str] = []
+
+    def to_xml(self, model_options: dict[str, str] | None = None) -> Element:
+        """The compliant model description (called by pythonfmu's builder)."""
+        info = ModelInfo(
+            identifier=self.modelName,
+            description=self.model_text,
+            version=self.project_version,
+            experiment=self.experiment,
+        )
+        options = {k: str(v).lower() for k, v in (model_options or {}).items()}
+        return model_description(info, self.variables, options)
+
+    # -- convenience for subclasses -----------------------------------------------
+
+    def value(self, name: str) -> Value:
+        """Current value of the variable called ``name``."""
+        return self.v[self.vr[name]]
+
+    def values(self, names: Sequence[str]) -> list[Value]:
+        """Current values of several variables, in order."""
+        return [self.v[self.vr[n]] for n in names]
+
+    def indices(self, names: Sequence[str]) -> list[int]:
+        """Value references of several variables, in order."""
+        return [self.vr[n] for n in names]
+
+    def report(self, message: str, status: Fmi2Status = Fmi2Status.error) -> None:
+        """Log ``message`` under the category that matches ``status``."""
+        self.log(f"{self.instance_name}: {message}", status)
+
+    # -- FMI life cycle -----------------------------------------------------------
+
+    def setup_experiment(self, start_time: float, stop_time=None, tolerance=None) -> None:
+        self.time = float(start_time)
+
+    def exit_initialization_mode(self) -> None:
+        self.problems = self._checked(self.check_parameters)
+        if not self.problems:
+            self.problems = self._checked(self.initialize)
+        for problem in self.problems:
+            self.report(problem)
+        self.initialized = True
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self.problems:
+            self.report("cannot step: " + "; ".join(self.problems), Fmi2Status.discard)
+            return False
+        problem = self._step_problem(current_time, step_size)
+        if problem is not None:
+            self.report(problem, Fmi2Status.discard)
+            return False
+        try:
+            self.step(current_time, step_size)
+        except StepRefusedError as refusal:
+            self.report(str(refusal), Fmi2Status.discard)
+            return False
+        except Exception:  # a bug must not become fmi2Fatal in the user's host
+            self.report("internal error, step refused:\n" + traceback.format_exc())
+            return False
+        self.time = current_time + step_size
+        return True
+
+    def _step_problem(self, t: float, h: float) -> str | None:
+        if not (math.isfinite(h) and h > 0.0):
+            return f"step size {h!r} s refused: it must be a finite number > 0"
+        if not math.isfinite(t):
+            return f"communication point {t!r} s refused: it must be finite"
+        if self.time is not None and abs(t - self.time) > 1e-9 * max(1.0, abs(t)):
+            return (
+                f"communication point {t!r} s refused: the FMU is at t = {self.time!r} s "
+                "(restore a saved FMU state to step from another time)"
+            )
+        v = self.v
+        for i in self._real_inputs:
+            if not math.isfinite(v[i]):
+                return f"input {self.variables[i].name} = {v[i]!r} is not finite; step refused"
+        return None
+
+    def _checked(self, function) -> list[str]:
+        try:
+            return list(function() or [])
+        except Exception:
+            return ["internal error during initialization:\n" + traceback.format_exc()]
+
+    # -- value access (called by pythonfmu's binary) -------------------------------
+
+    def get_real(self, vrs: Sequence[int]) -> list[float]:
+        return self._get(vrs, "Real", float)
+
+    def get_integer(self, vrs: Sequence[int]) -> list[int]:
+        return self._get(vrs, "Integer", int)
+
+    def get_boolean(self, vrs: Sequence[int]) -> list[bool]:
+        return self._get(vrs, "Boolean", bool)
+
+    def get_string(self, vrs: Sequence[int]) -> list[str]:
+        self.report(f"this FMU has no String variables (asked for {list(vrs)})")
+        return ["" for _ in vrs]
+
+    def set_real(self, vrs: Sequence[int], values: Sequence[float]) -> None:
+        self._set(vrs, values, "Real", float)
+
+    def set_integer(self, vrs: Sequence[int], values: Sequence[int]) -> None:
+        self._set(vrs, values, "Integer", int)
+
+    def set_boolean(self, vrs: Sequence[int], values: Sequence[bool]) -> None:
+        self._set(vrs, values, "Boolean", bool)
+
+    def set_string(self, vrs: Sequence[int], values: Sequence[str]) -> None:
+        self.report(f"this FMU has no String variables (set {list(vrs)} ignored)")
+
+    def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
+        v = self.v
+        if self._vrs_of_type[vtype].issuperset(vrs):
+            return [v[i] for i in vrs]
+        self.report(f"get{vtype}: value references {list(vrs)} are not all {vtype} variables")
+        return [cast(v[i]) if i in self._vrs_of_type[vtype] else cast(0) for i in vrs]
+
+    def _set(self, vrs: Sequence[int], values: Sequence, vtype: str, cast: type) -> None:
+        v = self.v
+        valid = self._vrs_of_type[vtype]
+        for i, x in zip(vrs, values):
+            if i not in valid:
+                self.report(f"set{vtype}: value reference {i} is not a {vtype} variable; ignored")
+            elif i in self._outputs:
+                self.report(f"{self.variables[i].name} is an output and cannot be set; ignored")
+            elif self.initialized and i in self._parameters:
+                self.report(
+                    f"parameter {self.variables[i].name} is fixed after initialization; "
+                    "the new value is ignored (set it before exitInitializationMode)",
+                    Fmi2Status.warning,
+                )
+            else:
+                v[i] = cast(x)

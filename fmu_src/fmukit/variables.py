@@ -1,0 +1,92 @@
+"""Declarations of FMU variables: name, type, causality, unit, description, start.
+
+A :class:`Variable` is a plain description; :class:`fmukit.slave.FmuSlave` stores
+the values and :func:`fmukit.model_description.model_description` writes the XML.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from fmukit.units import check_unit
+
+VarType = Literal["Real", "Integer", "Boolean"]
+Causality = Literal["parameter", "input", "output"]
+Value = float | int | bool
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One FMI 2.0 scalar variable.
+
+    Attributes:
+        name: FMI structured name, e.g. ``"k[2]"``.
+        type: ``"Real"``, ``"Integer"`` or ``"Boolean"``.
+        causality: ``"parameter"`` (fixed after initialization), ``"input"`` or
+            ``"output"`` (computed by ``doStep``, depending on no input directly).
+        description: one line for the user, with what the value means.
+        unit: unit name from :data:`fmukit.units.UNITS` (Real only; ``"1"`` when
+            dimensionless).
+        start: start value (parameters and inputs); outputs start at ``start`` or 0
+            until the first step.
+    """
+
+    name: str
+    type: VarType
+    causality: Causality
+    description: str
+    unit: str = ""
+    start: Value | None = None
+
+    def __post_init__(self) -> None:
+        if self.type == "Real":
+            check_unit(self.unit or "?")
+        elif self.unit:
+            raise ValueError(f"{self.name}: only Real variables carry a unit")
+        if self.causality in ("parameter", "input") and self.start is None:
+            raise ValueError(f"{self.name}: a {self.causality} needs a start value")
+        if not self.description:
+            raise ValueError(f"{self.name}: every variable needs a description")
+
+    @property
+    def variability(self) -> str:
+        """FMI variability: parameters are ``fixed``; Real signals ``continuous``."""
+        if self.causality == "parameter":
+            return "fixed"
+        return "continuous" if self.type == "Real" else "discrete"
+
+    @property
+    def initial_value(self) -> Value:
+        """The value held before initialization (start, or a typed zero)."""
+        if self.start is not None:
+            return self.start
+        return {"Real": 0.0, "Integer": 0, "Boolean": False}[self.type]
+
+
+def par(name: str, start: Value, unit: str, description: str) -> Variable:
+    """A parameter; its type follows ``start`` (bool → Boolean, int → Integer)."""
+    return Variable(name, _type_of(start), "parameter", description, unit, start)
+
+
+def inp(name: str, start: float, unit: str, description: str) -> Variable:
+    """A Real input."""
+    return Variable(name, "Real", "input", description, unit, float(start))
+
+
+def out(name: str, unit: str, description: str, vtype: VarType = "Real") -> Variable:
+    """An output (Real unless ``vtype`` says otherwise)."""
+    return Variable(name, vtype, "output", description, unit if vtype == "Real" else "")
+
+
+def indexed(name: str, n: int) -> list[str]:
+    """FMI structured names ``name[1] … name[n]`` (1-based, as in the paper)."""
+    return [f"{name}[{i}]" for i in range(1, n + 1)]
+
+
+def _type_of(value: Value) -> VarType:
+    if isinstance(value, bool):
+        return "Boolean"
+    if isinstance(value, int):
+        return "Integer"
+    return "Real"

@@ -1,0 +1,47 @@
+"""Sensor models of the plant: encoder quantization and current noise.
+
+The noise is counter-based (a hash of seed and sample number), so sample k is the
+same whatever happened before it: runs are reproducible for a seed, saving and
+restoring the FMU state needs only the counter, and a C port gives the same bits.
+"""
+
+from __future__ import annotations
+
+import math
+
+_MASK = (1 << 64) - 1
+
+
+def _splitmix64(z: int) -> int:
+    z = (z + 0x9E3779B97F4A7C15) & _MASK
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return z ^ (z >> 31)
+
+
+def gaussian(seed: int, k: int) -> float:
+    """Standard normal sample number ``k`` of stream ``seed`` (Box–Muller).
+
+    Args:
+        seed: stream identifier (any integer).
+        k: sample number (≥ 0).
+    """
+    base = _splitmix64((seed & _MASK) ^ 0x5DEECE66D)
+    a = _splitmix64((base + 2 * k) & _MASK)
+    b = _splitmix64((base + 2 * k + 1) & _MASK)
+    u1 = ((a >> 11) + 1) * 2.0**-53  # (0, 1]
+    u2 = (b >> 11) * 2.0**-53  # [0, 1)
+    return math.sqrt(-2.0 * math.log(u1)) * math.cos(2.0 * math.pi * u2)
+
+
+def quantize(theta: float, counts_per_rev: int) -> float:
+    """Angle (rad) as an incremental encoder reports it: whole counts, floored.
+
+    Args:
+        theta: true angle (rad) relative to the angle at start.
+        counts_per_rev: counts per revolution after quadrature; 0 = ideal encoder.
+    """
+    if counts_per_rev <= 0:
+        return theta
+    step = 2.0 * math.pi / counts_per_rev
+    return math.floor(theta / step) * step
