@@ -171,7 +171,8 @@ def _now() -> str:
 
 
 def _num(x: float) -> str:
-    return f"{float(x):.17g}"
+    """Shortest decimal that reads back as the same double."""
+    return repr(float(x))
 
 
 def _value(x: float | int | bool) -> str:
