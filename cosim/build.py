@@ -43,7 +43,12 @@ class FmuRecipe:
 PLANT = FmuRecipe(
     "MotorChainPlant", "motorchain.fmu:MotorChainPlant", ("fmukit", "flexchain", "motorchain")
 )
-RECIPES = (PLANT,)
+OBSERVER = FmuRecipe(
+    "ReactionTorqueObserver",
+    "arobserver.fmu:ReactionTorqueObserver",
+    ("fmukit", "flexchain", "arobserver"),
+)
+RECIPES = (PLANT, OBSERVER)
 
 
 # pythonfmu 0.7's loader (findClass) re-runs this script with the module's namespace

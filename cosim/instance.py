@@ -118,6 +118,47 @@ class FmuInstance:
             else:
                 raise UserError(f"{name}: variables of type {var.type} cannot be set here")
 
+    def reader(self, names: Sequence[str]):
+        """A function returning ``names`` as floats, with one get call per FMI type."""
+        groups = {"Real": [], "Integer": [], "Boolean": []}
+        for position, name in enumerate(names):
+            var = self._variable(name)
+            groups[var.type].append((position, var.valueReference))
+        calls = [
+            (fn, [p for p, _ in group], [vr for _, vr in group])
+            for fn, group in (
+                (self.slave.getReal, groups["Real"]),
+                (self.slave.getInteger, groups["Integer"]),
+                (self.slave.getBoolean, groups["Boolean"]),
+            )
+            if group
+        ]
+        if len(calls) == 1 and calls[0][0] == self.slave.getReal:
+            get, _, vrs = calls[0]
+            return lambda: get(vrs)
+        size = len(names)
+
+        def read() -> list[float]:
+            out = [0.0] * size
+            for get, positions, vrs in calls:
+                for p, x in zip(positions, get(vrs)):
+                    out[p] = float(x)
+            return out
+
+        return read
+
+    def real_writer(self, names: Sequence[str]):
+        """A function setting the Real variables ``names`` with one ``fmi2SetReal`` call."""
+        vrs = self._real_vrs(names)
+        put = self.slave.setReal
+        return lambda values: put(vrs, values)
+
+    def _real_vrs(self, names: Sequence[str]) -> list[int]:
+        for name in names:
+            if self._variable(name).type != "Real":
+                raise UserError(f"{name} is a {self._variable(name).type}, not a Real variable")
+        return self.vrs(names)
+
     def get(self, names: Sequence[str]) -> list[float]:
         """Values of ``names`` (Booleans and Integers converted to float)."""
         out = []

@@ -5,8 +5,19 @@ Standard library (plus the pythonfmu runtime that every FMU carries) only: this
 package is bundled into each FMU's ``resources/`` folder.
 """
 
+from fmukit.checks import choice_problem, range_problems
 from fmukit.model_description import model_description
 from fmukit.slave import FmuSlave
 from fmukit.variables import Variable, indexed, inp, out, par
 
-__all__ = ["FmuSlave", "Variable", "indexed", "inp", "model_description", "out", "par"]
+__all__ = [
+    "FmuSlave",
+    "Variable",
+    "choice_problem",
+    "indexed",
+    "inp",
+    "model_description",
+    "out",
+    "par",
+    "range_problems",
+]

@@ -58,8 +58,15 @@ class FmuSlave(Fmi2Slave):
         """Build the algorithm state from the parameters and set the outputs at t0."""
 
     def step(self, t: float, h: float) -> None:
-        """Advance from ``t`` to ``t + h`` (s): read inputs, write outputs."""
+        """Advance from ``t`` to ``t + h`` (s): read inputs, write outputs.
+
+        Outputs that are costly and only needed when read may be left stale: set
+        :attr:`stale` and compute them in :meth:`refresh`.
+        """
         raise NotImplementedError
+
+    def refresh(self) -> None:
+        """Bring outputs left stale by :meth:`step` up to date (called before any get)."""
 
     # -- construction -------------------------------------------------------------
 
@@ -86,6 +93,7 @@ class FmuSlave(Fmi2Slave):
             i for i, v in enumerate(self.variables) if v.causality == "input" and v.type == "Real"
         ]
         self.time: float | None = None
+        self.stale = False
         self.initialized = False
         self.problems: list[str] = []
 
@@ -200,6 +208,9 @@ class FmuSlave(Fmi2Slave):
         self.report(f"this FMU has no String variables (set {list(vrs)} ignored)")
 
     def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
+        if self.stale:
+            self.stale = False
+            self.refresh()
         v = self.v
         if self._vrs_of_type[vtype].issuperset(vrs):
             return [v[i] for i in vrs]

@@ -7,10 +7,9 @@ The build (``arcosim build --masses N``) generates a tiny script that fixes
 
 from __future__ import annotations
 
-import math
 from typing import ClassVar
 
-from fmukit import FmuSlave, Variable, indexed, inp, out, par
+from fmukit import FmuSlave, Variable, indexed, inp, out, par, range_problems
 
 from motorchain.physics import PlantPhysics
 from motorchain.sensors import gaussian, quantize
@@ -127,24 +126,19 @@ class MotorChainPlant(FmuSlave):
 
     def check_parameters(self) -> list[str]:
         n = self.n_masses
-        problems = []
-        positive = ["J_m", *indexed("J", n)]
-        non_negative = [
-            "D_m",
-            "f_c",
-            *indexed("k", n),
-            *indexed("B", n),
-            "i_noise_std",
-            "current_bandwidth",
-        ]
-        for name in positive + non_negative + ["k_t"]:
-            x = self.value(name)
-            if not math.isfinite(x):
-                problems.append(f"parameter {name} = {x!r} is not a finite number")
-            elif name in positive and x <= 0.0:
-                problems.append(f"parameter {name} = {x!r} must be > 0")
-            elif name in non_negative and x < 0.0:
-                problems.append(f"parameter {name} = {x!r} must be >= 0")
+        problems = range_problems(
+            self.value,
+            positive=["J_m", *indexed("J", n)],
+            non_negative=[
+                "D_m",
+                "f_c",
+                *indexed("k", n),
+                *indexed("B", n),
+                "i_noise_std",
+                "current_bandwidth",
+            ],
+            finite=["k_t"],
+        )
         if self.value("encoder_cpr") < 0:
             problems.append(
                 f"parameter encoder_cpr = {self.value('encoder_cpr')} must be >= 0 (0 = ideal)"

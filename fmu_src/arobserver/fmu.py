@@ -1,0 +1,228 @@
+"""``ReactionTorqueObserver``: the action-reaction observer as an FMI 2.0 co-simulation FMU.
+
+Inputs are the motor's measured current, velocity and angle (timing contract of
+shared/METHOD.md: the sample at ``t + h`` when the master steps the plant first,
+the sample at ``t`` with Jacobi ordering). All algorithms live in
+:mod:`flexchain`; this class maps FMU variables to them.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from flexchain.dob import Actuator
+from flexchain.observer import (
+    MODEL_BASED,
+    RIGID_IDENTIFICATION,
+    SELF_IDENTIFICATION,
+    STATE_ESTIMATION,
+    Observer,
+    ObserverSettings,
+)
+from fmukit import FmuSlave, Variable, choice_problem, indexed, inp, out, par, range_problems
+
+BENCH_J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
+MODES = {
+    0: "actuator self-identification",
+    1: "rigid-maneuver chain identification",
+    2: "state estimation",
+}
+ESTIMATORS = {0: "the paper's recursion"}
+
+
+def default_inertias(n: int) -> list[float]:
+    """Load inertias (kg·m²): the bench's for n = 3, else the bench's J_1 for each mass."""
+    return list(BENCH_J) if n == 3 else [BENCH_J[0]] * n
+
+
+class ReactionTorqueObserver(FmuSlave):
+    """Disturbance and reaction torque observers, identification and state estimation."""
+
+    n_masses: ClassVar[int] = 3
+    model_text: ClassVar[str] = (
+        "Action-reaction observer (Khalil & Sabanovic) for a motor driving n masses on "
+        "springs, from the motor's current and encoder only: disturbance and reaction "
+        "torque observers, actuator self-identification (mode 0), chain stiffness and "
+        "damping from a rigid maneuver (mode 1), load angles (mode 2)."
+    )
+
+    @classmethod
+    def declare(cls) -> list[Variable]:
+        n = cls.n_masses
+        J = default_inertias(n)
+        return [
+            inp(
+                "i_a",
+                0.0,
+                "A",
+                "Measured motor current: the mean over the step ending at the sample",
+            ),
+            inp("omega_m", 0.0, "rad/s", "Measured motor velocity at the sample"),
+            inp("theta_m", 0.0, "rad", "Measured motor angle at the sample"),
+            par(
+                "mode",
+                STATE_ESTIMATION,
+                "",
+                "0 = actuator self-identification (load detached), 1 = chain identification "
+                "from a rigid maneuver, 2 = state estimation",
+            ),
+            par("J_mo", 2.09e-5, "kg.m2", "Nominal motor inertia"),
+            par("k_to", 0.0406, "N.m/A", "Nominal torque constant"),
+            par("g_dist", 100.0, "rad/s", "Bandwidth of the disturbance observer G(s) = g/(s+g)"),
+            par(
+                "g_lpf", 100.0, "rad/s", "Bandwidth of the filter on later stages of the recursion"
+            ),
+            par("dkt", 0.0, "N.m/A", "Torque-constant error k_t - k_to (result of mode 0)"),
+            par("dJm", 0.0, "kg.m2", "Motor inertia error J_m - J_mo (result of mode 0)"),
+            par("D_m", 0.0, "N.m.s/rad", "Motor viscous friction (result of mode 0)"),
+            par("f_c", 0.0, "N.m", "Motor Coulomb friction (result of mode 0)"),
+            *(
+                par(name, J[i - 1], "kg.m2", f"Known inertia of load mass {i}")
+                for i, name in enumerate(indexed("J", n), start=1)
+            ),
+            *(
+                par(name, 0.1627, "N.m/rad", f"Stiffness of spring {i}, used in mode 2")
+                for i, name in enumerate(indexed("k", n), start=1)
+            ),
+            *(
+                par(name, 8.88e-6, "N.m.s/rad", f"Damping of spring {i}, used in mode 2")
+                for i, name in enumerate(indexed("B", n), start=1)
+            ),
+            par(
+                "kappa_correction",
+                True,
+                "",
+                "Mode 1: multi-mass correction kappa (shared/METHOD.md); false gives the "
+                "paper's literal eq. 21",
+            ),
+            par(
+                "estimator",
+                0,
+                "",
+                "Mode 2: 0 = the paper's recursion (eq. 22-26); 1 = model-based observer "
+                "(not available in this version; refused)",
+            ),
+            par(
+                "omega_min",
+                5.0,
+                "rad/s",
+                "Mode 0: speed below which the motor counts as stopped; such samples and the "
+                "5/g_dist s after them are left out of the fit",
+            ),
+            par(
+                "g_id",
+                30.0,
+                "rad/s",
+                "Mode 0: bandwidth of an extra low-pass on the fit's target and regressors "
+                "(reduces encoder noise in the acceleration); 0 = off",
+            ),
+            out("d_hat", "N.m", "Estimated disturbance d (eq. 9, DOB)"),
+            out("tau_reac_hat", "N.m", "Estimated reaction torque (eq. 16)"),
+            out("alpha_m_hat", "rad/s2", "Motor acceleration through G(s)"),
+            out("dkt_hat", "N.m/A", "Mode 0: estimated k_t - k_to (0 when it had to be fixed)"),
+            out("dJm_hat", "kg.m2", "Mode 0: estimated J_m - J_mo"),
+            out("D_m_hat", "N.m.s/rad", "Mode 0: estimated motor viscous friction"),
+            out("f_c_hat", "N.m", "Mode 0: estimated motor Coulomb friction"),
+            out(
+                "self_id_rank_deficient",
+                "",
+                "Mode 0: current, velocity and acceleration were collinear (free motor), so "
+                "k_t was fixed to k_to",
+                "Boolean",
+            ),
+            out("k_hat", "N.m/rad", "Mode 1: estimated spring stiffness"),
+            out("B_hat", "N.m.s/rad", "Mode 1: estimated spring damping"),
+            out("theta_rigid_hat", "rad", "Mode 1: estimated rigid motion (eq. 20)"),
+            *(
+                out(name, "rad", f"Mode 2: estimated angle of load mass {i}")
+                for i, name in enumerate(indexed("theta_hat", n), start=1)
+            ),
+            *(
+                out(name, "rad/s", f"Mode 2: estimated velocity of load mass {i}")
+                for i, name in enumerate(indexed("omega_hat", n), start=1)
+            ),
+            out(
+                "id_valid",
+                "",
+                "Mode 0/1: the fit has at least 40 samples and its scaled normal matrix a "
+                "reciprocal condition number >= 1e-10 (mode 1: and k_hat > 0)",
+                "Boolean",
+            ),
+        ]
+
+    def check_parameters(self) -> list[str]:
+        n = self.n_masses
+        problems = range_problems(
+            self.value,
+            positive=["J_mo", "k_to", "g_dist", "g_lpf", *indexed("J", n), *indexed("k", n)],
+            non_negative=["D_m", "f_c", *indexed("B", n), "omega_min", "g_id"],
+            finite=["dkt", "dJm"],
+        )
+        if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
+            problems.append("parameters J_mo + dJm must be > 0 (the motor inertia)")
+        for problem in (
+            choice_problem("mode", self.value("mode"), MODES),
+            choice_problem("estimator", self.value("estimator"), ESTIMATORS),
+        ):
+            if problem is not None:
+                problems.append(problem)
+        if self.value("estimator") == MODEL_BASED:
+            problems[-1] += "; the model-based observer comes in a later version"
+        return problems
+
+    def initialize(self) -> None:
+        n = self.n_masses
+        v = self.value
+        settings = ObserverSettings(
+            mode=v("mode"),
+            actuator=Actuator(v("J_mo"), v("k_to"), v("dkt"), v("dJm"), v("D_m"), v("f_c")),
+            g_dist=v("g_dist"),
+            g_lpf=v("g_lpf"),
+            J=tuple(self.values(indexed("J", n))),
+            k=tuple(self.values(indexed("k", n))),
+            B=tuple(self.values(indexed("B", n))),
+            kappa_correction=bool(v("kappa_correction")),
+            estimator=v("estimator"),
+            omega_min=v("omega_min"),
+            g_id=v("g_id"),
+        )
+        self.observer = Observer(settings, v("theta_m"), v("omega_m"))
+        self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
+        self.out_theta = self.indices(indexed("theta_hat", n))
+        self.out_omega = self.indices(indexed("omega_hat", n))
+        if settings.mode == STATE_ESTIMATION:
+            for i in self.out_theta:
+                self.v[i] = v("theta_m")
+
+    def step(self, t: float, h: float) -> None:
+        v = self.v
+        i_a, omega, theta = (v[i] for i in self.inputs)
+        obs = self.observer
+        obs.step(h, i_a, omega, theta)
+        vr = self.vr
+        v[vr["d_hat"]] = obs.dob.d_hat
+        v[vr["tau_reac_hat"]] = obs.dob.tau_reac_hat
+        v[vr["alpha_m_hat"]] = obs.dob.alpha_hat
+        if obs.estimator is not None:
+            for i, x in zip(self.out_theta, obs.estimator.theta):
+                v[i] = x
+            for i, x in zip(self.out_omega, obs.estimator.omega):
+                v[i] = x
+        else:
+            self.stale = True  # identification is solved when an output is read
+
+    def refresh(self) -> None:
+        obs = self.observer
+        obs.estimate()
+        ident, v, vr = obs.identifier, self.v, self.vr
+        if obs.settings.mode == SELF_IDENTIFICATION:
+            v[vr["dkt_hat"]] = ident.dkt
+            v[vr["dJm_hat"]] = ident.dJm
+            v[vr["D_m_hat"]] = ident.D_m
+            v[vr["f_c_hat"]] = ident.f_c
+            v[vr["self_id_rank_deficient"]] = ident.rank_deficient
+        elif obs.settings.mode == RIGID_IDENTIFICATION:
+            v[vr["k_hat"]] = ident.k
+            v[vr["B_hat"]] = ident.B
+            v[vr["theta_rigid_hat"]] = ident.theta_rigid
+        v[vr["id_valid"]] = ident.valid

@@ -1,0 +1,140 @@
+"""Disturbance observer (eq. 8–9) and reaction torque observer (eq. 16).
+
+Sign convention of shared/METHOD.md. The nominal motor model is
+``J_mo θ̈_m = k_to i_a − d``; the discrete form pairs the velocity change over a
+step with the current that acted over that same step (METHOD.md: low-passing
+``k_to i + g J_mo θ̇`` and subtracting ``g J_mo θ̇`` leaves ~10 % error):
+
+    α_k = (ω_k − ω_{k−1}) / h                      (rad/s²)
+    v_k = (θ_k − θ_{k−1}) / h                      (rad/s, mean velocity over the step)
+    d̂  = G[k_to i_k − J_mo α_k]
+    τ̂_reac = G[(k_to + Δk_t) i_k − (J_mo + ΔJ) α_k − D v_k − f_c sgn(v_k)]
+
+so ``τ̂_reac = d̂ − G[D θ̇ + f_c sgn θ̇ − Δk_t i + ΔJ θ̈]`` (eq. 16).
+
+Coulomb friction over a step uses the mean sign of the velocity, taken linear
+between the two samples (:func:`mean_sign`), so a reversal inside a step counts
+for the fraction of the step on each side. Over a step that starts or ends with
+the motor standing still (``ω_{k−1} = 0`` or ``ω_k = 0``) static friction hides
+the reaction torque: it is only known to lie within ``±f_c`` of the drive torque, and the
+observer keeps the value in that interval closest to its previous estimate
+(a motor stuck at rest with the chain at rest gives exactly 0, not ``k_t i``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """Nominal and identified actuator terms.
+
+    Attributes:
+        J_mo: nominal motor inertia (kg·m²).
+        k_to: nominal torque constant (N·m/A).
+        dkt: k_t − k_to (N·m/A).
+        dJm: J_m − J_mo (kg·m²).
+        D_m: motor viscous friction (N·m·s/rad).
+        f_c: motor Coulomb friction (N·m).
+    """
+
+    J_mo: float
+    k_to: float
+    dkt: float = 0.0
+    dJm: float = 0.0
+    D_m: float = 0.0
+    f_c: float = 0.0
+
+
+def sign(x: float) -> float:
+    """−1, 0 or +1."""
+    return (x > 0.0) - (x < 0.0)
+
+
+def mean_sign(w0: float, w1: float) -> float:
+    """Mean of sgn ω over a step where ω goes linearly from ``w0`` to ``w1`` (rad/s)."""
+    if w0 >= 0.0 and w1 >= 0.0:
+        return 1.0 if (w0 > 0.0 or w1 > 0.0) else 0.0
+    if w0 <= 0.0 and w1 <= 0.0:
+        return -1.0
+    r = w0 / (w0 - w1)  # fraction of the step before the reversal
+    return sign(w0) * (2.0 * r - 1.0)
+
+
+def clamp(x: float, bound: float) -> float:
+    """``x`` limited to ``[−bound, bound]``."""
+    return -bound if x < -bound else (bound if x > bound else x)
+
+
+class ReactionObserver:
+    """DOB and reaction torque observer on one filter bank ``G(s) = g/(s+g)``.
+
+    Args:
+        actuator: nominal and identified actuator terms.
+        g: observer bandwidth ``g_dist`` (rad/s).
+        theta0: motor angle at start (rad).
+        omega0: motor velocity at start (rad/s).
+
+    Attributes (after :meth:`step`):
+        d_hat: disturbance estimate (N·m).
+        tau_reac_hat: reaction torque estimate (N·m).
+        alpha_hat: low-passed motor acceleration (rad/s²).
+        accel: unfiltered velocity change over the last step / h (rad/s²).
+        velocity: mean velocity over the last step (rad/s).
+        friction_sign: mean of sgn θ̇ over the last step (:func:`mean_sign`).
+        sticking: the motor stood still at one end of the last step, so static
+            friction (unknown within ±f_c) may have acted during it.
+        torque: the unfiltered reaction torque of the last step (N·m).
+        drive: the torque on the motor other than Coulomb friction over the last
+            step, ``k_t i − J_m α − D v`` (N·m): the reaction torque is
+            ``drive − f_c · friction_sign`` when the motor moved throughout.
+    """
+
+    def __init__(self, actuator: Actuator, g: float, theta0: float, omega0: float) -> None:
+        self.actuator = actuator
+        self.g = g
+        self.theta = theta0
+        self.omega = omega0
+        self.d_hat = 0.0
+        self.tau_reac_hat = 0.0
+        self.alpha_hat = 0.0
+        self.accel = 0.0
+        self.velocity = omega0
+        self.torque = 0.0
+        self.drive = 0.0
+        self.friction_sign = 0.0
+        self.sticking = False
+        self._kt = actuator.k_to + actuator.dkt
+        self._jm = actuator.J_mo + actuator.dJm
+
+    def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
+        """Take the sample (i_a, ω, θ) that ends a step of ``h`` seconds.
+
+        Args:
+            h: time since the previous sample (s), > 0.
+            i_a: current that acted over the step (A).
+            omega: motor velocity at the sample (rad/s).
+            theta: motor angle at the sample (rad).
+        """
+        act = self.actuator
+        accel = (omega - self.omega) / h
+        velocity = (theta - self.theta) / h
+        a = math.exp(-self.g * h)
+        b = 1.0 - a
+        self.d_hat = a * self.d_hat + b * (act.k_to * i_a - act.J_mo * accel)
+        self.drive = drive = self._kt * i_a - self._jm * accel - act.D_m * velocity
+        self.friction_sign = mean_sign(self.omega, omega)
+        self.sticking = omega == 0.0 or self.omega == 0.0
+        if self.sticking:
+            torque = drive - clamp(drive - self.torque, act.f_c)
+        else:
+            torque = drive - act.f_c * self.friction_sign
+        self.torque = torque
+        self.tau_reac_hat = a * self.tau_reac_hat + b * torque
+        self.alpha_hat = a * self.alpha_hat + b * accel
+        self.accel = accel
+        self.velocity = velocity
+        self.omega = omega
+        self.theta = theta

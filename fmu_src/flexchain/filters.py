@@ -1,0 +1,61 @@
+"""First-order low-pass filters discretized exactly for the step actually taken.
+
+``G(s) = g / (s + g)`` with its input held over each step (the timing contract of
+shared/METHOD.md: a sample carries what acted over the step that ends there):
+
+    y_k = e^{−g h} y_{k−1} + (1 − e^{−g h}) u_k
+
+is exact for any step ``h``, so steps may vary from one sample to the next.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+class LowPass:
+    """``G(s) = g / (s + g)``, zero initial state.
+
+    Args:
+        g: corner frequency (rad/s), > 0.
+
+    Attributes:
+        y: the filter output (same unit as the input).
+    """
+
+    __slots__ = ("g", "y")
+
+    def __init__(self, g: float) -> None:
+        self.g = g
+        self.y = 0.0
+
+    def step(self, h: float, u: float) -> float:
+        """Advance by ``h`` (s) with input ``u`` held over the step; return the output."""
+        a = math.exp(-self.g * h)
+        self.y = a * self.y + (1.0 - a) * u
+        return self.y
+
+
+class LowPassBank:
+    """Several filters with one corner frequency, advanced together.
+
+    Args:
+        g: corner frequency (rad/s), > 0.
+        size: number of channels.
+
+    Attributes:
+        y: outputs, one per channel.
+    """
+
+    __slots__ = ("g", "y")
+
+    def __init__(self, g: float, size: int) -> None:
+        self.g = g
+        self.y = [0.0] * size
+
+    def step(self, h: float, u: list[float]) -> list[float]:
+        """Advance every channel by ``h`` (s) with inputs ``u``; return the outputs."""
+        a = math.exp(-self.g * h)
+        b = 1.0 - a
+        self.y = [a * y + b * x for y, x in zip(self.y, u)]
+        return self.y

@@ -1,0 +1,132 @@
+"""Least squares from normal equations accumulated one sample at a time.
+
+Memory is constant (a p × p matrix and a p-vector) however long the record, an
+estimate exists after every sample, and the final estimate is the batch
+least-squares solution of the same rows.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from flexchain.linalg import solve
+
+#: Below this reciprocal condition number (of the normal matrix scaled to unit
+#: diagonal) a fit is called ill-conditioned.
+RCOND_MIN = 1e-10
+
+
+class NormalEquations:
+    """Accumulated ``XᵀX`` and ``Xᵀy`` of a linear regression ``y ≈ X β``.
+
+    Args:
+        p: number of regressors.
+    """
+
+    def __init__(self, p: int) -> None:
+        self.p = p
+        self.xtx = [[0.0] * p for _ in range(p)]
+        self.xty = [0.0] * p
+        self.count = 0
+
+    def add(self, x: Sequence[float], y: float, weight: float = 1.0) -> None:
+        """Add one row ``x`` (length p) with target ``y``."""
+        for r, xr in enumerate(x):
+            if xr != 0.0:
+                wxr = weight * xr
+                row = self.xtx[r]
+                for c in range(r, self.p):
+                    row[c] += wxr * x[c]
+                self.xty[r] += wxr * y
+        self.count += 1
+
+    def solve(self, columns: Sequence[int] | None = None) -> tuple[list[float], float]:
+        """Least-squares coefficients over ``columns`` (default all), others fixed at 0.
+
+        Returns:
+            ``(beta, rcond)``: coefficients of length p (0 for columns left out, and
+            all 0 when the system is singular), and the reciprocal condition number
+            of the normal matrix scaled to unit diagonal (0 when singular).
+        """
+        cols = list(range(self.p)) if columns is None else list(columns)
+        beta = [0.0] * self.p
+        if self.count == 0:
+            return beta, 0.0
+        sub, rcond = solve_normal(
+            [[self.entry(r, c) for c in cols] for r in cols], [self.xty[r] for r in cols]
+        )
+        for i, c in enumerate(cols):
+            beta[c] = sub[i]
+        return beta, rcond
+
+    def entry(self, r: int, c: int) -> float:
+        """Element (r, c) of the symmetric ``XᵀX``."""
+        return self.xtx[r][c] if r <= c else self.xtx[c][r]
+
+
+def reciprocal_condition(a: list[list[float]]) -> float:
+    """1-norm reciprocal condition number of a small symmetric matrix (exact inverse)."""
+    n = len(a)
+    try:
+        inv = solve(a, [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)])
+    except ValueError:
+        return 0.0
+    norm = max(sum(abs(a[i][j]) for i in range(n)) for j in range(n))
+    norm_inv = max(sum(abs(inv[i][j]) for i in range(n)) for j in range(n))
+    if not (math.isfinite(norm_inv) and norm > 0.0 and norm_inv > 0.0):
+        return 0.0
+    return 1.0 / (norm * norm_inv)
+
+
+def eliminate(
+    equations: NormalEquations, keep: Sequence[int], drop: Sequence[int]
+) -> tuple[list[list[float]], list[float]] | None:
+    """Normal equations of the ``keep`` coefficients with the ``drop`` ones solved out.
+
+    The Schur complement ``A − C D⁻¹ Cᵀ`` and ``b₁ − C D⁻¹ b₂``: adding these to other
+    equations gives the least-squares fit in which the dropped coefficients are
+    free (nuisance parameters of this block of rows only).
+
+    Returns:
+        ``(xtx, xty)`` over ``keep``, or None when the dropped block is singular
+        (too few rows to fix the nuisance parameters; the block carries no information).
+    """
+    m = equations.entry
+    d = [[m(r, c) for c in drop] for r in drop]
+    if reciprocal_condition(d) < 1e-13:
+        return None
+    c_t = [[m(r, c) for c in keep] for r in drop]  # D-rows × keep-columns
+    rhs = [[*c_t[i], equations.xty[r]] for i, r in enumerate(drop)]
+    try:
+        z = solve(d, rhs)  # D⁻¹ [Cᵀ | b₂]
+    except ValueError:
+        return None
+    nk = len(keep)
+    xtx = [
+        [
+            m(keep[i], keep[j]) - sum(c_t[q][i] * z[q][j] for q in range(len(drop)))
+            for j in range(nk)
+        ]
+        for i in range(nk)
+    ]
+    xty = [
+        equations.xty[keep[i]] - sum(c_t[q][i] * z[q][nk] for q in range(len(drop)))
+        for i in range(nk)
+    ]
+    return xtx, xty
+
+
+def solve_normal(xtx: list[list[float]], xty: list[float]) -> tuple[list[float], float]:
+    """Solve small normal equations; return ``(beta, rcond)`` (zeros and 0 when singular)."""
+    p = len(xty)
+    diag = [xtx[i][i] for i in range(p)]
+    if min(diag) <= 0.0:
+        return [0.0] * p, 0.0
+    scale = [1.0 / math.sqrt(x) for x in diag]
+    scaled = [[xtx[i][j] * scale[i] * scale[j] for j in range(p)] for i in range(p)]
+    rcond = reciprocal_condition(scaled)
+    if rcond == 0.0:
+        return [0.0] * p, 0.0
+    z = solve(scaled, [[xty[i] * scale[i]] for i in range(p)])
+    return [z[i][0] * scale[i] for i in range(p)], rcond

@@ -1,0 +1,77 @@
+"""State estimation by the paper's recursion along the chain (eq. 22–26).
+
+From the torque τ_i entering spring i and the angle θ_{i−1} before it, the spring's
+deflection is ``δ_i = τ_i / (B_i s + k_i)`` (pole at −k_i/B_i, stable; the paper's
+printed exponents have the wrong sign), so ``θ_i = θ_{i−1} − δ_i``, and the next
+spring carries ``τ_{i+1} = τ_i − J_i θ̈_i``. Start: ``τ_1 = τ̂_reac`` and
+``θ_0 = G[θ_m]`` (the motor angle through the DOB's own ``G(s)``, so that both
+carry the same lag). Each later stage passes its torque and angle through one
+more ``G_lpf(s) = g_lpf / (s + g_lpf)``, as the paper filters θ̈.
+
+Expect stage 1 to work and later stages to amplify errors (METHOD.md: J_i ω²/k ≫ 1
+above the first mode).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+
+class ChainRecursion:
+    """Angles and velocities of the n load masses from τ̂_reac and θ_m.
+
+    Args:
+        J, k, B: per mass / spring inertia (kg·m²), stiffness (N·m/rad, > 0) and
+            damping (N·m·s/rad, ≥ 0), length n.
+        g_dist: DOB bandwidth (rad/s), for ``G[θ_m]``.
+        g_lpf: bandwidth of the filter on later stages (rad/s).
+        theta0: motor angle at start (rad); the chain starts at rest, aligned.
+
+    Attributes (after :meth:`step`):
+        theta: estimated angles θ̂_1 … θ̂_n (rad).
+        omega: estimated velocities (rad/s), backward differences of ``theta``.
+    """
+
+    def __init__(
+        self,
+        J: Sequence[float],
+        k: Sequence[float],
+        B: Sequence[float],
+        g_dist: float,
+        g_lpf: float,
+        theta0: float,
+    ) -> None:
+        n = len(J)
+        self.J, self.k, self.B = list(J), list(k), list(B)
+        self.g_dist, self.g_lpf = g_dist, g_lpf
+        self.theta_m_filtered = theta0
+        self.deflection = [0.0] * n
+        self.theta = [theta0] * n
+        self.omega = [0.0] * n
+        self.torque_next = [0.0] * n  # G_lpf[τ_i − J_i θ̈_i], feeds stage i+1
+        self.angle_next = [theta0] * n  # G_lpf[θ̂_i], feeds stage i+1
+
+    def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
+        """Take the sample that ends a step of ``h`` s."""
+        a0 = math.exp(-self.g_dist * h)
+        self.theta_m_filtered = a0 * self.theta_m_filtered + (1.0 - a0) * theta_m
+        a = math.exp(-self.g_lpf * h)
+        b = 1.0 - a
+        torque, angle_before = tau_reac_hat, self.theta_m_filtered
+        n = len(self.J)
+        for i in range(n):
+            k, B = self.k[i], self.B[i]
+            if B > 0.0:
+                e = math.exp(-k / B * h)
+                self.deflection[i] = e * self.deflection[i] + (1.0 - e) * torque / k
+            else:
+                self.deflection[i] = torque / k
+            theta = angle_before - self.deflection[i]
+            omega = (theta - self.theta[i]) / h
+            accel = (omega - self.omega[i]) / h
+            self.theta[i], self.omega[i] = theta, omega
+            if i + 1 < n:
+                self.torque_next[i] = a * self.torque_next[i] + b * (torque - self.J[i] * accel)
+                self.angle_next[i] = a * self.angle_next[i] + b * theta
+                torque, angle_before = self.torque_next[i], self.angle_next[i]
