@@ -52,15 +52,18 @@ RECIPES = (PLANT, OBSERVER)
 
 
 # pythonfmu 0.7's loader (findClass) re-runs this script with the module's namespace
-# as globals and then releases one reference to that namespace it never owned, once
-# per fmi2Instantiate. A script that defines no functions of its own holds too few
-# references, so the namespace is freed and the second instantiation in a process
-# fails ("module has no attribute ..."). Holding one more reference each time the
-# script runs keeps the count steady (checked over 40 instantiations with GC).
+# as globals and then releases one reference to that namespace it never took, once
+# per fmi2Instantiate. A thin script like ours holds few references, so the
+# namespace is freed and the second instantiation in a process fails ("module has
+# no attribute ..."). Taking one reference each time the script runs cancels the
+# stray release exactly. (Holding the extra references in a list inside the
+# namespace is wrong: the list is a cycle that the GC clears at exit, releasing
+# references the count no longer has: a use-after-free, seen as "corrupted
+# double-linked list" at interpreter exit.)
 _NAMESPACE_GUARD = (
-    "# Keeps pythonfmu 0.7 from freeing this namespace (see cosim/build.py).\n"
-    '_NAMESPACE_REFS = globals().setdefault("_NAMESPACE_REFS", [])\n'
-    "_NAMESPACE_REFS.append(globals())\n"
+    "# Cancels pythonfmu 0.7's stray release of this namespace (see cosim/build.py).\n"
+    "import ctypes as _ctypes\n"
+    "_ctypes.pythonapi.Py_IncRef(_ctypes.py_object(globals()))\n"
 )
 
 

@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
-from flexchain.linalg import expm, matmul, matvec, solve
 from scipy.linalg import expm as scipy_expm
+
+from flexchain.linalg import expm, matmul, matvec, solve
 
 
 @pytest.mark.parametrize("scale", [1e-3, 0.3, 5.0, 400.0])

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from motorchain.physics import PlantPhysics
 from scipy.integrate import solve_ivp
+
+from motorchain.physics import PlantPhysics
 
 BENCH = {
     "J_m": 2.09e-5,

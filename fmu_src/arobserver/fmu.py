@@ -126,8 +126,8 @@ class ReactionTorqueObserver(FmuSlave):
             out(
                 "self_id_rank_deficient",
                 "",
-                "Mode 0: current, velocity and acceleration were collinear (free motor), so "
-                "k_t was fixed to k_to",
+                "Mode 0: the fit cannot separate k_t from J_m (free motor: collinear "
+                "regressors, or a fitted k_t outside [k_to/2, 2 k_to]), so k_t = k_to was fixed",
                 "Boolean",
             ),
             out("k_hat", "N.m/rad", "Mode 1: estimated spring stiffness"),

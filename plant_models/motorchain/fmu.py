@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import ClassVar
 
 from fmukit import FmuSlave, Variable, indexed, inp, out, par, range_problems
-
 from motorchain.physics import PlantPhysics
 from motorchain.sensors import gaussian, quantize
 
