@@ -15,12 +15,9 @@ $(STAMP): pyproject.toml
 
 build: $(STAMP)
 	$(BIN)/arcosim build
-	$(BIN)/arcosim build --masses 1
-	$(BIN)/arcosim build --masses 5
-	$(BIN)/arcosim build --masses 20
 
-demo: $(STAMP)
-	$(BIN)/arcosim demo
+demo: build
+	$(BIN)/arcosim reproduce
 
 test: build
 	$(BIN)/ruff check .

@@ -125,6 +125,14 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
     return [build_fmu(recipe, n, target) for recipe in RECIPES]
 
 
+def ensure_built(n: int = 3, out: Path | None = None) -> Path:
+    """Folder holding the FMUs for n masses, building them first if any is missing."""
+    target = out if out is not None else default_out_dir(n)
+    if not all((target / f"{r.name}.fmu").is_file() for r in RECIPES):
+        build_all(n, target)
+    return target
+
+
 def _package_dir(name: str) -> Path:
     module = importlib.import_module(name)
     return Path(module.__file__).parent

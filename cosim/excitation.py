@@ -9,31 +9,43 @@ from __future__ import annotations
 import numpy as np
 
 
-def raised_cosine_window(t: np.ndarray, duration: float, ramp: float) -> np.ndarray:
-    """1 in the middle, raised-cosine ramps of ``ramp`` s at both ends, 0 outside [0, duration]."""
-    w = np.ones_like(t, dtype=float)
-    up = t < ramp
-    w[up] = 0.5 - 0.5 * np.cos(np.pi * t[up] / ramp)
-    down = t > duration - ramp
-    w[down] = 0.5 - 0.5 * np.cos(np.pi * (duration - t[down]) / ramp)
-    w[(t < 0) | (t > duration)] = 0.0
-    return w
+def raised_cosine_window(
+    t: np.ndarray, duration: float, ramp: float, derivative: int = 0
+) -> np.ndarray:
+    """Window that rises over ``ramp`` s as a raised cosine, holds 1, and falls over the
+    last ``ramp`` s of ``duration``; 0 outside. ``derivative`` = 1 or 2 gives its
+    first or second time derivative (1/s, 1/s²)."""
+    t = np.asarray(t, dtype=float)
+    k = np.pi / ramp
+    out = np.zeros_like(t) if derivative else np.ones_like(t)
+    for part, tau, sign in ((t < ramp, t, 1.0), (t > duration - ramp, duration - t, -1.0)):
+        x = tau[part]
+        if derivative == 0:
+            out[part] = 0.5 - 0.5 * np.cos(k * x)
+        elif derivative == 1:
+            out[part] = sign * 0.5 * k * np.sin(k * x)
+        else:
+            out[part] = 0.5 * k * k * np.cos(k * x)
+    out[(t < 0) | (t > duration)] = 0.0
+    return out
 
 
 def rigid_maneuver(
     t: np.ndarray,
-    amplitude: float = 2.0,
+    amplitude: float = 3.0,
     frequency: float = 2.1,
     periods: int = 8,
     ramp_periods: int = 3,
 ) -> np.ndarray:
     """Back-and-forth maneuver far below the first mode, without drift or ringing.
 
-    A cosine current at ``frequency`` (rad/s; default about an eighth of the
-    bench's first mode, 16.8 rad/s) under a raised-cosine window of
-    ``ramp_periods`` periods each side: the cosine phase gives the velocity a zero
-    mean, so the chain swings about its start instead of drifting away, and the
-    smooth window keeps energy away from the resonances (shared/METHOD.md).
+    The motion is ``p(t) = w(t) sin(ω t)`` with ``w`` a raised-cosine window of
+    ``ramp_periods`` periods each side, and the current is proportional to its
+    acceleration, ``i = −(amplitude / ω²) p̈``: p and ṗ vanish at both ends, so the
+    current's first and second integrals vanish too and the chain swings about its
+    start and comes back to rest there (a windowed cosine current would leave it
+    several radians away). The smooth window keeps energy away from the resonances
+    (shared/METHOD.md); ω defaults to about an eighth of the bench's first mode.
 
     The amplitude must be well above the current that overcomes the motor's
     Coulomb friction (f_c / k_t ≈ 0.05 A on the bench): the motor sticks at every
@@ -44,14 +56,18 @@ def rigid_maneuver(
 
     Args:
         t: step times (s).
-        amplitude: peak current (A).
-        frequency: maneuver frequency (rad/s).
+        amplitude: peak current (A), reached in the middle part.
+        frequency: maneuver frequency ω (rad/s).
         periods: total length in periods (ramps included).
         ramp_periods: length of each ramp in periods.
     """
     period = 2 * np.pi / frequency
-    window = raised_cosine_window(t, periods * period, ramp_periods * period)
-    return amplitude * window * np.cos(frequency * t)
+    duration, ramp = periods * period, ramp_periods * period
+    w = raised_cosine_window(t, duration, ramp)
+    w1 = raised_cosine_window(t, duration, ramp, derivative=1)
+    w2 = raised_cosine_window(t, duration, ramp, derivative=2)
+    s, c = np.sin(frequency * t), np.cos(frequency * t)
+    return amplitude * (w * s - (2.0 / frequency) * w1 * c - w2 * s / frequency**2)
 
 
 def multisine(

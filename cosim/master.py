@@ -15,7 +15,7 @@ Orderings (both honour the timing contract of shared/METHOD.md):
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +49,7 @@ def cosimulate(
     observer_parameters: Mapping[str, float | int | bool] | None = None,
     ordering: str = "gauss-seidel",
     t0: float = 0.0,
+    progress: Callable[[int], None] | None = None,
 ) -> Recording:
     """Run plant and observer for ``len(i_ref)`` steps of ``h`` seconds.
 
@@ -60,6 +61,7 @@ def cosimulate(
         plant_parameters, observer_parameters: start values by variable name.
         ordering: ``"gauss-seidel"`` or ``"jacobi"`` (see module doc).
         t0: start time (s).
+        progress: called with the number of steps done, every 1000 steps and at the end.
 
     Returns:
         The recording, sample 0 being the values after initialization at t0;
@@ -99,6 +101,10 @@ def cosimulate(
             plant_log[k + 1] = read_plant()
         if record_observer:
             observer_log[k + 1] = read_observer()
+        if progress is not None and (k + 1) % 1000 == 0:
+            progress(1000)
+    if progress is not None and steps % 1000:
+        progress(steps % 1000)
     recording = Recording(time=t0 + np.arange(steps + 1) * h)
     for j, name in enumerate(record_plant):
         recording.signals[f"plant.{name}"] = plant_log[:, j]

@@ -1,0 +1,125 @@
+"""Recorded drive logs: reading, checking and scaling, and writing recordings as CSV.
+
+A log is a CSV file with a header row and at least the columns ``time`` (s),
+``i_a`` (A), ``omega_m`` (rad/s) and ``theta_m`` (rad), one row per sample as the
+timing contract of shared/METHOD.md defines it: the angle and velocity at ``time``
+and the current that acted over the step ending at ``time``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from cosim.errors import UserError
+
+LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
+
+
+@dataclass(frozen=True)
+class DriveLog:
+    """A checked log: ``time`` strictly increasing, every value finite, SI units."""
+
+    path: Path
+    columns: dict[str, np.ndarray]
+
+    @property
+    def time(self) -> np.ndarray:
+        return self.columns["time"]
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+
+def parse_scales(texts: Iterable[str]) -> dict[str, float]:
+    """``["i_a=0.001", ...]`` → ``{"i_a": 0.001}`` (factor to SI); checks each."""
+    scales = {}
+    for text in texts:
+        column, sep, factor = text.partition("=")
+        try:
+            value = float(factor)
+        except ValueError:
+            value = math.nan
+        if not sep or column not in LOG_COLUMNS or not math.isfinite(value) or value == 0.0:
+            raise UserError(
+                f"--scale {text!r}: write COLUMN=FACTOR with COLUMN one of "
+                f"{', '.join(LOG_COLUMNS)} and a finite, non-zero FACTOR (e.g. i_a=0.001 for mA)"
+            )
+        scales[column] = value
+    return scales
+
+
+def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> DriveLog:
+    """Read and check a log; raise :class:`UserError` naming the row or column at fault.
+
+    Args:
+        path: CSV file with a header row.
+        scales: factors that convert a column to SI (``{"i_a": 1e-3}`` for mA,
+            ``{"theta_m": 2 * pi / 4096}`` for counts).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"{path}: no such file")
+    with path.open(newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        header = next(reader, None)
+        if header is None:
+            raise UserError(
+                f"{path}: the file is empty (expected a header row with {', '.join(LOG_COLUMNS)})"
+            )
+        header = [h.strip() for h in header]
+        missing = [c for c in LOG_COLUMNS if c not in header]
+        if missing:
+            raise UserError(
+                f"{path}: missing column {', '.join(missing)} (the header has: {', '.join(header)})"
+            )
+        index = {c: header.index(c) for c in LOG_COLUMNS}
+        rows = []
+        for line, row in enumerate(reader, start=2):
+            if not row or all(not cell.strip() for cell in row):
+                continue
+            values = []
+            for c in LOG_COLUMNS:
+                i = index[c]
+                cell = row[i].strip() if i < len(row) else ""
+                try:
+                    x = float(cell)
+                except ValueError:
+                    raise UserError(
+                        f"{path}, row {line}, column {c}: {cell!r} is not a number"
+                    ) from None
+                if not math.isfinite(x):
+                    raise UserError(
+                        f"{path}, row {line}, column {c}: {cell} is not a finite number"
+                    )
+                values.append(x)
+            rows.append((line, values))
+    if len(rows) < 2:
+        raise UserError(f"{path}: needs at least two data rows (has {len(rows)})")
+    data = np.array([v for _, v in rows])
+    for c, factor in (scales or {}).items():
+        data[:, LOG_COLUMNS.index(c)] *= factor
+    steps = np.diff(data[:, 0])
+    bad = np.flatnonzero(~(steps > 0))
+    if bad.size:
+        line = rows[bad[0] + 1][0]
+        raise UserError(
+            f"{path}, row {line}, column time: {float(data[bad[0] + 1, 0])!r} s does not increase "
+            f"(previous row: {float(data[bad[0], 0])!r} s)"
+        )
+    return DriveLog(path, {c: data[:, j] for j, c in enumerate(LOG_COLUMNS)})
+
+
+def write_csv(path: str | Path, columns: Mapping[str, np.ndarray]) -> Path:
+    """Write equal-length columns as CSV with a header (full precision); return the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
+    np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+    return path
