@@ -51,8 +51,8 @@ def rigid_maneuver(
     Coulomb friction (f_c / k_t ≈ 0.05 A on the bench): the motor sticks at every
     reversal while the spring torque crosses the ±f_c band, the reaction torque
     is hidden then, and the double integral of mode 1 turns that into drift. On
-    the bench 0.5 A gave k̂ 90 % low, 1 A 2–8 % and 2 A 1.3–3.5 % (ideal to
-    realistic sensors).
+    the bench 0.5 A gave k̂ 90 % low, 1 A 2–8 %, 2 A 1.3–3.5 % and 3 A (the
+    default) 0.8–1.0 % (ideal to realistic sensors).
 
     Args:
         t: step times (s).

@@ -61,6 +61,13 @@ def figure_flexible_response(recording: Recording, n: int, path: Path) -> Path:
         a.set_ylabel("angle (rad)")
         a.grid(True, alpha=0.3)
     zoom.set_xlim(2.0, 3.0)
+    inside = (t >= 2.0) & (t <= 3.0)
+    if inside.any():
+        shown = [recording["plant.theta_m_true"][inside]]
+        shown += [recording[f"plant.theta[{i}]"][inside] for i in range(1, n + 1)]
+        low, high = min(x.min() for x in shown), max(x.max() for x in shown)
+        pad = 0.1 * (high - low) + 1e-9
+        zoom.set_ylim(low - pad, high + pad)
     ax.set_xlabel("time (s)")
     zoom.set_xlabel("time (s), magnified")
     ax.legend(loc="upper left", fontsize=8, ncol=n + 1)

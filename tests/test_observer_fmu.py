@@ -143,7 +143,7 @@ def rigid_run(fmus, kappa_correction: bool, sensors=IDEAL):
 def test_rigid_maneuver_identifies_k_with_kappa(fmus) -> None:
     r = rigid_run(fmus, True)
     assert r["observer.id_valid"][-1] == 1.0
-    assert r["observer.k_hat"][-1] == pytest.approx(K_TRUE, rel=0.03)  # measured −1.3 %
+    assert r["observer.k_hat"][-1] == pytest.approx(K_TRUE, rel=0.03)  # measured −0.77 %
     assert abs(r["plant.twist"][-1]) < 0.05 * np.max(np.abs(r["plant.twist"]))  # little ringing
 
 
