@@ -36,10 +36,11 @@ from cosim.report import (
     text_table,
 )
 from cosim.scenarios import SCENARIOS, recording_columns, run_scenario
+from flexchain import bench
 
 N_MASSES = 3
 SEEDS = (1, 2, 3, 4, 5)
-TRUE = {"J_m": 2.09e-5, "k_t": 0.0406, "D_m": 2e-5, "f_c": 2e-3, "k": 0.1627, "B": 8.88e-6}
+TRUE = {"D_m": bench.D_M, "f_c": bench.F_C, "k": bench.K, "B": bench.B}
 G_DIST = 100.0
 
 

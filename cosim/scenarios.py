@@ -34,7 +34,6 @@ PLANT_SIGNALS = (
 )
 #: Sensors switched off (``--ideal``): exact angle, true velocity, no current noise.
 IDEAL_SENSORS = {"encoder_cpr": 0, "i_noise_std": 0.0}
-BENCH_MODES = np.array([16.8, 30.2, 90.1])  # rad/s
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
+from flexchain import bench
 from flexchain.dob import Actuator
 from flexchain.observer import (
     MODEL_BASED,
@@ -21,7 +22,6 @@ from flexchain.observer import (
 )
 from fmukit import FmuSlave, Variable, choice_problem, indexed, inp, out, par, range_problems
 
-BENCH_J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
 MODES = {
     0: "actuator self-identification",
     1: "rigid-maneuver chain identification",
@@ -30,15 +30,9 @@ MODES = {
 ESTIMATORS = {0: "the paper's recursion"}
 
 
-def default_inertias(n: int) -> list[float]:
-    """Load inertias (kg·m²): the bench's for n = 3, else the bench's J_1 for each mass."""
-    return list(BENCH_J) if n == 3 else [BENCH_J[0]] * n
-
-
 class ReactionTorqueObserver(FmuSlave):
     """Disturbance and reaction torque observers, identification and state estimation."""
 
-    n_masses: ClassVar[int] = 3
     model_text: ClassVar[str] = (
         "Action-reaction observer (Khalil & Sabanovic) for a motor driving n masses on "
         "springs, from the motor's current and encoder only: disturbance and reaction "
@@ -49,7 +43,7 @@ class ReactionTorqueObserver(FmuSlave):
     @classmethod
     def declare(cls) -> list[Variable]:
         n = cls.n_masses
-        J = default_inertias(n)
+        J = bench.inertias(n)
         return [
             inp(
                 "i_a",
@@ -66,8 +60,8 @@ class ReactionTorqueObserver(FmuSlave):
                 "0 = actuator self-identification (load detached), 1 = chain identification "
                 "from a rigid maneuver, 2 = state estimation",
             ),
-            par("J_mo", 2.09e-5, "kg.m2", "Nominal motor inertia"),
-            par("k_to", 0.0406, "N.m/A", "Nominal torque constant"),
+            par("J_mo", bench.J_M, "kg.m2", "Nominal motor inertia"),
+            par("k_to", bench.K_T, "N.m/A", "Nominal torque constant"),
             par("g_dist", 100.0, "rad/s", "Bandwidth of the disturbance observer G(s) = g/(s+g)"),
             par(
                 "g_lpf", 100.0, "rad/s", "Bandwidth of the filter on later stages of the recursion"
@@ -81,11 +75,11 @@ class ReactionTorqueObserver(FmuSlave):
                 for i, name in enumerate(indexed("J", n), start=1)
             ),
             *(
-                par(name, 0.1627, "N.m/rad", f"Stiffness of spring {i}, used in mode 2")
+                par(name, bench.K, "N.m/rad", f"Stiffness of spring {i}, used in mode 2")
                 for i, name in enumerate(indexed("k", n), start=1)
             ),
             *(
-                par(name, 8.88e-6, "N.m.s/rad", f"Damping of spring {i}, used in mode 2")
+                par(name, bench.B, "N.m.s/rad", f"Damping of spring {i}, used in mode 2")
                 for i, name in enumerate(indexed("B", n), start=1)
             ),
             par(

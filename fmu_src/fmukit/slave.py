@@ -41,6 +41,7 @@ class FmuSlave(Fmi2Slave):
     :meth:`initialize` and :meth:`step`; the FMI plumbing stays here.
     """
 
+    n_masses: ClassVar[int] = 3  # set per build by the generated script
     model_text: ClassVar[str] = ""
     project_version: ClassVar[str] = "0.0.0"
     experiment: ClassVar[tuple[float, float, float]] = (0.0, 10.0, 1e-3)

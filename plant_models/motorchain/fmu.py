@@ -9,25 +9,15 @@ from __future__ import annotations
 
 from typing import ClassVar
 
+from flexchain import bench
 from fmukit import FmuSlave, Variable, indexed, inp, out, par, range_problems
 from motorchain.physics import PlantPhysics
 from motorchain.sensors import gaussian, quantize
-
-#: The paper's bench in SI units (shared/METHOD.md), used as defaults for n = 3.
-BENCH_J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
-BENCH_K = 0.1627
-BENCH_B = 8.88e-6
-
-
-def default_inertias(n: int) -> list[float]:
-    """Load inertias (kg·m²): the bench's for n = 3, else the bench's J_1 for each mass."""
-    return list(BENCH_J) if n == 3 else [BENCH_J[0]] * n
 
 
 class MotorChainPlant(FmuSlave):
     """Motor, n load masses joined by springs, an encoder and a current sensor."""
 
-    n_masses: ClassVar[int] = 3
     model_text: ClassVar[str] = (
         "Motor driving a chain of n inertias joined by springs (Khalil & Sabanovic bench "
         "by default), with an incremental encoder and a noisy current sensor. Outputs "
@@ -38,19 +28,19 @@ class MotorChainPlant(FmuSlave):
     @classmethod
     def declare(cls) -> list[Variable]:
         n = cls.n_masses
-        J = default_inertias(n)
+        J = bench.inertias(n)
         v: list[Variable] = [
             inp("i_ref", 0.0, "A", "Current command; held over each communication step"),
             *(
                 inp(name, 0.0, "N.m", f"External torque on load mass {i}")
                 for i, name in enumerate(indexed("tau_ext", n), start=1)
             ),
-            par("J_m", 2.09e-5, "kg.m2", "Motor (rotor) inertia"),
-            par("k_t", 0.0406, "N.m/A", "Motor torque constant"),
-            par("D_m", 2e-5, "N.m.s/rad", "Motor viscous friction coefficient"),
+            par("J_m", bench.J_M, "kg.m2", "Motor (rotor) inertia"),
+            par("k_t", bench.K_T, "N.m/A", "Motor torque constant"),
+            par("D_m", bench.D_M, "N.m.s/rad", "Motor viscous friction coefficient"),
             par(
                 "f_c",
-                2e-3,
+                bench.F_C,
                 "N.m",
                 "Motor Coulomb friction; the motor sticks while |drive torque| <= f_c",
             ),
@@ -59,11 +49,11 @@ class MotorChainPlant(FmuSlave):
                 for i, name in enumerate(indexed("J", n), start=1)
             ),
             *(
-                par(name, BENCH_K, "N.m/rad", f"Stiffness of spring {i} (mass {i - 1} to {i})")
+                par(name, bench.K, "N.m/rad", f"Stiffness of spring {i} (mass {i - 1} to {i})")
                 for i, name in enumerate(indexed("k", n), start=1)
             ),
             *(
-                par(name, BENCH_B, "N.m.s/rad", f"Damping of spring {i} (mass {i - 1} to {i})")
+                par(name, bench.B, "N.m.s/rad", f"Damping of spring {i} (mass {i - 1} to {i})")
                 for i, name in enumerate(indexed("B", n), start=1)
             ),
             par(
