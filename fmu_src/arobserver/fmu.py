@@ -20,7 +20,7 @@ from flexchain.observer import (
     Observer,
     ObserverSettings,
 )
-from fmukit import FmuSlave, Variable, choice_problem, indexed, inp, out, par, range_problems
+from fmukit import FmuSlave, Variable, array, choice_problem, indexed, inp, out, par, range_problems
 
 MODES = {
     0: "actuator self-identification",
@@ -70,17 +70,20 @@ class ReactionTorqueObserver(FmuSlave):
             par("dJm", 0.0, "kg.m2", "Motor inertia error J_m - J_mo (result of mode 0)"),
             par("D_m", 0.0, "N.m.s/rad", "Motor viscous friction (result of mode 0)"),
             par("f_c", 0.0, "N.m", "Motor Coulomb friction (result of mode 0)"),
-            *(
-                par(name, J[i - 1], "kg.m2", f"Known inertia of load mass {i}")
-                for i, name in enumerate(indexed("J", n), start=1)
+            *array(par, "J", J, "kg.m2", lambda i: f"Known inertia of load mass {i}"),
+            *array(
+                par,
+                "k",
+                [bench.K] * n,
+                "N.m/rad",
+                lambda i: f"Stiffness of spring {i}, used in mode 2",
             ),
-            *(
-                par(name, bench.K, "N.m/rad", f"Stiffness of spring {i}, used in mode 2")
-                for i, name in enumerate(indexed("k", n), start=1)
-            ),
-            *(
-                par(name, bench.B, "N.m.s/rad", f"Damping of spring {i}, used in mode 2")
-                for i, name in enumerate(indexed("B", n), start=1)
+            *array(
+                par,
+                "B",
+                [bench.B] * n,
+                "N.m.s/rad",
+                lambda i: f"Damping of spring {i}, used in mode 2",
             ),
             par(
                 "kappa_correction",
@@ -127,13 +130,15 @@ class ReactionTorqueObserver(FmuSlave):
             out("k_hat", "N.m/rad", "Mode 1: estimated spring stiffness"),
             out("B_hat", "N.m.s/rad", "Mode 1: estimated spring damping"),
             out("theta_rigid_hat", "rad", "Mode 1: estimated rigid motion (eq. 20)"),
-            *(
-                out(name, "rad", f"Mode 2: estimated angle of load mass {i}")
-                for i, name in enumerate(indexed("theta_hat", n), start=1)
+            *array(
+                out, "theta_hat", n, "rad", lambda i: f"Mode 2: estimated angle of load mass {i}"
             ),
-            *(
-                out(name, "rad/s", f"Mode 2: estimated velocity of load mass {i}")
-                for i, name in enumerate(indexed("omega_hat", n), start=1)
+            *array(
+                out,
+                "omega_hat",
+                n,
+                "rad/s",
+                lambda i: f"Mode 2: estimated velocity of load mass {i}",
             ),
             out(
                 "id_valid",

@@ -8,11 +8,12 @@ package is bundled into each FMU's ``resources/`` folder.
 from fmukit.checks import choice_problem, range_problems
 from fmukit.model_description import model_description
 from fmukit.slave import FmuSlave
-from fmukit.variables import Variable, indexed, inp, out, par
+from fmukit.variables import Variable, array, indexed, inp, out, par
 
 __all__ = [
     "FmuSlave",
     "Variable",
+    "array",
     "choice_problem",
     "indexed",
     "inp",

@@ -6,6 +6,7 @@ the values and :func:`fmukit.model_description.model_description` writes the XML
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -77,6 +78,24 @@ def inp(name: str, start: float, unit: str, description: str) -> Variable:
 def out(name: str, unit: str, description: str, vtype: VarType = "Real") -> Variable:
     """An output (Real unless ``vtype`` says otherwise)."""
     return Variable(name, vtype, "output", description, unit if vtype == "Real" else "")
+
+
+def array(
+    kind: Callable[..., Variable],
+    name: str,
+    starts: Sequence[Value] | int,
+    unit: str,
+    describe: Callable[[int], str],
+) -> list[Variable]:
+    """Variables ``name[1] … name[n]`` made by ``kind`` (:func:`par`, :func:`inp`, :func:`out`).
+
+    Args:
+        starts: start values, one per element (parameters and inputs), or n (outputs).
+        describe: description of element i (1-based).
+    """
+    if isinstance(starts, int):
+        return [kind(f"{name}[{i}]", unit, describe(i)) for i in range(1, starts + 1)]
+    return [kind(f"{name}[{i}]", x, unit, describe(i)) for i, x in enumerate(starts, start=1)]
 
 
 def indexed(name: str, n: int) -> list[str]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 from flexchain import bench
-from fmukit import FmuSlave, Variable, indexed, inp, out, par, range_problems
+from fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
 from motorchain.physics import PlantPhysics
 from motorchain.sensors import gaussian, quantize
 
@@ -31,10 +31,7 @@ class MotorChainPlant(FmuSlave):
         J = bench.inertias(n)
         v: list[Variable] = [
             inp("i_ref", 0.0, "A", "Current command; held over each communication step"),
-            *(
-                inp(name, 0.0, "N.m", f"External torque on load mass {i}")
-                for i, name in enumerate(indexed("tau_ext", n), start=1)
-            ),
+            *array(inp, "tau_ext", [0.0] * n, "N.m", lambda i: f"External torque on load mass {i}"),
             par("J_m", bench.J_M, "kg.m2", "Motor (rotor) inertia"),
             par("k_t", bench.K_T, "N.m/A", "Motor torque constant"),
             par("D_m", bench.D_M, "N.m.s/rad", "Motor viscous friction coefficient"),
@@ -44,17 +41,20 @@ class MotorChainPlant(FmuSlave):
                 "N.m",
                 "Motor Coulomb friction; the motor sticks while |drive torque| <= f_c",
             ),
-            *(
-                par(name, J[i - 1], "kg.m2", f"Inertia of load mass {i}")
-                for i, name in enumerate(indexed("J", n), start=1)
+            *array(par, "J", J, "kg.m2", lambda i: f"Inertia of load mass {i}"),
+            *array(
+                par,
+                "k",
+                [bench.K] * n,
+                "N.m/rad",
+                lambda i: f"Stiffness of spring {i} (mass {i - 1} to {i})",
             ),
-            *(
-                par(name, bench.K, "N.m/rad", f"Stiffness of spring {i} (mass {i - 1} to {i})")
-                for i, name in enumerate(indexed("k", n), start=1)
-            ),
-            *(
-                par(name, bench.B, "N.m.s/rad", f"Damping of spring {i} (mass {i - 1} to {i})")
-                for i, name in enumerate(indexed("B", n), start=1)
+            *array(
+                par,
+                "B",
+                [bench.B] * n,
+                "N.m.s/rad",
+                lambda i: f"Damping of spring {i} (mass {i - 1} to {i})",
             ),
             par(
                 "attached",
@@ -88,13 +88,15 @@ class MotorChainPlant(FmuSlave):
             ),
             out("theta_m_true", "rad", "True motor angle (verification only)"),
             out("omega_m_true", "rad/s", "True motor velocity (verification only)"),
-            *(
-                out(name, "rad", f"True angle of load mass {i} (verification only)")
-                for i, name in enumerate(indexed("theta", n), start=1)
+            *array(
+                out, "theta", n, "rad", lambda i: f"True angle of load mass {i} (verification only)"
             ),
-            *(
-                out(name, "rad/s", f"True velocity of load mass {i} (verification only)")
-                for i, name in enumerate(indexed("omega", n), start=1)
+            *array(
+                out,
+                "omega",
+                n,
+                "rad/s",
+                lambda i: f"True velocity of load mass {i} (verification only)",
             ),
             out(
                 "tau_reac",
