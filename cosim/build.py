@@ -12,11 +12,13 @@ import argparse
 import importlib
 import sys
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 from cosim import __version__
 from cosim.errors import UserError
+from cosim.native_loader import add_python_loader, loader_problem
 
 MIN_MASSES, MAX_MASSES = 1, 20
 
@@ -115,6 +117,11 @@ def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
         sys.modules.pop(identifier, None)
         if tmp in sys.path:
             sys.path.remove(tmp)
+    problem = loader_problem()
+    if problem is None:
+        add_python_loader(Path(built))
+    else:
+        warnings.warn(f"{Path(built).name} will load in Python hosts only: {problem}", stacklevel=2)
     return Path(built)
 
 
