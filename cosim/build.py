@@ -113,6 +113,8 @@ def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
             script,
             dest=out / f"{recipe.name}.fmu",
             project_files=sources,
+            canGetAndSetFMUstate=True,
+            canSerializeFMUstate=True,
         )
         sys.modules.pop(identifier, None)
         if tmp in sys.path:

@@ -10,7 +10,9 @@ Conventions it settles (see README, "FMU conventions"):
   step (non-finite input, step size ≤ 0, communication point that is not the
   current time) is refused with fmi2Discard and a log line naming the problem,
   and leaves the state untouched.
-* Algorithm state is kept in plain JSON-serializable values (floats, ints, lists).
+* Algorithm state is kept in plain data (floats, ints, lists, small classes), so
+  FMU state get/set and serialization cover every filter and accumulator
+  (:mod:`fmukit.state`).
 * Timing contract (shared/METHOD.md): after ``doStep(t, h)`` the outputs are the
   sample at ``t + h``.
 """
@@ -27,6 +29,7 @@ from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 from fmukit.model_description import ModelInfo, model_description
+from fmukit.state import restore, snapshot
 from fmukit.variables import Value, Variable
 
 
@@ -97,6 +100,7 @@ class FmuSlave(Fmi2Slave):
         self.stale = False
         self.initialized = False
         self.problems: list[str] = []
+        self._base_attributes = frozenset(vars(self)) | {"_base_attributes"}
 
     def to_xml(self, model_options: dict[str, str] | None = None) -> Element:
         """The compliant model description (called by pythonfmu's builder)."""
@@ -131,6 +135,29 @@ class FmuSlave(Fmi2Slave):
 
     def setup_experiment(self, start_time: float, stop_time=None, tolerance=None) -> None:
         self.time = float(start_time)
+
+    # -- FMU state (fmi2GetFMUstate, fmi2SetFMUstate, serialization) ----------------
+
+    def _get_fmu_state(self) -> dict:
+        """Values, time, status and every attribute the subclass made, as JSON data."""
+        own = {k: v for k, v in vars(self).items() if k not in self._base_attributes}
+        return {
+            "values": list(self.v),
+            "time": self.time,
+            "stale": self.stale,
+            "initialized": self.initialized,
+            "problems": list(self.problems),
+            "algorithm": snapshot(own),
+        }
+
+    def _set_fmu_state(self, state: dict) -> None:
+        self.v = list(state["values"])
+        self.time = state["time"]
+        self.stale = state["stale"]
+        self.initialized = state["initialized"]
+        self.problems = list(state["problems"])
+        for name, value in restore(state["algorithm"]).items():
+            setattr(self, name, value)
 
     def exit_initialization_mode(self) -> None:
         self.problems = self._checked(self.check_parameters)

@@ -33,6 +33,9 @@ _CACHE_SIZE = 16
 class PlantPhysics:
     """The plant's equations of motion and their exact step.
 
+    ``_cache`` (discretized matrices by step size) is derived data, left out of the
+    FMU state and rebuilt on demand.
+
     Args:
         J_m: motor inertia (kg·m²), > 0.
         k_t: torque constant (N·m/A).
@@ -45,6 +48,8 @@ class PlantPhysics:
         attached: False decouples spring 1, so the motor runs free.
         current_bandwidth: current-loop bandwidth (rad/s); 0 = ideal (i = i_ref).
     """
+
+    _transient = ("_cache",)
 
     def __init__(
         self,
