@@ -20,6 +20,7 @@ demo: build
 	$(BIN)/arcosim reproduce
 
 test: build
+	$(BIN)/arcosim validate
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/python -m pytest

@@ -168,6 +168,13 @@ class FmuSlave(Fmi2Slave):
         self.initialized = True
 
     def do_step(self, current_time: float, step_size: float) -> bool:
+        if not self.initialized:
+            self.report(
+                "doStep called before initialization finished; call "
+                "fmi2EnterInitializationMode and fmi2ExitInitializationMode first",
+                Fmi2Status.discard,
+            )
+            return False
         if self.problems:
             self.report("cannot step: " + "; ".join(self.problems), Fmi2Status.discard)
             return False

@@ -1,0 +1,43 @@
+"""``arcosim validate``: passes the project's FMUs, fails a broken one."""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+from cosim.cli import main
+
+
+def test_validate_passes_the_built_fmus(build_fmus, capsys) -> None:
+    fmus = [
+        str(build_fmus(n) / f"{name}.fmu")
+        for n in (1, 3)
+        for name in ("MotorChainPlant", "ReactionTorqueObserver")
+    ]
+    assert main(["validate", *fmus]) == 0
+    out = capsys.readouterr().out
+    assert out.count(": OK") == 4 and "problem" not in out
+
+
+def test_validate_names_what_is_wrong(build_fmus, tmp_path: Path, capsys) -> None:
+    source = build_fmus(3) / "MotorChainPlant.fmu"
+    broken = tmp_path / "Broken.fmu"
+    with zipfile.ZipFile(source) as z, zipfile.ZipFile(broken, "w") as out:
+        for item in z.infolist():
+            data = z.read(item)
+            if item.filename == "modelDescription.xml":
+                text = data.decode()
+                text = text.replace('unit="N.m/A" ', "", 1)  # k_t loses its unit
+                text = text.replace('description="Motor (rotor) inertia"', "", 1)
+                data = text.encode()
+            out.writestr(item, data)
+    assert main(["validate", str(broken)]) == 1
+    out = capsys.readouterr().out
+    assert "k_t: unit None is missing or undefined" in out
+    assert "J_m: no description" in out
+
+
+def test_validate_without_fmus_says_what_to_do(tmp_path: Path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate"]) == 2
+    assert "run `arcosim build`" in capsys.readouterr().err
