@@ -50,7 +50,10 @@ OBSERVER = FmuRecipe(
     "arobserver.fmu:ReactionTorqueObserver",
     ("fmukit", "flexchain", "arobserver"),
 )
-RECIPES = (PLANT, OBSERVER)
+SOURCE = FmuRecipe(
+    "ExcitationSource", "arsource.fmu:ExcitationSource", ("fmukit", "flexchain", "arsource")
+)
+RECIPES = (PLANT, OBSERVER, SOURCE)
 
 
 # pythonfmu 0.7's loader (findClass) re-runs this script with the module's namespace

@@ -63,8 +63,8 @@ def _self_identification_current(t: np.ndarray) -> np.ndarray:
 
 
 def _flexible_current(t: np.ndarray) -> np.ndarray:
-    """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s (A)."""
-    return excitation.multisine(t, 0.3, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1)
+    """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s, peak 0.3 A."""
+    return excitation.multisine(t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1)
 
 
 #: The maneuver's length: 8 periods at 2.1 rad/s.

@@ -43,6 +43,8 @@ CASES = [
     ("ReactionTorqueObserver", {"mode": 0}),
     ("ReactionTorqueObserver", {"mode": 1, "f_c": 2e-3}),
     ("ReactionTorqueObserver", {"mode": 2}),
+    ("ExcitationSource", {"signal": 3}),
+    ("ExcitationSource", {"signal": 1}),
 ]
 
 

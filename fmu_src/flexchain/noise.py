@@ -1,8 +1,9 @@
-"""Sensor models of the plant: encoder quantization and current noise.
+"""Reproducible noise and the encoder model, for the plant's sensors and the
+excitation source.
 
 The noise is counter-based (a hash of seed and sample number), so sample k is the
 same whatever happened before it: runs are reproducible for a seed, saving and
-restoring the FMU state needs only the counter, and a C port gives the same bits.
+restoring an FMU's state needs only the counter, and a C port gives the same bits.
 """
 
 from __future__ import annotations
@@ -17,6 +18,12 @@ def _splitmix64(z: int) -> int:
     z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
     z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
     return z ^ (z >> 31)
+
+
+def uniform(seed: int, k: int) -> float:
+    """Uniform sample number ``k`` of stream ``seed``, in [0, 1)."""
+    base = _splitmix64((seed & _MASK) ^ 0x2545F4914F6CDD1D)
+    return (_splitmix64((base + k) & _MASK) >> 11) * 2.0**-53
 
 
 def gaussian(seed: int, k: int) -> float:

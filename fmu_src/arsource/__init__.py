@@ -1,0 +1,1 @@
+"""The excitation source FMU class (a thin FMI wrapper around :mod:`flexchain.excitation`)."""
