@@ -132,15 +132,19 @@ def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
 
 def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
     """Build every FMU of the project for n load masses; return their paths."""
+    from cosim.ssp import write_ssp
+
     check_masses(n)
     target = out if out is not None else default_out_dir(n)
-    return [build_fmu(recipe, n, target) for recipe in RECIPES]
+    built = [build_fmu(recipe, n, target) for recipe in RECIPES]
+    return [*built, write_ssp(target / "ActionReaction.ssp", target)]
 
 
 def ensure_built(n: int = 3, out: Path | None = None) -> Path:
     """Folder holding the FMUs for n masses, building them first if any is missing."""
     target = out if out is not None else default_out_dir(n)
-    if not all((target / f"{r.name}.fmu").is_file() for r in RECIPES):
+    wanted = [target / f"{r.name}.fmu" for r in RECIPES] + [target / "ActionReaction.ssp"]
+    if not all(path.is_file() for path in wanted):
         build_all(n, target)
     return target
 

@@ -115,6 +115,8 @@ class FmuInstance:
                 self.slave.setInteger([var.valueReference], [int(value)])
             elif var.type == "Boolean":
                 self.slave.setBoolean([var.valueReference], [bool(value)])
+            elif var.type == "String":
+                self.slave.setString([var.valueReference], [str(value)])
             else:
                 raise UserError(f"{name}: variables of type {var.type} cannot be set here")
 

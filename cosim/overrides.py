@@ -12,7 +12,7 @@ from collections.abc import Iterable, Mapping
 
 from cosim.errors import UserError
 
-Value = float | int | bool
+Value = float | int | bool | str
 
 
 def parse_assignment(text: str) -> tuple[str, str]:
@@ -25,6 +25,8 @@ def parse_assignment(text: str) -> tuple[str, str]:
 
 def typed_value(name: str, text: str, vtype: str) -> Value:
     """Convert ``text`` to the FMI type ``vtype`` of variable ``name``."""
+    if vtype == "String":
+        return text
     try:
         if vtype == "Boolean":
             lowered = text.lower()

@@ -257,3 +257,34 @@ def test_same_fmu_instantiates_again_and_again_in_one_process(plant_fmu: Path) -
         [sys.executable, "-c", script, str(plant_fmu)], capture_output=True, text=True
     )
     assert result.returncode == 0, result.stderr
+
+
+def test_step_before_initialization_is_refused(plant_fmu: Path) -> None:
+    from fmpy.fmi1 import FMICallException
+
+    with FmuInstance(plant_fmu, "early") as plant:
+        with pytest.raises(FMICallException) as refused:
+            plant.slave.doStep(0.0, 1e-3)
+        assert refused.value.status == 2  # fmi2Discard, not fatal
+        assert any("before initialization" in m for m in plant.messages)
+        plant.initialize()
+        assert plant.do_step(0.0, 1e-3) == 0
+
+
+def test_trace_file_records_outputs_and_never_overwrites(plant_fmu: Path, tmp_path) -> None:
+    trace = tmp_path / "plant.csv"
+    with FmuInstance(plant_fmu, "traced") as plant:
+        plant.initialize({**IDEAL, "trace_file": str(trace)})
+        plant.set({"i_ref": 0.3})
+        for k in range(5):
+            assert plant.do_step(k * 1e-3, 1e-3) == 0
+        last = plant.get(["theta_m_true"])[0]
+    lines = trace.read_text().splitlines()
+    assert len(lines) == 7 and lines[0].startswith("time,i_a,theta_m")
+    column = lines[0].split(",").index("theta_m_true")
+    assert float(lines[-1].split(",")[column]) == last  # full precision
+    with FmuInstance(plant_fmu, "again") as plant:
+        plant.initialize({"trace_file": str(trace)})
+        assert plant.do_step(0.0, 1e-3) == 2
+        assert any("exists; choose a new name" in m for m in plant.messages)
+    assert len(trace.read_text().splitlines()) == 7  # the user's file is intact

@@ -175,7 +175,9 @@ def _num(x: float) -> str:
     return repr(float(x))
 
 
-def _value(x: float | int | bool) -> str:
+def _value(x: float | int | bool | str) -> str:
+    if isinstance(x, str):
+        return x
     if isinstance(x, bool):
         return "true" if x else "false"
     if isinstance(x, int):

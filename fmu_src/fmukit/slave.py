@@ -22,7 +22,8 @@ from __future__ import annotations
 import math
 import traceback
 from collections.abc import Sequence
-from typing import ClassVar
+from pathlib import Path
+from typing import ClassVar, TextIO
 from xml.etree.ElementTree import Element
 
 from pythonfmu import Fmi2Slave
@@ -30,7 +31,17 @@ from pythonfmu.enums import Fmi2Status
 
 from fmukit.model_description import ModelInfo, model_description
 from fmukit.state import restore, snapshot
-from fmukit.variables import Value, Variable
+from fmukit.variables import Value, Variable, par
+
+#: Every FMU's last parameter: a CSV of its outputs after every step, at full
+#: precision, written from inside whatever host runs it ("" = off).
+TRACE_FILE = par(
+    "trace_file",
+    "",
+    "",
+    "Path of a CSV to write the outputs to after every step at full precision "
+    "(empty = off; an existing file is never overwritten)",
+)
 
 
 class StepRefusedError(Exception):
@@ -78,12 +89,17 @@ class FmuSlave(Fmi2Slave):
         super().__init__(**kwargs)
         cls = type(self)
         self.modelName = cls.__name__
-        self.variables: list[Variable] = cls.declare()
+        self.variables: list[Variable] = [*cls.declare(), TRACE_FILE]
         self.vr: dict[str, int] = {v.name: i for i, v in enumerate(self.variables)}
         if len(self.vr) != len(self.variables):
             raise ValueError(f"{cls.__name__}: duplicate variable names")
         self.v: list[Value] = [var.initial_value for var in self.variables]
-        by_type: dict[str, set[int]] = {"Real": set(), "Integer": set(), "Boolean": set()}
+        by_type: dict[str, set[int]] = {
+            "Real": set(),
+            "Integer": set(),
+            "Boolean": set(),
+            "String": set(),
+        }
         for i, var in enumerate(self.variables):
             by_type[var.type].add(i)
         self._vrs_of_type = {k: frozenset(s) for k, s in by_type.items()}
@@ -100,6 +116,8 @@ class FmuSlave(Fmi2Slave):
         self.stale = False
         self.initialized = False
         self.problems: list[str] = []
+        self._trace: TextIO | None = None
+        self._trace_outputs = sorted(self._outputs)
         self._base_attributes = frozenset(vars(self)) | {"_base_attributes"}
 
     def to_xml(self, model_options: dict[str, str] | None = None) -> Element:
@@ -163,6 +181,8 @@ class FmuSlave(Fmi2Slave):
         self.problems = self._checked(self.check_parameters)
         if not self.problems:
             self.problems = self._checked(self.initialize)
+        if not self.problems:
+            self.problems = self._checked(self._open_trace)
         for problem in self.problems:
             self.report(problem)
         self.initialized = True
@@ -191,7 +211,37 @@ class FmuSlave(Fmi2Slave):
             self.report("internal error, step refused:\n" + traceback.format_exc())
             return False
         self.time = current_time + step_size
+        if self._trace is not None:
+            self._write_trace()
         return True
+
+    def terminate(self) -> None:
+        if self._trace is not None:
+            self._trace.close()
+            self._trace = None
+
+    # -- trace file: every output at full precision, from inside any host ---------
+
+    def _open_trace(self) -> list[str]:
+        path = str(self.v[self.vr["trace_file"]])
+        if not path:
+            return []
+        if Path(path).exists():
+            return [f"trace_file {path!r} exists; choose a new name (it is never overwritten)"]
+        try:
+            self._trace = open(path, "x", encoding="utf-8", buffering=1)  # noqa: SIM115
+        except OSError as error:
+            return [f"trace_file {path!r} cannot be written: {error.strerror}"]
+        names = [self.variables[i].name for i in self._trace_outputs]
+        self._trace.write(",".join(["time", *names]) + "\n")
+        self._write_trace()
+        return []
+
+    def _write_trace(self) -> None:
+        v = self.v
+        row = [repr(float(self.time or 0.0))]
+        row += [repr(float(v[i])) for i in self._trace_outputs]
+        self._trace.write(",".join(row) + "\n")
 
     def _step_problem(self, t: float, h: float) -> str | None:
         if not (math.isfinite(h) and h > 0.0):
@@ -227,8 +277,7 @@ class FmuSlave(Fmi2Slave):
         return self._get(vrs, "Boolean", bool)
 
     def get_string(self, vrs: Sequence[int]) -> list[str]:
-        self.report(f"this FMU has no String variables (asked for {list(vrs)})")
-        return ["" for _ in vrs]
+        return self._get(vrs, "String", str)
 
     def set_real(self, vrs: Sequence[int], values: Sequence[float]) -> None:
         self._set(vrs, values, "Real", float)
@@ -240,7 +289,7 @@ class FmuSlave(Fmi2Slave):
         self._set(vrs, values, "Boolean", bool)
 
     def set_string(self, vrs: Sequence[int], values: Sequence[str]) -> None:
-        self.report(f"this FMU has no String variables (set {list(vrs)} ignored)")
+        self._set(vrs, values, "String", str)
 
     def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
         if self.stale:

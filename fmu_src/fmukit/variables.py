@@ -12,9 +12,9 @@ from typing import Literal
 
 from fmukit.units import check_unit
 
-VarType = Literal["Real", "Integer", "Boolean"]
+VarType = Literal["Real", "Integer", "Boolean", "String"]
 Causality = Literal["parameter", "input", "output"]
-Value = float | int | bool
+Value = float | int | bool | str
 
 
 @dataclass(frozen=True)
@@ -23,7 +23,7 @@ class Variable:
 
     Attributes:
         name: FMI structured name, e.g. ``"k[2]"``.
-        type: ``"Real"``, ``"Integer"`` or ``"Boolean"``.
+        type: ``"Real"``, ``"Integer"``, ``"Boolean"`` or ``"String"``.
         causality: ``"parameter"`` (fixed after initialization), ``"input"`` or
             ``"output"`` (computed by ``doStep``, depending on no input directly).
         description: one line for the user, with what the value means.
@@ -62,11 +62,11 @@ class Variable:
         """The value held before initialization (start, or a typed zero)."""
         if self.start is not None:
             return self.start
-        return {"Real": 0.0, "Integer": 0, "Boolean": False}[self.type]
+        return {"Real": 0.0, "Integer": 0, "Boolean": False, "String": ""}[self.type]
 
 
 def par(name: str, start: Value, unit: str, description: str) -> Variable:
-    """A parameter; its type follows ``start`` (bool → Boolean, int → Integer)."""
+    """A parameter; its type follows ``start`` (str → String, bool → Boolean, int → Integer)."""
     return Variable(name, _type_of(start), "parameter", description, unit, start)
 
 
@@ -104,6 +104,8 @@ def indexed(name: str, n: int) -> list[str]:
 
 
 def _type_of(value: Value) -> VarType:
+    if isinstance(value, str):
+        return "String"
     if isinstance(value, bool):
         return "Boolean"
     if isinstance(value, int):

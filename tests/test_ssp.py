@@ -1,0 +1,45 @@
+"""The SSP system: written by the build, read back, run by `arcosim ssp`."""
+
+from __future__ import annotations
+
+import pytest
+
+from cosim.cli import main
+from cosim.errors import UserError
+from cosim.ssp import BENCH, CONNECTIONS, read_ssp, run_ssp
+
+
+def test_build_writes_an_ssp_with_connections_and_the_bench_set(build_fmus) -> None:
+    system = read_ssp(build_fmus(3) / "ActionReaction.ssp")
+    try:
+        assert set(system.components) == {"source", "plant", "observer"}
+        assert all(path.is_file() for path in system.components.values())
+        assert system.connections == list(CONNECTIONS)
+        assert system.parameter_sets["bench"]["observer"] == BENCH["observer"]
+        assert system.stop == 10.0
+    finally:
+        system.folder.cleanup()
+
+
+def test_run_ssp_applies_the_parameter_set(build_fmus) -> None:
+    recording = run_ssp(build_fmus(3) / "ActionReaction.ssp", "bench", stop=0.2)
+    assert len(recording.time) == 201
+    assert recording["observer.theta_hat[1]"][-1] != 0.0  # mode 2 from the set
+    assert abs(recording["source.i_ref"][50]) > 0.0  # the multi-sine from the set
+
+
+def test_unknown_parameter_set_is_named(build_fmus) -> None:
+    with pytest.raises(UserError, match="no parameter set 'lab'"):
+        run_ssp(build_fmus(3) / "ActionReaction.ssp", "lab", stop=0.01)
+
+
+def test_arcosim_ssp_command(build_fmus, tmp_path, capsys) -> None:
+    out = tmp_path / "ssp.csv"
+    assert (
+        main(
+            ["ssp", str(build_fmus(3) / "ActionReaction.ssp"), "--stop", "0.05", "--out", str(out)]
+        )
+        == 0
+    )
+    assert "50 steps" in capsys.readouterr().out
+    assert out.read_text().splitlines()[0].startswith("time,source.i_ref")
