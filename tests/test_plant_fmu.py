@@ -288,3 +288,22 @@ def test_trace_file_records_outputs_and_never_overwrites(plant_fmu: Path, tmp_pa
         assert plant.do_step(0.0, 1e-3) == 2
         assert any("exists; choose a new name" in m for m in plant.messages)
     assert len(trace.read_text().splitlines()) == 7  # the user's file is intact
+
+
+def test_every_fmu_for_several_n_loads_in_one_process(build_fmus) -> None:
+    """Nine FMUs (three kinds × n = 1, 3, 5) instantiated, initialized and stepped
+    together: model identifiers carry n, bundled packages are identical copies."""
+    from contextlib import ExitStack
+
+    with ExitStack() as stack:
+        fmus = [
+            stack.enter_context(FmuInstance(build_fmus(n) / f"{name}.fmu", f"{name}-{n}"))
+            for n in (1, 3, 5)
+            for name in ("MotorChainPlant", "ReactionTorqueObserver", "ExcitationSource")
+        ]
+        for fmu in fmus:
+            fmu.initialize()
+        for k in range(20):
+            assert all(fmu.do_step(k * 1e-3, 1e-3) == 0 for fmu in fmus)
+        identifiers = {fmu.description.coSimulation.modelIdentifier for fmu in fmus}
+        assert len(identifiers) == 9
