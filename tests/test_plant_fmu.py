@@ -213,6 +213,7 @@ def test_invalid_parameter_is_refused_with_a_message(plant_fmu, name, value, phr
         ({"tau_ext[2]": float("inf")}, 0.0, 1e-3, "input tau_ext[2] = inf is not finite"),
         ({}, 0.0, 0.0, "step size 0.0 s refused"),
         ({}, 0.0, -1e-3, "step size -0.001 s refused"),
+        ({}, 0.0, float("nan"), "step size nan s refused"),
         ({}, 0.5, 1e-3, "communication point 0.5 s refused"),
     ],
 )
