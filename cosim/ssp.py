@@ -26,6 +26,7 @@ from cosim.errors import UserError
 from cosim.instance import FmuInstance
 from cosim.logs import write_csv
 from cosim.master import Recording
+from fmukit.variables import type_of
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -126,7 +127,7 @@ def write_ssp(
             parameters = SubElement(pset, f"{{{SSV}}}Parameters")
             for pname, value in values.items():
                 p = SubElement(parameters, f"{{{SSV}}}Parameter", {"name": pname})
-                SubElement(p, f"{{{SSV}}}{_ssv_type(value)}", {"value": _text(value)})
+                SubElement(p, f"{{{SSV}}}{type_of(value)}", {"value": _text(value)})
     connections = SubElement(system, f"{{{SSD}}}Connections")
     for a, ca, b, cb in CONNECTIONS:
         SubElement(
@@ -241,16 +242,6 @@ def run_ssp(
         for j, out in enumerate(outs):
             recording.signals[f"{name}.{out}"] = logs[name][:, j]
     return recording
-
-
-def _ssv_type(value: object) -> str:
-    if isinstance(value, bool):
-        return "Boolean"
-    if isinstance(value, int):
-        return "Integer"
-    if isinstance(value, str):
-        return "String"
-    return "Real"
 
 
 def _text(value: object) -> str:

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import subprocess
 import tempfile
 import zipfile
 from pathlib import Path
@@ -24,6 +23,7 @@ from xml.etree import ElementTree
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
+from cosim.ecos import ecos_binary, run_ecos
 from cosim.errors import UserError
 from cosim.instance import FmuInstance
 
@@ -118,38 +118,11 @@ def check_runtime(fmu: Path) -> list[str]:
 
 def check_ecos(fmu: Path) -> tuple[list[str], str | None]:
     """Run the FMU alone in ecos with a bare environment: (problems, why skipped)."""
-    try:
-        import ecospy
-    except ImportError:
-        return [], "ecospy is not installed"
-    binary = Path(ecospy.__file__).parent / "binaries" / "ecos"
-    if not binary.is_file():
-        return [], "ecospy has no ecos binary for this platform"
-    if (
-        "libtbb.so.12 => not found"
-        in subprocess.run(["ldd", str(binary)], capture_output=True, text=True).stdout
-    ):
-        return [], "ecos needs the Debian package libtbb12"
-    binary.chmod(0o755)
+    binary, why_not = ecos_binary()
+    if binary is None:
+        return [], why_not
     with tempfile.TemporaryDirectory(prefix="arcosim_ecos_") as tmp:
-        result = subprocess.run(
-            [
-                str(binary),
-                "simulate",
-                "--path",
-                str(fmu.resolve()),
-                "--stopTime",
-                "0.02",
-                "--stepSize",
-                "0.001",
-                "--noParallel",
-            ],
-            capture_output=True,
-            text=True,
-            cwd=tmp,
-            timeout=120,
-            env={"PATH": "/usr/bin:/bin", "HOME": tmp},
-        )
+        result = run_ecos(binary, fmu, Path(tmp), stop=0.02, timeout=120)
         if result.returncode != 0 or not list(Path(tmp).glob("*.csv")):
             return [f"ecos (C++ host) failed with exit {result.returncode}"], None
     return [], None

@@ -12,47 +12,21 @@ from pathlib import Path
 
 import pytest
 
+from cosim.ecos import ecos_binary, run_ecos
 from cosim.native_loader import LOADER
 
 
 def ecos_executable() -> Path:
-    """The ecos binary shipped in the ecospy wheel, or skip with the reason."""
-    try:
-        import ecospy
-    except ImportError:
-        pytest.skip("ecospy is not installed (pip install ecospy)")
-    binary = Path(ecospy.__file__).parent / "binaries" / "ecos"
-    if not binary.is_file():
-        pytest.skip(f"ecospy has no Linux ecos binary ({binary})")
-    missing = subprocess.run(["ldd", str(binary)], capture_output=True, text=True).stdout
-    if "libtbb.so.12 => not found" in missing:
-        pytest.skip(
-            "ecos needs the Debian package libtbb12 (apt-get install libtbb12); .ci/run installs it"
-        )
-    binary.chmod(0o755)
+    """The ecos binary, or skip naming what is missing (.ci/run installs libtbb12)."""
+    binary, why_not = ecos_binary()
+    if binary is None:
+        pytest.skip(why_not)
     return binary
 
 
-def run_ecos(fmu: Path, workdir: Path, stop: float = 0.05) -> list[dict[str, str]]:
+def run_ecos_csv(fmu: Path, workdir: Path, stop: float = 0.05) -> list[dict[str, str]]:
     """Simulate ``fmu`` alone in ecos with a bare environment; return its CSV rows."""
-    result = subprocess.run(
-        [
-            str(ecos_executable()),
-            "simulate",
-            "--path",
-            str(fmu),
-            "--stopTime",
-            str(stop),
-            "--stepSize",
-            "0.001",
-            "--noParallel",
-        ],
-        capture_output=True,
-        text=True,
-        cwd=workdir,
-        env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"},
-        timeout=120,
-    )
+    result = run_ecos(ecos_executable(), fmu, workdir, stop, timeout=120)
     assert result.returncode == 0, f"ecos exit {result.returncode}: {result.stderr[-2000:]}"
     (out,) = workdir.glob("*.csv")
     with out.open() as f:
@@ -63,7 +37,7 @@ def run_ecos(fmu: Path, workdir: Path, stop: float = 0.05) -> list[dict[str, str
 @pytest.mark.parametrize("name", ["MotorChainPlant", "ReactionTorqueObserver"])
 def test_fmu_runs_in_the_ecos_cpp_engine(build_fmus, tmp_path, name) -> None:
     fmu = build_fmus(3) / f"{name}.fmu"
-    rows = run_ecos(fmu, tmp_path)
+    rows = run_ecos_csv(fmu, tmp_path)
     assert len(rows) >= 50
     key = next(k for k in rows[0] if k.endswith("::J[3][REAL]"))
     assert float(rows[-1][key]) == pytest.approx(6.192707e-4, abs=1e-6)
@@ -101,26 +75,7 @@ def test_ssp_in_ecos_matches_the_fmpy_jacobi_run(build_fmus, tmp_path) -> None:
         "trace": {c: {**BENCH[c], "trace_file": str(tmp_path / f"trace_{c}.csv")} for c in BENCH}
     }
     ssp = write_ssp(tmp_path / "traced.ssp", build_fmus(3), traced, stop=1.0)
-    result = subprocess.run(
-        [
-            str(ecos),
-            "simulate",
-            "--path",
-            str(ssp),
-            "--stopTime",
-            "1",
-            "--stepSize",
-            "0.001",
-            "--noParallel",
-            "--parameterSet",
-            "trace",
-        ],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        env={"PATH": "/usr/bin:/bin", "HOME": "/tmp"},
-        timeout=300,
-    )
+    result = run_ecos(ecos, ssp, tmp_path, stop=1.0, parameter_set="trace")
     assert result.returncode == 0, result.stderr[-2000:]
     ours = run_ssp(ssp, None, 1.0, 1e-3, extra=BENCH)
     compared = 0

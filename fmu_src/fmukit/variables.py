@@ -67,7 +67,7 @@ class Variable:
 
 def par(name: str, start: Value, unit: str, description: str) -> Variable:
     """A parameter; its type follows ``start`` (str → String, bool → Boolean, int → Integer)."""
-    return Variable(name, _type_of(start), "parameter", description, unit, start)
+    return Variable(name, type_of(start), "parameter", description, unit, start)
 
 
 def inp(name: str, start: float, unit: str, description: str) -> Variable:
@@ -103,7 +103,8 @@ def indexed(name: str, n: int) -> list[str]:
     return [f"{name}[{i}]" for i in range(1, n + 1)]
 
 
-def _type_of(value: Value) -> VarType:
+def type_of(value: Value) -> VarType:
+    """The FMI type of a Python value: str → String, bool → Boolean, int → Integer, else Real."""
     if isinstance(value, str):
         return "String"
     if isinstance(value, bool):
