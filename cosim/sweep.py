@@ -371,6 +371,9 @@ def sweep(
         )
     pending = [(i, v) for i, v in enumerate(runs) if i not in done]
     blobs = {name: path.read_bytes() for name, path in fmus.items()}
+    if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
+        with open(results, "a", encoding="utf-8") as f:
+            f.write("\n")  # an interrupted write: keep its partial line apart
     with open(results, "a", newline="", encoding="utf-8") as f:
         writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
         if not done:
@@ -389,7 +392,7 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
         )
         client = Client(cluster)
     else:
@@ -420,13 +423,18 @@ def _finished_runs(results: Path, columns: Sequence[str]) -> set[int]:
             raise UserError(
                 f"{results} was written by another spec (columns differ); choose another --out"
             )
-        return {int(row["run"]) for row in reader if row.get("run", "").strip().isdigit()}
+        return {int(row["run"]) for row in reader if _complete(row)}
+
+
+def _complete(row: Mapping[str, str | None]) -> bool:
+    """A row written in full (an interrupted write leaves a short last line)."""
+    return row.get("error") is not None and (row.get("run") or "").strip().isdigit()
 
 
 def read_results(results: Path) -> list[dict[str, str]]:
-    """The rows of a results CSV, one per finished run."""
+    """The rows of a results CSV, one per finished run (a cut-off last line is left out)."""
     with open(results, newline="", encoding="utf-8") as f:
-        return list(csv.DictReader(f))
+        return [row for row in csv.DictReader(f) if _complete(row)]
 
 
 def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:

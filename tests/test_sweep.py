@@ -121,8 +121,10 @@ def test_resume_keeps_finished_runs_and_repeats_none(workdir) -> None:
     interrupted.mkdir()
     with open(workdir / "full" / "results.csv") as f:
         lines = f.readlines()
-    (interrupted / "results.csv").write_text("".join(lines[:3]))  # header + 2 finished runs
+    # header, 2 finished runs, and a third cut off mid-write
+    (interrupted / "results.csv").write_text("".join(lines[:3]) + lines[3][:12])
     kept = read_results(interrupted / "results.csv")
+    assert len(kept) == 2
     with pytest.raises(UserError, match="--resume"):
         sweep(spec, interrupted, workers=1, show_progress=False)
     assert (
@@ -151,7 +153,7 @@ def test_runs_on_an_existing_cluster(workdir) -> None:
 
     spec = load_spec(spec_file(workdir, SMALL))
     with LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0"
     ) as cluster:
         rows = read_results(
             sweep(
