@@ -149,6 +149,19 @@ def ensure_built(n: int = 3, out: Path | None = None) -> Path:
     return target
 
 
+def fmu_variables(folder: Path) -> dict[str, dict[str, object]]:
+    """The plant's and the observer's variables by name (fmpy ``ScalarVariable``),
+    keyed ``"plant"`` and ``"observer"`` as in ``--set plant.k[2]=0.2``."""
+    from fmpy import read_model_description
+
+    return {
+        prefix: {
+            v.name: v for v in read_model_description(str(folder / f"{r.name}.fmu")).modelVariables
+        }
+        for prefix, r in (("plant", PLANT), ("observer", OBSERVER))
+    }
+
+
 def _package_dir(name: str) -> Path:
     module = importlib.import_module(name)
     return Path(module.__file__).parent

@@ -16,9 +16,7 @@ import dataclasses
 import json
 from pathlib import Path
 
-from fmpy import read_model_description
-
-from cosim.build import OBSERVER, PLANT, check_masses, ensure_built
+from cosim.build import check_masses, ensure_built, fmu_variables
 from cosim.errors import UserError
 from cosim.logs import write_csv
 from cosim.master import ORDERINGS
@@ -69,12 +67,7 @@ def _execute(args: argparse.Namespace) -> int:
         scenario = dataclasses.replace(scenario, duration=args.duration)
     n = check_masses(args.masses)
     folder = ensure_built(n)
-    variables = {
-        prefix: {
-            v.name: v for v in read_model_description(str(folder / f"{r.name}.fmu")).modelVariables
-        }
-        for prefix, r in (("plant", PLANT), ("observer", OBSERVER))
-    }
+    variables = fmu_variables(folder)
     overrides = split_overrides(args.set, variables)
     recording = run_scenario(
         scenario,
