@@ -50,6 +50,7 @@ def cosimulate(
     ordering: str = "gauss-seidel",
     t0: float = 0.0,
     progress: Callable[[int], None] | None = None,
+    record_every: int = 1,
 ) -> Recording:
     """Run plant and observer for ``len(i_ref)`` steps of ``h`` seconds.
 
@@ -62,6 +63,8 @@ def cosimulate(
         ordering: ``"gauss-seidel"`` or ``"jacobi"`` (see module doc).
         t0: start time (s).
         progress: called with the number of steps done, every 1000 steps and at the end.
+        record_every: record after every this many steps (and always after the last);
+            reading outputs costs time, and some (identification) cost a solve.
 
     Returns:
         The recording, sample 0 being the values after initialization at t0;
@@ -83,10 +86,16 @@ def cosimulate(
     read_plant = plant.reader(record_plant)
     read_observer = observer.reader(record_observer)
     steps = len(i_ref)
-    plant_log = np.empty((steps + 1, len(record_plant)))
-    observer_log = np.empty((steps + 1, len(record_observer)))
+    if record_every < 1:
+        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
+    recorded = [0, *range(record_every, steps + 1, record_every)]
+    if recorded[-1] != steps:
+        recorded.append(steps)
+    plant_log = np.empty((len(recorded), len(record_plant)))
+    observer_log = np.empty((len(recorded), len(record_observer)))
     plant_log[0] = read_plant() if record_plant else []
     observer_log[0] = read_observer() if record_observer else []
+    row = 1
     gauss_seidel = ordering == "gauss-seidel"
     for k in range(steps):
         t = t0 + k * h
@@ -97,15 +106,17 @@ def cosimulate(
         if gauss_seidel:
             write_measured(read_measured())
         _step(observer, t, h)
-        if record_plant:
-            plant_log[k + 1] = read_plant()
-        if record_observer:
-            observer_log[k + 1] = read_observer()
+        if row < len(recorded) and recorded[row] == k + 1:
+            if record_plant:
+                plant_log[row] = read_plant()
+            if record_observer:
+                observer_log[row] = read_observer()
+            row += 1
         if progress is not None and (k + 1) % 1000 == 0:
             progress(1000)
     if progress is not None and steps % 1000:
         progress(steps % 1000)
-    recording = Recording(time=t0 + np.arange(steps + 1) * h)
+    recording = Recording(time=t0 + np.array(recorded) * h)
     for j, name in enumerate(record_plant):
         recording.signals[f"plant.{name}"] = plant_log[:, j]
     for j, name in enumerate(record_observer):

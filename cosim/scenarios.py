@@ -129,6 +129,7 @@ def run_scenario(
     record_observer: Sequence[str] | None = None,
     fmu_dir: Path | None = None,
     progress: Callable[[int], None] | None = None,
+    record_every: int = 1,
 ) -> Recording:
     """Build (if needed) and run a scenario; settings override the scenario's own.
 
@@ -143,6 +144,7 @@ def run_scenario(
             signals of the plant, every observer output).
         fmu_dir: folder of the FMUs (default ``dist/`` or ``dist/n{n}/``).
         progress: called with the number of steps done since the last call.
+        record_every: record after every this many steps (and after the last).
     """
     folder = fmu_dir if fmu_dir is not None else ensure_built(n)
     t = np.arange(round(scenario.duration / h)) * h

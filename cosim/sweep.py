@@ -92,6 +92,7 @@ def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dic
         "f_c_hat",
         *(f"theta_hat[{i}]" for i in range(1, n + 1)),
     ]
+    every_step = "theta_error" in spec.metrics  # scores need the whole record
     r = run_scenario(
         scenario,
         n,
@@ -102,6 +103,7 @@ def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dic
         record_plant=record_plant,
         record_observer=record_observer,
         fmu_dir=folder,
+        record_every=1 if every_step else 10**9,
     )
     plant = typed["plant"]
 

@@ -319,3 +319,16 @@ def test_run_scenario_python_api(build_fmus) -> None:
     )
     assert r["observer.D_m_hat"][-1] == pytest.approx(2e-5, rel=1e-6)
     assert r["observer.f_c_hat"][-1] == pytest.approx(2e-3, rel=1e-6)
+
+
+def test_master_records_every_nth_step_and_the_last(build_fmus) -> None:
+    folder = build_fmus(3)
+    with (
+        FmuInstance(folder / "MotorChainPlant.fmu", "p") as p,
+        FmuInstance(folder / "ReactionTorqueObserver.fmu", "o") as o,
+    ):
+        r = cosimulate(
+            p, o, [0.3] * 25, 1e-3, ["theta_m_true"], ["k_hat"], IDEAL, {"mode": 1}, record_every=10
+        )
+    np.testing.assert_allclose(r.time, [0.0, 0.010, 0.020, 0.025])
+    assert len(r["plant.theta_m_true"]) == 4 and r["plant.theta_m_true"][-1] > 0

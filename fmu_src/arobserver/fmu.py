@@ -28,6 +28,18 @@ MODES = {
     2: "state estimation",
 }
 ESTIMATORS = {0: "the paper's recursion"}
+#: Outputs of modes 0 and 1, solved from the normal equations only when read.
+IDENTIFICATION_OUTPUTS = (
+    "dkt_hat",
+    "dJm_hat",
+    "D_m_hat",
+    "f_c_hat",
+    "self_id_rank_deficient",
+    "k_hat",
+    "B_hat",
+    "theta_rigid_hat",
+    "id_valid",
+)
 
 
 class ReactionTorqueObserver(FmuSlave):
@@ -189,6 +201,7 @@ class ReactionTorqueObserver(FmuSlave):
         self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
         self.out_theta = self.indices(indexed("theta_hat", n))
         self.out_omega = self.indices(indexed("omega_hat", n))
+        self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
         if settings.mode == STATE_ESTIMATION:
             for i in self.out_theta:
                 self.v[i] = v("theta_m")

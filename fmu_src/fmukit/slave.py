@@ -75,13 +75,14 @@ class FmuSlave(Fmi2Slave):
     def step(self, t: float, h: float) -> None:
         """Advance from ``t`` to ``t + h`` (s): read inputs, write outputs.
 
-        Outputs that are costly and only needed when read may be left stale: set
-        :attr:`stale` and compute them in :meth:`refresh`.
+        Outputs that are costly and only needed when read may be left stale: list
+        their value references in :attr:`lazy`, set :attr:`stale`, and compute them
+        in :meth:`refresh`, which runs only when one of them is read.
         """
         raise NotImplementedError
 
     def refresh(self) -> None:
-        """Bring outputs left stale by :meth:`step` up to date (called before any get)."""
+        """Bring the :attr:`lazy` outputs up to date (called before one of them is read)."""
 
     # -- construction -------------------------------------------------------------
 
@@ -114,6 +115,7 @@ class FmuSlave(Fmi2Slave):
         ]
         self.time: float | None = None
         self.stale = False
+        self.lazy: frozenset[int] = frozenset()
         self.initialized = False
         self.problems: list[str] = []
         self._trace: TextIO | None = None
@@ -292,7 +294,7 @@ class FmuSlave(Fmi2Slave):
         self._set(vrs, values, "String", str)
 
     def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
-        if self.stale:
+        if self.stale and not self.lazy.isdisjoint(vrs):
             self.stale = False
             self.refresh()
         v = self.v
