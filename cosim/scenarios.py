@@ -176,6 +176,7 @@ def run_scenario(
             observer_values,
             ordering=ordering,
             progress=progress,
+            record_every=record_every,
         )
 
 

@@ -332,3 +332,17 @@ def test_master_records_every_nth_step_and_the_last(build_fmus) -> None:
         )
     np.testing.assert_allclose(r.time, [0.0, 0.010, 0.020, 0.025])
     assert len(r["plant.theta_m_true"]) == 4 and r["plant.theta_m_true"][-1] > 0
+
+
+def test_run_scenario_passes_record_every_to_the_master(build_fmus) -> None:
+    import dataclasses
+
+    scenario = dataclasses.replace(SCENARIOS["rigid"], duration=0.1)
+    r = run_scenario(
+        scenario,
+        fmu_dir=build_fmus(3),
+        record_plant=["twist"],
+        record_observer=["k_hat"],
+        record_every=40,
+    )
+    np.testing.assert_allclose(r.time, [0.0, 0.04, 0.08, 0.1])
