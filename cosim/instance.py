@@ -7,6 +7,7 @@ status instead of an exception, so a master can carry on or stop cleanly.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
@@ -26,6 +27,27 @@ from fmpy.fmi2 import (
 from cosim.errors import UserError
 
 STATUS_NAMES = ("ok", "warning", "discard", "error", "fatal", "pending")
+
+_EXTRACTED: dict[tuple[str, int, int], str] = {}
+
+
+def extracted(path: Path) -> str:
+    """The folder an FMU file is unzipped into, once per file (and version) per process.
+
+    Every instance of one FMU then loads the same binary. pythonfmu 0.7's binary has
+    a destructor that misbehaves at process exit (a use-after-free seen with
+    valgrind), and each separately unzipped copy runs its own, so fewer copies mean
+    fewer chances; it also spares an unzip per instance. The folders are removed at
+    exit.
+    """
+    stat = path.stat()
+    key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    folder = _EXTRACTED.get(key)
+    if folder is None or not Path(folder).is_dir():
+        folder = extract(str(path))
+        _EXTRACTED[key] = folder
+        atexit.register(shutil.rmtree, folder, True)
+    return folder
 
 
 class FmuInstance:
@@ -50,7 +72,7 @@ class FmuInstance:
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.messages: list[str] = []
         self._echo = echo_log
-        self._unzipped = extract(str(path))
+        self._unzipped = extracted(path)
         self._callbacks = self._make_callbacks()
         self.slave = FMU2Slave(
             guid=self.description.guid,
@@ -84,14 +106,13 @@ class FmuInstance:
         return 0
 
     def close(self) -> None:
-        """Terminate, free the instance and remove the unzipped FMU."""
+        """Terminate and free the instance (the unzipped FMU stays for the next one)."""
         if self.slave is None:
             return
         with contextlib.suppress(FMICallException):
             self.slave.terminate()
         self.slave.freeInstance()
         self.slave = None
-        shutil.rmtree(self._unzipped, ignore_errors=True)
 
     def __enter__(self) -> FmuInstance:
         return self

@@ -308,3 +308,17 @@ def test_every_fmu_for_several_n_loads_in_one_process(build_fmus) -> None:
             assert all(fmu.do_step(k * 1e-3, 1e-3) == 0 for fmu in fmus)
         identifiers = {fmu.description.coSimulation.modelIdentifier for fmu in fmus}
         assert len(identifiers) == 9
+
+
+def test_instances_of_one_fmu_share_one_unzipped_copy(plant_fmu: Path) -> None:
+    with FmuInstance(plant_fmu, "a") as a, FmuInstance(plant_fmu, "b") as b:
+        assert a._unzipped == b._unzipped
+        a.initialize(IDEAL)
+        b.initialize({**IDEAL, "k[1]": 0.3})
+        a.set({"i_ref": 0.3})
+        b.set({"i_ref": 0.3})
+        for k in range(50):
+            assert a.do_step(k * 1e-3, 1e-3) == 0 and b.do_step(k * 1e-3, 1e-3) == 0
+        assert a.get(["theta[1]"]) != b.get(["theta[1]"])  # separate instances
+    with FmuInstance(plant_fmu, "c") as c:
+        assert c._unzipped == a._unzipped and Path(c._unzipped).is_dir()
