@@ -219,3 +219,23 @@ def test_nan_input_is_refused_and_no_output_is_ever_nan(fmus) -> None:
 def test_observer_runs_from_its_own_resources_with_nothing_installed(fmus, tmp_path) -> None:
     """The FMU's resources/ run in `python -I -S` with nothing installed."""
     assert step_from_resources(fmus[1], tmp_path, "i_a", "d_hat") > 0
+
+
+def test_trace_file_holds_current_identification_outputs(fmus, tmp_path) -> None:
+    """k_hat is solved lazily; the trace must see the solved value, not a stale one."""
+    trace = tmp_path / "observer.csv"
+    with FmuInstance(fmus[1], "traced") as o:
+        o.initialize({"mode": 1, "trace_file": str(trace)})
+        for k in range(200):
+            o.set(
+                {
+                    "i_a": 0.3 * math.sin(5e-3 * k),
+                    "omega_m": math.cos(5e-3 * k),
+                    "theta_m": math.sin(5e-3 * k) / 5,
+                }
+            )
+            assert o.do_step(k * 1e-3, 1e-3) == 0
+        k_hat = o.get(["k_hat"])[0]
+    header, *rows = trace.read_text().splitlines()
+    column = header.split(",").index("k_hat")
+    assert k_hat != 0.0 and float(rows[-1].split(",")[column]) == k_hat

@@ -240,6 +240,7 @@ class FmuSlave(Fmi2Slave):
         return []
 
     def _write_trace(self) -> None:
+        self._refresh(self._trace_outputs)
         v = self.v
         row = [repr(float(self.time or 0.0))]
         row += [repr(float(v[i])) for i in self._trace_outputs]
@@ -293,10 +294,14 @@ class FmuSlave(Fmi2Slave):
     def set_string(self, vrs: Sequence[int], values: Sequence[str]) -> None:
         self._set(vrs, values, "String", str)
 
-    def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
+    def _refresh(self, vrs: Sequence[int]) -> None:
+        """Run :meth:`refresh` if ``vrs`` include a stale :attr:`lazy` output."""
         if self.stale and not self.lazy.isdisjoint(vrs):
             self.stale = False
             self.refresh()
+
+    def _get(self, vrs: Sequence[int], vtype: str, cast: type) -> list:
+        self._refresh(vrs)
         v = self.v
         if self._vrs_of_type[vtype].issuperset(vrs):
             return [v[i] for i in vrs]
