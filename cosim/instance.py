@@ -11,7 +11,6 @@ import atexit
 import contextlib
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
-from ctypes import c_char_p
 from pathlib import Path
 
 from fmpy import extract, read_model_description
@@ -184,16 +183,7 @@ class FmuInstance:
 
     def get(self, names: Sequence[str]) -> list[float]:
         """Values of ``names`` (Booleans and Integers converted to float)."""
-        out = []
-        for name in names:
-            var = self._variable(name)
-            if var.type == "Real":
-                out.append(self.slave.getReal([var.valueReference])[0])
-            elif var.type == "Integer":
-                out.append(float(self.slave.getInteger([var.valueReference])[0]))
-            else:
-                out.append(float(self.slave.getBoolean([var.valueReference])[0]))
-        return out
+        return list(self.reader(names)())
 
     def _variable(self, name: str):
         try:
@@ -220,5 +210,4 @@ class FmuInstance:
         callbacks.logger = fmi2CallbackLoggerTYPE(logger)
         callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self._keep_alive = (logger, c_char_p)
         return callbacks

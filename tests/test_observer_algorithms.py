@@ -10,7 +10,7 @@ from scipy.signal import lfilter
 
 from flexchain.dob import Actuator, ReactionObserver, mean_sign
 from flexchain.filters import LowPass
-from flexchain.least_squares import NormalEquations, eliminate
+from flexchain.least_squares import NormalEquations
 from flexchain.recursion import ChainRecursion
 from flexchain.rigid_identification import SETTLE, RigidChainIdentifier, kappa
 from flexchain.self_identification import ActuatorIdentifier
@@ -61,17 +61,6 @@ def test_normal_equations_equal_batch_least_squares() -> None:
     want = np.linalg.lstsq(x[:, [0, 2]], y, rcond=None)[0]
     np.testing.assert_allclose([reduced[0], reduced[2]], want, rtol=1e-9)
     assert reduced[1] == reduced[3] == 0.0
-
-
-def test_eliminating_nuisance_columns_keeps_the_fit() -> None:
-    rng = np.random.default_rng(5)
-    x = rng.normal(size=(300, 4))
-    y = rng.normal(size=300)
-    eq = NormalEquations(4)
-    for row, target in zip(x, y):
-        eq.add(row, target)
-    xtx, xty = eliminate(eq, (0, 1), (2, 3))
-    np.testing.assert_allclose(np.linalg.solve(xtx, xty), np.linalg.lstsq(x, y, rcond=None)[0][:2])
 
 
 def test_rigid_identifier_final_estimate_is_the_batch_fit() -> None:

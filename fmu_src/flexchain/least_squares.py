@@ -79,44 +79,6 @@ def reciprocal_condition(a: list[list[float]]) -> float:
     return 1.0 / (norm * norm_inv)
 
 
-def eliminate(
-    equations: NormalEquations, keep: Sequence[int], drop: Sequence[int]
-) -> tuple[list[list[float]], list[float]] | None:
-    """Normal equations of the ``keep`` coefficients with the ``drop`` ones solved out.
-
-    The Schur complement ``A − C D⁻¹ Cᵀ`` and ``b₁ − C D⁻¹ b₂``: adding these to other
-    equations gives the least-squares fit in which the dropped coefficients are
-    free (nuisance parameters of this block of rows only).
-
-    Returns:
-        ``(xtx, xty)`` over ``keep``, or None when the dropped block is singular
-        (too few rows to fix the nuisance parameters; the block carries no information).
-    """
-    m = equations.entry
-    d = [[m(r, c) for c in drop] for r in drop]
-    if reciprocal_condition(d) < 1e-13:
-        return None
-    c_t = [[m(r, c) for c in keep] for r in drop]  # D-rows × keep-columns
-    rhs = [[*c_t[i], equations.xty[r]] for i, r in enumerate(drop)]
-    try:
-        z = solve(d, rhs)  # D⁻¹ [Cᵀ | b₂]
-    except ValueError:
-        return None
-    nk = len(keep)
-    xtx = [
-        [
-            m(keep[i], keep[j]) - sum(c_t[q][i] * z[q][j] for q in range(len(drop)))
-            for j in range(nk)
-        ]
-        for i in range(nk)
-    ]
-    xty = [
-        equations.xty[keep[i]] - sum(c_t[q][i] * z[q][nk] for q in range(len(drop)))
-        for i in range(nk)
-    ]
-    return xtx, xty
-
-
 def solve_normal(xtx: list[list[float]], xty: list[float]) -> tuple[list[float], float]:
     """Solve small normal equations; return ``(beta, rcond)`` (zeros and 0 when singular)."""
     p = len(xty)
