@@ -27,6 +27,7 @@ from cosim import __version__
 from cosim.build import ensure_built
 from cosim.logs import write_csv
 from cosim.master import Recording
+from cosim.metrics import flexible_score, percent_error
 from cosim.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from cosim.report import (
     figure_flexible_response,
@@ -52,11 +53,6 @@ class Results:
     rigid: list[dict[str, float]] = field(default_factory=list)
     scores: list[float] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
-
-
-def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -> float:
-    """METHOD.md's state score: rms(θ̂_i − θ_i) / rms(θ_i − θ_m)."""
-    return float(np.sqrt(np.mean((estimate - truth) ** 2) / np.mean((truth - motor) ** 2)))
 
 
 def reproduce(out: Path, ideal: bool = False, show_progress: bool = True) -> Results:
@@ -237,7 +233,7 @@ def state_rows(results: Results) -> list[list[str]]:
 
 
 def _pct(value: float, truth: float) -> str:
-    return f"{100 * (value / truth - 1):+.2f} %"
+    return f"{percent_error(value, truth):+.2f} %"
 
 
 def _report(results: Results, ideal: bool, k_mean: float, b_mean: float) -> str:

@@ -26,10 +26,9 @@ import traceback
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import numpy as np
-
 from cosim.build import OBSERVER, PLANT, ensure_built, fmu_variables
 from cosim.errors import UserError
+from cosim.metrics import flexible_score, percent_error
 from cosim.overrides import typed_value
 from cosim.sweep_spec import SweepSpec, check_names, draw_runs, load_spec, metric_columns
 from cosim.sweep_summary import complete, read_results, write_summary
@@ -107,29 +106,22 @@ def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dic
     )
     plant = typed["plant"]
 
-    def pct(estimate: float, truth: float) -> float:
-        return 100.0 * (estimate / truth - 1.0)
-
     out: dict[str, float] = {}
     for metric in spec.metrics:
         if metric == "k_error":
-            out[metric] = pct(r["observer.k_hat"][-1], plant.get("k[1]", bench.K))
+            out[metric] = percent_error(r["observer.k_hat"][-1], plant.get("k[1]", bench.K))
         elif metric == "B_error":
-            out[metric] = pct(r["observer.B_hat"][-1], plant.get("B[1]", bench.B))
+            out[metric] = percent_error(r["observer.B_hat"][-1], plant.get("B[1]", bench.B))
         elif metric == "D_m_error":
-            out[metric] = pct(r["observer.D_m_hat"][-1], plant.get("D_m", bench.D_M))
+            out[metric] = percent_error(r["observer.D_m_hat"][-1], plant.get("D_m", bench.D_M))
         elif metric == "f_c_error":
-            out[metric] = pct(r["observer.f_c_hat"][-1], plant.get("f_c", bench.F_C))
+            out[metric] = percent_error(r["observer.f_c_hat"][-1], plant.get("f_c", bench.F_C))
         elif metric == "theta_error":
             motor = r["plant.theta_m_true"]
             for i in range(1, n + 1):
                 truth = r[f"plant.theta[{i}]"]
                 est = r[f"observer.theta_hat[{i}]"]
-                out[f"theta_error[{i}]"] = float(
-                    np.sqrt(
-                        np.mean((est - truth) ** 2) / max(np.mean((truth - motor) ** 2), 1e-300)
-                    )
-                )
+                out[f"theta_error[{i}]"] = flexible_score(est, truth, motor)
     return out
 
 

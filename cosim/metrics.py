@@ -1,0 +1,20 @@
+"""How estimates are scored against the plant's truth (shared/METHOD.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -> float:
+    """State score of one mass: rms(θ̂_i − θ_i) / rms(θ_i − θ_m).
+
+    The error relative to the flexible part of the motion (the rigid part is easy and
+    would hide errors); 0 is perfect, the naive ``θ̂_i = θ_m`` scores 1.
+    """
+    flexible = max(float(np.mean((truth - motor) ** 2)), 1e-300)
+    return float(np.sqrt(np.mean((estimate - truth) ** 2) / flexible))
+
+
+def percent_error(estimate: float, truth: float) -> float:
+    """Relative error of ``estimate`` in percent of ``truth``."""
+    return 100.0 * (estimate / truth - 1.0)
