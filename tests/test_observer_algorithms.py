@@ -9,7 +9,7 @@ import pytest
 from scipy.signal import lfilter
 
 from flexchain.dob import Actuator, ReactionObserver, mean_sign
-from flexchain.filters import LowPass
+from flexchain.filters import LowPassBank
 from flexchain.least_squares import NormalEquations
 from flexchain.recursion import ChainRecursion
 from flexchain.rigid_identification import SETTLE, RigidChainIdentifier, kappa
@@ -26,12 +26,13 @@ def lowpass(x: np.ndarray, g: float, h: float, y0: float = 0.0) -> np.ndarray:
 
 def test_lowpass_is_exact_for_any_step_sequence() -> None:
     """Unit step through G: 1 − e^{−g t}, whatever the steps taken."""
-    f = LowPass(50.0)
+    f = LowPassBank(50.0, 2)
     t = 0.0
     for h in (1e-3, 7e-3, 2e-4, 0.05, 1e-6, 0.013):
-        f.step(h, 1.0)
+        f.step(h, [1.0, -2.0])
         t += h
-        assert f.y == pytest.approx(1 - math.exp(-50.0 * t), rel=1e-12)
+        assert f.y[0] == pytest.approx(1 - math.exp(-50.0 * t), rel=1e-12)
+        assert f.y[1] == pytest.approx(-2 * (1 - math.exp(-50.0 * t)), rel=1e-12)
 
 
 @pytest.mark.parametrize(

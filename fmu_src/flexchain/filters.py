@@ -13,29 +13,6 @@ from __future__ import annotations
 import math
 
 
-class LowPass:
-    """``G(s) = g / (s + g)``, zero initial state.
-
-    Args:
-        g: corner frequency (rad/s), > 0.
-
-    Attributes:
-        y: the filter output (same unit as the input).
-    """
-
-    __slots__ = ("g", "y")
-
-    def __init__(self, g: float) -> None:
-        self.g = g
-        self.y = 0.0
-
-    def step(self, h: float, u: float) -> float:
-        """Advance by ``h`` (s) with input ``u`` held over the step; return the output."""
-        a = math.exp(-self.g * h)
-        self.y = a * self.y + (1.0 - a) * u
-        return self.y
-
-
 class LowPassBank:
     """Several filters with one corner frequency, advanced together.
 

@@ -34,10 +34,10 @@ Multi-mass correction. For n > 1 the rigid motion is the centre of mass, not
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 from flexchain.dob import sign
+from flexchain.filters import LowPassBank
 from flexchain.least_squares import RCOND_MIN, NormalEquations
 
 #: Rows start this many filter time constants (1/g) after the start.
@@ -83,8 +83,8 @@ class RigidChainIdentifier:
         self.theta_last = theta0  # motor angle at the last step processed
         self.h_last = 0.0  # its length (s)
         self.held: list[tuple[float, float, float, float]] = []  # (h, drive, ω, θ)
-        # G[θ_m], G[θ̇_m], G[I₁], G[I₂], G[t], G[1], G[τ]
-        self.filtered = [theta0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        self.filtered = LowPassBank(g, 7)  # G[θ_m], G[θ̇_m], G[I₁], G[I₂], G[t], G[1], G[τ]
+        self.filtered.y[0] = theta0
         self.equations = NormalEquations(4)
         self.rows = 0
         self.k = self.B = self.theta_rigid = 0.0
@@ -163,10 +163,7 @@ class RigidChainIdentifier:
         self.t += h
         self.i2 += h * self.i1 + 0.5 * h * h * torque
         self.i1 += h * torque
-        a = math.exp(-self.g * h)
-        b = 1.0 - a
-        raw = (theta, omega, self.i1, self.i2, self.t, 1.0, torque)
-        self.filtered = f = [a * y + b * x for y, x in zip(self.filtered, raw)]
+        f = self.filtered.step(h, [theta, omega, self.i1, self.i2, self.t, 1.0, torque])
         if self.t < SETTLE / self.g:
             return
         m = self.total_inertia
@@ -183,7 +180,7 @@ class RigidChainIdentifier:
         k21, b21, b3, b4 = beta
         c4 = -b3 / k21
         c5 = -(b4 + b21 * c4) / k21
-        f = self.filtered
+        f = self.filtered.y
         self.k = self.kappa * k21
         self.B = self.kappa * b21
         self.theta_rigid = f[3] / self.total_inertia + c4 * f[4] + c5 * f[5]

@@ -30,8 +30,7 @@ last ``5 / g + 5 / g_id`` seconds: a stuck motor's friction is not ``f_c sgn θ�
 
 from __future__ import annotations
 
-import math
-
+from flexchain.filters import LowPassBank
 from flexchain.least_squares import RCOND_MIN, NormalEquations
 
 #: A four-regressor fit this close to singular is taken as the rank deficiency
@@ -59,8 +58,8 @@ class ActuatorIdentifier:
         self.g_id = g_id
         self.k_to = k_to
         self.omega_min = omega_min
-        self.filtered = [0.0, 0.0, 0.0, 0.0]
-        self.smoothed = [0.0, 0.0, 0.0, 0.0, 0.0]  # F[G[regressors]], F[d̂]
+        self.filtered = LowPassBank(g, 4)  # G[i], G[v], G[α], G[sgn]
+        self.smoothed = LowPassBank(g_id, 5) if g_id > 0.0 else None  # F[G[…]], F[d̂]
         self.settle = 5.0 / g + (5.0 / g_id if g_id > 0.0 else 0.0)
         self.moving_time = 0.0
         self.equations = NormalEquations(4)
@@ -87,17 +86,10 @@ class ActuatorIdentifier:
             friction_sign: mean of sgn θ̇ over the step.
             d_hat: the DOB's estimate after this sample (N·m).
         """
-        a = math.exp(-self.g * h)
-        b = 1.0 - a
-        raw = (i_a, velocity, accel, friction_sign)
-        f = self.filtered
-        self.filtered = f = [a * f[j] + b * raw[j] for j in range(4)]
-        row, target = f, d_hat
-        if self.g_id > 0.0:
-            a2 = math.exp(-self.g_id * h)
-            b2 = 1.0 - a2
-            self.smoothed = sm = [a2 * y + b2 * x for y, x in zip(self.smoothed, (*f, d_hat))]
-            row, target = sm[:4], sm[4]
+        row = self.filtered.step(h, [i_a, velocity, accel, friction_sign])
+        target = d_hat
+        if self.smoothed is not None:
+            *row, target = self.smoothed.step(h, [*row, d_hat])
         self.moving_time = self.moving_time + h if abs(velocity) > self.omega_min else 0.0
         if self.moving_time >= self.settle:
             self.equations.add(row, target)
