@@ -18,7 +18,7 @@ from pathlib import Path
 
 from cosim import __version__
 from cosim.errors import UserError
-from cosim.native_loader import add_python_loader, loader_problem
+from cosim.native_loader import loader_problem, patch_linux_binaries
 
 MIN_MASSES, MAX_MASSES = 1, 20
 
@@ -123,10 +123,9 @@ def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
         if tmp in sys.path:
             sys.path.remove(tmp)
     problem = loader_problem()
-    if problem is None:
-        add_python_loader(Path(built))
-    else:
+    if problem is not None:
         warnings.warn(f"{Path(built).name} will load in Python hosts only: {problem}", stacklevel=2)
+    patch_linux_binaries(Path(built), add_loader=problem is None)
     return Path(built)
 
 

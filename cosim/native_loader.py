@@ -1,10 +1,14 @@
-"""Make a pythonfmu FMU loadable in hosts that are not Python (C/C++ engines).
+"""Patch a pythonfmu FMU's Linux binary so it works in every host and exits cleanly.
 
-Compiles ``cosim/native/python_loader.c`` against this Python's shared library and
-adds it to the FMU's Linux binary as a needed library (``patchelf``), with RUNPATH
-``$ORIGIN`` so the loader finds it beside the binary. See the C file for why.
-Linux only; elsewhere (and without a C compiler or a shared libpython) the FMU is
-left as it is and still runs in Python hosts.
+Two patches, applied to ``binaries/linux64/*.so`` inside the FMU at build time:
+
+- always: drop pythonfmu 0.7's exit-time use-after-free (``cosim/exit_fix.py``);
+- where possible: compile ``cosim/native/python_loader.c`` against this Python's shared
+  library and add it to the binary as a needed library (``patchelf``), with RUNPATH
+  ``$ORIGIN`` so the loader finds it beside the binary. That makes the FMU loadable in
+  hosts that are not Python (C/C++ engines); see the C file for why. Linux only;
+  elsewhere (and without a C compiler or a shared libpython) the FMU still runs in
+  Python hosts.
 """
 
 from __future__ import annotations
@@ -16,6 +20,8 @@ import sysconfig
 import tempfile
 import zipfile
 from pathlib import Path
+
+from cosim.exit_fix import remove_exit_bug
 
 LOADER = "libarcosim_python.so"
 SOURCE = Path(__file__).parent / "native" / "python_loader.c"
@@ -34,54 +40,67 @@ def loader_problem() -> str | None:
     return None
 
 
-def add_python_loader(fmu: Path) -> None:
-    """Compile the loader and patch the FMU's ``binaries/linux64`` binary in place.
+def patch_linux_binaries(fmu: Path, add_loader: bool) -> None:
+    """Patch the FMU's ``binaries/linux64`` binaries in place (see the module docstring).
+
+    Args:
+        fmu: the FMU file, rewritten in place.
+        add_loader: also compile and attach the Python loader (needs
+            ``loader_problem()`` to be None).
 
     Raises:
         RuntimeError: when the compiler or patchelf fails (their output included).
     """
+    with zipfile.ZipFile(fmu) as z:
+        members = {info.filename: z.read(info) for info in z.infolist()}
+    binaries = [
+        n
+        for n in members
+        if n.startswith("binaries/linux64/") and n.endswith(".so") and not n.endswith(LOADER)
+    ]
+    for name in binaries:
+        members[name] = remove_exit_bug(members[name])
+    if add_loader:
+        with tempfile.TemporaryDirectory(prefix="arcosim_native_") as tmp:
+            loader = _compile_loader(Path(tmp))
+            for name in binaries:
+                binary = Path(tmp) / Path(name).name
+                binary.write_bytes(members[name])
+                _run([_patchelf(), "--add-needed", LOADER, str(binary)])
+                _run([_patchelf(), "--set-rpath", "$ORIGIN", str(binary)])
+                members[name] = binary.read_bytes()
+            members[f"binaries/linux64/{LOADER}"] = loader.read_bytes()
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+
+
+def _compile_loader(folder: Path) -> Path:
+    """Compile the loader for this Python into ``folder``; return its path."""
     libdir = sysconfig.get_config_var("LIBDIR")
     soname = sysconfig.get_config_var("INSTSONAME")
     home = sys.base_prefix
-    with tempfile.TemporaryDirectory(prefix="arcosim_native_") as tmp:
-        tmp = Path(tmp)
-        loader = tmp / LOADER
-        compiler = shutil.which("gcc") or shutil.which("cc")
-        _run(
-            [
-                compiler,
-                "-shared",
-                "-fPIC",
-                "-O2",
-                "-o",
-                str(loader),
-                str(SOURCE),
-                f'-DARCOSIM_LIBPYTHON="{soname}"',
-                f'-DARCOSIM_PYTHONHOME="{home}"',
-                f"-L{libdir}",
-                "-Wl,--no-as-needed",
-                "-lpython3",
-                "-ldl",
-                f"-Wl,-rpath,$ORIGIN:{libdir}",
-            ]
-        )
-        with zipfile.ZipFile(fmu) as z:
-            members = {info.filename: z.read(info) for info in z.infolist()}
-        binaries = [
-            n
-            for n in members
-            if n.startswith("binaries/linux64/") and n.endswith(".so") and not n.endswith(LOADER)
+    loader = folder / LOADER
+    compiler = shutil.which("gcc") or shutil.which("cc")
+    _run(
+        [
+            compiler,
+            "-shared",
+            "-fPIC",
+            "-O2",
+            "-o",
+            str(loader),
+            str(SOURCE),
+            f'-DARCOSIM_LIBPYTHON="{soname}"',
+            f'-DARCOSIM_PYTHONHOME="{home}"',
+            f"-L{libdir}",
+            "-Wl,--no-as-needed",
+            "-lpython3",
+            "-ldl",
+            f"-Wl,-rpath,$ORIGIN:{libdir}",
         ]
-        for name in binaries:
-            binary = tmp / Path(name).name
-            binary.write_bytes(members[name])
-            _run([_patchelf(), "--add-needed", LOADER, str(binary)])
-            _run([_patchelf(), "--set-rpath", "$ORIGIN", str(binary)])
-            members[name] = binary.read_bytes()
-        members[f"binaries/linux64/{LOADER}"] = loader.read_bytes()
-        with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
-            for name, data in members.items():
-                z.writestr(name, data)
+    )
+    return loader
 
 
 def _patchelf() -> str | None:
