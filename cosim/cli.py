@@ -7,7 +7,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from cosim import __version__, build, identify, reproduce, simulate, ssp, sweep, validate
+from cosim import __version__, bench, build, identify, reproduce, simulate, ssp, sweep, validate
 from cosim.errors import UserError
 
 
@@ -20,7 +20,7 @@ def make_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"arcosim {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND")
-    for module in (build, simulate, identify, reproduce, ssp, sweep, validate):
+    for module in (build, simulate, identify, reproduce, sweep, ssp, validate, bench):
         module.add_parser(subparsers)
     return parser
 

@@ -4,6 +4,8 @@ Contract (scripts rely on it)::
 
     arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
                              [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
+                             [--method observer|output-error] [--fit-inertia-scale]
+                             [--start-k K]
 
 * the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
@@ -12,6 +14,13 @@ Contract (scripts rely on it)::
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
 * ``--out FILE``: every output over time as CSV (``time`` first).
+* ``--method output-error``: instead of replaying the observer FMU, fit the uniform
+  chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
+  from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
+  observer's parameters (``--set``: J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, J[i]) say
+  what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
+  standard errors under ``std``, and the evidence (start, residual, velocity used).
+  Needs a constant sample step.
 
 A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
 error naming the row or column, and exit status 2.
@@ -26,12 +35,14 @@ from pathlib import Path
 
 import numpy as np
 
-from cosim.build import OBSERVER, check_masses, ensure_built
+from cosim.build import OBSERVER, check_masses, ensure_built, fmu_variables
 from cosim.errors import UserError
 from cosim.instance import FmuInstance
 from cosim.logs import DriveLog, parse_scales, read_log, write_csv
 from cosim.master import MEASURED, Recording
+from cosim.output_error import Fit, MotorRecord, motor_record, uniform_chain
 from cosim.overrides import check_name, parse_assignment, typed_value
+from flexchain.dob import Actuator
 
 
 def replay_log(
@@ -134,12 +145,30 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--json", action="store_true", help="print the final outputs as one JSON object")
     p.add_argument("--out", type=Path, help="write every output over time to this CSV file")
+    p.add_argument(
+        "--method",
+        choices=("observer", "output-error"),
+        default="observer",
+        help="observer: replay the observer FMU (default); output-error: fit k and B offline",
+    )
+    p.add_argument(
+        "--fit-inertia-scale",
+        action="store_true",
+        help="output-error: also fit a common scale on the load inertias J[i]",
+    )
+    p.add_argument(
+        "--start-k",
+        type=float,
+        help="output-error: start from this stiffness (N.m/rad) instead of the resonance",
+    )
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
     folder = ensure_built(check_masses(args.masses))
+    if args.method == "output-error":
+        return _output_error(args, log, folder)
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
         recording = replay_log(observer, log, parameters)
@@ -161,3 +190,70 @@ def _print_summary(final: dict, samples: int, out: Path | None) -> None:
         print(f"  {key:24s} {value}")
     if out:
         print(f"wrote {out}")
+
+
+def known_parameters(folder: Path, assignments: Sequence[str]) -> dict[str, float]:
+    """The observer FMU's parameter defaults with ``--set`` applied (offline methods)."""
+    variables = fmu_variables(folder)["observer"]
+    values: dict[str, float] = {
+        name: float(v.start)
+        for name, v in variables.items()
+        if v.causality == "parameter" and v.type in ("Real", "Integer")
+    }
+    for text in assignments:
+        name, value = parse_assignment(text)
+        check_name(name, variables, "the observer")
+        if variables[name].causality != "parameter":
+            raise UserError(f"--set {text!r}: {name} is an {variables[name].causality}")
+        values[name] = float(typed_value(name, value, variables[name].type))
+    return values
+
+
+def actuator_of(values: Mapping[str, float]) -> Actuator:
+    """The actuator terms among the observer's parameters."""
+    for name in ("J_mo", "k_to", "g_dist"):
+        if not values[name] > 0:
+            raise UserError(f"{name} = {values[name]!r} must be > 0")
+    return Actuator(
+        values["J_mo"], values["k_to"], values["dkt"], values["dJm"], values["D_m"], values["f_c"]
+    )
+
+
+def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path) -> int:
+    values = known_parameters(folder, args.set)
+    n = check_masses(args.masses)
+    J = [values[f"J[{i}]"] for i in range(1, n + 1)]
+    if any(not x > 0 for x in J):
+        raise UserError(f"the load inertias must be > 0, got J = {J}")
+    c = log.columns
+    record = motor_record(
+        log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
+    )
+    result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
+    names = {"k": "k_hat", "B": "B_hat", "J_scale": "J_scale"}
+    report = {names[k]: v for k, v in result.as_dict().items()}
+    report["std"] = {names[k]: v for k, v in result.std_dict().items()}
+    report.update(evidence(result, record))
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(f"{len(log)} samples, output-error fit of the uniform chain ({n} masses):")
+        for key in (k for k in report if k in names.values()):
+            print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
+        for key in ("start", "velocity", "rms_residual", "rms_data", "newey_west_lag"):
+            print(f"  {key}: {report[key]}")
+    return 0
+
+
+def evidence(result: Fit, record: MotorRecord) -> dict[str, object]:
+    """What an output-error fit rests on, for the JSON report."""
+    return {
+        "method": "output-error",
+        "start": result.start_note,
+        "velocity": record.velocity_source,
+        "rms_residual": result.rms_residual,
+        "rms_data": result.rms_data,
+        "newey_west_lag": result.lag,
+        "duration": record.duration,
+        "evaluations": result.evaluations,
+    }

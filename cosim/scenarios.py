@@ -140,6 +140,7 @@ def run_scenario(
         h: communication step (s).
         ordering: ``"gauss-seidel"`` or ``"jacobi"``.
         ideal: switch the plant's sensors off (before ``plant`` overrides).
+            The observer is told the plant's ``encoder_cpr`` unless ``observer`` sets it.
         record_plant, record_observer: outputs to record (default: measured and truth
             signals of the plant, every observer output).
         fmu_dir: folder of the FMUs (default ``dist/`` or ``dist/n{n}/``).
@@ -151,6 +152,8 @@ def run_scenario(
     current = scenario.current(t)
     plant_values = {**scenario.plant, **(IDEAL_SENSORS if ideal else {}), **(plant or {})}
     observer_values = {**scenario.observer, **(observer or {})}
+    if "encoder_cpr" in plant_values and "encoder_cpr" not in observer_values:
+        observer_values["encoder_cpr"] = plant_values["encoder_cpr"]  # same sensor
     with (
         FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as p,
         FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as o,

@@ -165,7 +165,7 @@ def test_state_estimation_by_recursion(fmus, tmp_path_factory) -> None:
             truth,
             estimates,
             IDEAL,
-            {"mode": 2, "g_dist": g, "g_lpf": g, "D_m": 2e-5, "f_c": 2e-3},
+            {"mode": 2, "g_dist": g, "g_lpf": g, "D_m": 2e-5, "f_c": 2e-3, "encoder_cpr": 0},
         )
         scores[g] = [
             flexible_score(
@@ -186,7 +186,8 @@ def test_state_estimation_by_recursion(fmus, tmp_path_factory) -> None:
         ({"g_dist": -1.0}, "g_dist = -1.0 must be > 0"),
         ({"k[2]": 0.0}, "k[2] = 0.0 must be > 0"),
         ({"mode": 7}, "mode = 7 is not allowed"),
-        ({"estimator": 1}, "the model-based observer comes in a later version"),
+        ({"estimator": 3}, "estimator = 3 is not allowed"),
+        ({"encoder_cpr": -5}, "encoder_cpr = -5 must be >= 0"),
         ({"J_mo": float("nan")}, "J_mo = nan is not a finite number"),
     ],
 )

@@ -13,7 +13,6 @@ from typing import ClassVar
 from flexchain import bench
 from flexchain.dob import Actuator
 from flexchain.observer import (
-    MODEL_BASED,
     RIGID_IDENTIFICATION,
     SELF_IDENTIFICATION,
     STATE_ESTIMATION,
@@ -27,7 +26,7 @@ MODES = {
     1: "rigid-maneuver chain identification",
     2: "state estimation",
 }
-ESTIMATORS = {0: "the paper's recursion"}
+ESTIMATORS = {0: "the paper's recursion", 1: "model-based observer"}
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
 IDENTIFICATION_OUTPUTS = (
     "dkt_hat",
@@ -109,7 +108,27 @@ class ReactionTorqueObserver(FmuSlave):
                 0,
                 "",
                 "Mode 2: 0 = the paper's recursion (eq. 22-26); 1 = model-based observer "
-                "(not available in this version; refused)",
+                "(chain model driven by theta_m, Kalman-corrected by tau_reac_hat)",
+            ),
+            par(
+                "encoder_cpr",
+                2000,
+                "",
+                "Counts per revolution of the motor encoder (0 = angle not quantized). Mode 2 "
+                "takes the angle at the middle of its count (+pi/cpr); estimator 1 designs its "
+                "gain for the quantization noise 2*pi/cpr/sqrt(12) rad",
+            ),
+            par(
+                "torque_noise_std",
+                1e-4,
+                "N.m",
+                "Estimator 1: unmodelled white torque on each load mass (Kalman design)",
+            ),
+            par(
+                "tau_noise_std",
+                1.5e-3,
+                "N.m",
+                "Estimator 1: white noise on tau_reac_hat (Kalman design)",
             ),
             par(
                 "omega_min",
@@ -166,7 +185,16 @@ class ReactionTorqueObserver(FmuSlave):
         problems = range_problems(
             self.value,
             positive=["J_mo", "k_to", "g_dist", "g_lpf", *indexed("J", n), *indexed("k", n)],
-            non_negative=["D_m", "f_c", *indexed("B", n), "omega_min", "g_id"],
+            non_negative=[
+                "D_m",
+                "f_c",
+                *indexed("B", n),
+                "omega_min",
+                "g_id",
+                "encoder_cpr",
+                "torque_noise_std",
+                "tau_noise_std",
+            ],
             finite=["dkt", "dJm"],
         )
         if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
@@ -177,8 +205,6 @@ class ReactionTorqueObserver(FmuSlave):
         ):
             if problem is not None:
                 problems.append(problem)
-        if self.value("estimator") == MODEL_BASED:
-            problems[-1] += "; the model-based observer comes in a later version"
         return problems
 
     def initialize(self) -> None:
@@ -196,6 +222,9 @@ class ReactionTorqueObserver(FmuSlave):
             estimator=v("estimator"),
             omega_min=v("omega_min"),
             g_id=v("g_id"),
+            encoder_cpr=v("encoder_cpr"),
+            torque_noise_std=v("torque_noise_std"),
+            tau_noise_std=v("tau_noise_std"),
         )
         self.observer = Observer(settings, v("theta_m"), v("omega_m"))
         self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
@@ -203,8 +232,8 @@ class ReactionTorqueObserver(FmuSlave):
         self.out_omega = self.indices(indexed("omega_hat", n))
         self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
         if settings.mode == STATE_ESTIMATION:
-            for i in self.out_theta:
-                self.v[i] = v("theta_m")
+            for i, x in zip(self.out_theta, self.observer.estimator.theta):
+                self.v[i] = x
 
     def step(self, t: float, h: float) -> None:
         v = self.v

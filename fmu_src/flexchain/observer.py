@@ -3,14 +3,17 @@ three modes, advanced one sample at a time.
 
 * mode 0 — actuator self-identification, load detached (:mod:`flexchain.self_identification`)
 * mode 1 — chain identification from a rigid maneuver (:mod:`flexchain.rigid_identification`)
-* mode 2 — state estimation (:mod:`flexchain.recursion`)
+* mode 2 — state estimation: the paper's recursion (:mod:`flexchain.recursion`) or the
+  model-based observer (:mod:`flexchain.model_observer`)
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from flexchain.dob import Actuator, ReactionObserver
+from flexchain.model_observer import ModelObserver, NoiseModel
 from flexchain.recursion import ChainRecursion
 from flexchain.rigid_identification import RigidChainIdentifier
 from flexchain.self_identification import ActuatorIdentifier
@@ -30,9 +33,15 @@ class ObserverSettings:
         g_lpf: bandwidth of the recursion's extra filter (rad/s).
         J, k, B: load inertias (kg·m²), spring stiffnesses (N·m/rad), dampings (N·m·s/rad).
         kappa_correction: multi-mass correction κ in mode 1.
-        estimator: 0 = recursion (eq. 22–26); 1 = model-based (not yet available).
+        estimator: 0 = recursion (eq. 22–26); 1 = model-based observer.
         omega_min: speed below which mode 0 treats the motor as stopped (rad/s).
         g_id: bandwidth of mode 0's extra filter on target and regressors (rad/s); 0 = none.
+        encoder_cpr: counts per revolution of the motor encoder (0: not quantized). Mode 2
+            takes the motor angle at the middle of its count (an encoder that reports
+            whole counts reads half a count low on average), and the model-based
+            observer takes its quantization noise, 2π/cpr/√12 rad, into its gain.
+        torque_noise_std: model-based observer: unmodelled torque on each mass (N·m).
+        tau_noise_std: model-based observer: noise on τ̂_reac (N·m).
     """
 
     mode: int
@@ -46,6 +55,18 @@ class ObserverSettings:
     estimator: int = RECURSION
     omega_min: float = 5.0
     g_id: float = 30.0
+    encoder_cpr: int = 0
+    torque_noise_std: float = 1e-4
+    tau_noise_std: float = 1.5e-3
+
+    def angle_offset(self) -> float:
+        """Half a count of the encoder (rad), 0 when the angle is not quantized."""
+        return math.pi / self.encoder_cpr if self.encoder_cpr > 0 else 0.0
+
+    def noise(self) -> NoiseModel:
+        """The model-based observer's noise model."""
+        quantum = 2.0 * math.pi / self.encoder_cpr if self.encoder_cpr > 0 else 0.0
+        return NoiseModel(quantum / math.sqrt(12.0), self.torque_noise_std, self.tau_noise_std)
 
 
 class Observer:
@@ -65,15 +86,18 @@ class Observer:
         s = settings
         self.dob = ReactionObserver(s.actuator, s.g_dist, theta0, omega0)
         self.identifier: ActuatorIdentifier | RigidChainIdentifier | None = None
-        self.estimator: ChainRecursion | None = None
+        self.estimator: ChainRecursion | ModelObserver | None = None
+        self.offset = s.angle_offset() if s.mode == STATE_ESTIMATION else 0.0
         if s.mode == SELF_IDENTIFICATION:
             self.identifier = ActuatorIdentifier(s.g_dist, s.omega_min, s.actuator.k_to, s.g_id)
         elif s.mode == RIGID_IDENTIFICATION:
             self.identifier = RigidChainIdentifier(
                 s.J, s.g_dist, s.kappa_correction, theta0, s.actuator.f_c
             )
-        elif s.mode == STATE_ESTIMATION:
-            self.estimator = ChainRecursion(s.J, s.k, s.B, s.g_dist, s.g_lpf, theta0)
+        elif s.estimator == MODEL_BASED:
+            self.estimator = ModelObserver(s.J, s.k, s.B, s.g_dist, s.noise(), theta0 + self.offset)
+        else:
+            self.estimator = ChainRecursion(s.J, s.k, s.B, s.g_dist, s.g_lpf, theta0 + self.offset)
 
     def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
         """Take the sample (i_a, ω, θ) that ends a step of ``h`` s (A, rad/s, rad)."""
@@ -85,7 +109,7 @@ class Observer:
         elif mode == RIGID_IDENTIFICATION:
             self.identifier.step(h, dob.drive, dob.friction_sign, omega, theta, dob.sticking)
         else:
-            self.estimator.step(h, dob.tau_reac_hat, theta)
+            self.estimator.step(h, dob.tau_reac_hat, theta + self.offset)
 
     def estimate(self) -> None:
         """Solve the identification's normal equations (modes 0 and 1)."""
