@@ -347,7 +347,8 @@ def uniform_chain(
 
     Start: ``k_start`` if given, else from the lowest resonance of the data (the
     first clamped mode of a uniform chain scales as √k), refined by a scan of the cost
-    over k from 0.3 to 3 times that (the cost has local minima); B from ``zeta_start`` on the first mode.
+    over k from 0.3 to 3 times that (the cost has local minima); B from
+    ``zeta_start`` on the first mode.
 
     Raises:
         UserError: when the data show no resonance and no ``k_start`` is given.
