@@ -40,6 +40,7 @@ from cosim.metrics import flexible_score, percent_error
 from cosim.output_error import MotorRecord, motor_record, uniform_chain
 from cosim.scenarios import Scenario, run_scenario
 from flexchain import bench
+from flexchain.chain import spring_matrix
 from flexchain.dob import Actuator
 from flexchain.observer import (
     MODEL_BASED,
@@ -81,11 +82,8 @@ class Case:
 
     def first_mode(self) -> float:
         """Lowest flexible mode of motor + chain (rad/s)."""
-        n = self.n
         M = np.diag([bench.J_M, *self.J])
-        K = np.zeros((n + 1, n + 1))
-        for i, kk in enumerate(self.k):
-            K[i : i + 2, i : i + 2] += kk * np.array([[1, -1], [-1, 1]])
+        K = np.array(spring_matrix(self.k))
         w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
         return float(np.sqrt(w2[1]))
 
@@ -151,26 +149,35 @@ def _run(case: Case, scenario: Scenario, seed: int) -> dict[str, np.ndarray]:
     return signals
 
 
-def replay(settings: ObserverSettings, log: dict[str, np.ndarray]) -> Observer:
-    """Run the observer's algorithms over a log (as the FMU would); return the observer."""
+def replay(
+    settings: ObserverSettings,
+    log: dict[str, np.ndarray],
+    after_sample: Callable[[int, Observer], None] | None = None,
+) -> Observer:
+    """Run the observer's algorithms over a log (as the FMU would); return the observer.
+
+    ``after_sample(k, observer)`` is called for the initial sample (k = 0) and after
+    each step."""
     h = float(log["time"][1] - log["time"][0])
     i_a, w, th = (log[c].tolist() for c in ("i_a", "omega_m", "theta_m"))
     observer = Observer(settings, th[0], w[0])
+    if after_sample is not None:
+        after_sample(0, observer)
     for k in range(1, len(th)):
         observer.step(h, i_a[k], w[k], th[k])
+        if after_sample is not None:
+            after_sample(k, observer)
     return observer
 
 
 def estimate_states(settings: ObserverSettings, log: dict[str, np.ndarray], n: int) -> np.ndarray:
     """Load-angle estimates over the log, shape (N, n)."""
-    h = float(log["time"][1] - log["time"][0])
-    i_a, w, th = (log[c].tolist() for c in ("i_a", "omega_m", "theta_m"))
-    observer = Observer(settings, th[0], w[0])
-    out = np.empty((len(th), n))
-    out[0] = observer.estimator.theta
-    for k in range(1, len(th)):
-        observer.step(h, i_a[k], w[k], th[k])
+    out = np.empty((len(log["time"]), n))
+
+    def keep(k: int, observer: Observer) -> None:
         out[k] = observer.estimator.theta
+
+    replay(settings, log, keep)
     return out
 
 

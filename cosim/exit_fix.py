@@ -133,10 +133,12 @@ def remove_exit_bug(data: bytes) -> bytes:
         ValueError: the destructor is in ``.fini_array`` but not as its last entry, a
             layout this fix does not handle (a pythonfmu other than 0.7?).
     """
-    if not has_exit_bug(data):
+    if data[:4] != b"\x7fELF":
         return data
     address = _symbol_address(data, UNLOAD_SYMBOL)
     functions = fini_functions(data)
+    if address is None or address not in functions:
+        return data
     if functions[-1] != address:
         raise ValueError(
             f"{UNLOAD_SYMBOL} is not the last .fini_array entry; this pythonfmu binary "

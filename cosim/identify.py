@@ -101,16 +101,23 @@ def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer
     return result
 
 
-def observer_parameters(fmu: FmuInstance, assignments: Sequence[str], mode: int | None) -> dict:
-    """``--set`` texts (observer parameters, no prefix) and ``--mode`` as typed values."""
+def parameter_sets(variables: Mapping[str, object], assignments: Sequence[str]) -> dict:
+    """``--set`` texts (observer parameters, no prefix) as typed values, checked against
+    the observer's variables (anything with ``causality`` and ``type``, by name)."""
     parameters: dict[str, float | int | bool] = {}
     for text in assignments:
         name, value = parse_assignment(text)
-        check_name(name, fmu.variables, "the observer")
-        var = fmu.variables[name]
+        check_name(name, variables, "the observer")
+        var = variables[name]
         if var.causality != "parameter":
             raise UserError(f"--set {text!r}: {name} is an {var.causality}, not a parameter")
         parameters[name] = typed_value(name, value, var.type)
+    return parameters
+
+
+def observer_parameters(fmu: FmuInstance, assignments: Sequence[str], mode: int | None) -> dict:
+    """``--set`` texts (observer parameters, no prefix) and ``--mode`` as typed values."""
+    parameters = parameter_sets(fmu.variables, assignments)
     if mode is not None:
         parameters["mode"] = mode
     return parameters
@@ -166,9 +173,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
-    folder = ensure_built(check_masses(args.masses))
+    n = check_masses(args.masses)
+    folder = ensure_built(n)
     if args.method == "output-error":
-        return _output_error(args, log, folder)
+        return _output_error(args, log, folder, n)
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
         recording = replay_log(observer, log, parameters)
@@ -200,12 +208,7 @@ def known_parameters(folder: Path, assignments: Sequence[str]) -> dict[str, floa
         for name, v in variables.items()
         if v.causality == "parameter" and v.type in ("Real", "Integer")
     }
-    for text in assignments:
-        name, value = parse_assignment(text)
-        check_name(name, variables, "the observer")
-        if variables[name].causality != "parameter":
-            raise UserError(f"--set {text!r}: {name} is an {variables[name].causality}")
-        values[name] = float(typed_value(name, value, variables[name].type))
+    values.update({k: float(v) for k, v in parameter_sets(variables, assignments).items()})
     return values
 
 
@@ -219,9 +222,8 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     )
 
 
-def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path) -> int:
+def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int) -> int:
     values = known_parameters(folder, args.set)
-    n = check_masses(args.masses)
     J = [values[f"J[{i}]"] for i in range(1, n + 1)]
     if any(not x > 0 for x in J):
         raise UserError(f"the load inertias must be > 0, got J = {J}")

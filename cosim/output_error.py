@@ -28,6 +28,7 @@ import scipy.linalg
 from scipy import optimize, signal
 
 from cosim.errors import UserError
+from flexchain.chain import spring_matrix
 from flexchain.dob import Actuator, ReactionObserver
 from flexchain.driven_chain import discretize
 
@@ -287,21 +288,8 @@ def newey_west_covariance(jac: np.ndarray, residual: np.ndarray, lag: int) -> np
 
 def clamped_frequencies(J: Sequence[float], k: Sequence[float]) -> np.ndarray:
     """Natural frequencies (rad/s) of the load chain with the motor held still."""
-    A, _ = _undamped(J, k)
-    return np.sqrt(np.sort(np.linalg.eigvals(A).real))
-
-
-def _undamped(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """``M⁻¹K`` of the clamped chain and K."""
-    n = len(J)
-    K = np.zeros((n, n))
-    for i in range(n):
-        K[i, i] += k[i]
-        if i + 1 < n:
-            K[i, i] += k[i + 1]
-            K[i, i + 1] -= k[i + 1]
-            K[i + 1, i] -= k[i + 1]
-    return K / np.asarray(J)[:, None], K
+    K = np.array(spring_matrix(k))[1:, 1:]  # motor row and column removed: held still
+    return np.sqrt(np.sort(np.linalg.eigvals(K / np.asarray(J)[:, None]).real))
 
 
 def resonance_peaks(record: MotorRecord, count: int, band: tuple[float, float]) -> np.ndarray:

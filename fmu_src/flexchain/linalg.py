@@ -26,6 +26,11 @@ def identity(n: int) -> Matrix:
     return m
 
 
+def transpose(a: Matrix) -> Matrix:
+    """``aᵀ``."""
+    return [list(col) for col in zip(*a)]
+
+
 def matmul(a: Matrix, b: Matrix) -> Matrix:
     """``a @ b`` for ``(r × k) @ (k × c)``."""
     columns = list(zip(*b))

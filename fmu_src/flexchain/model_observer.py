@@ -57,11 +57,6 @@ class StepModel:
     K: list[float]
 
 
-def transpose(a: Matrix) -> Matrix:
-    """``aᵀ``."""
-    return [list(col) for col in zip(*a)]
-
-
 def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Matrix:
     """Prior covariance P of the steady-state Kalman filter with a scalar measurement
     of the last state: ``P = F (P − P hᵀ h P / (h P hᵀ + r)) Fᵀ + Q``, h = [0 … 0 1].
@@ -73,7 +68,7 @@ def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Mat
         ValueError: if the iteration does not converge.
     """
     m = len(F)
-    A = transpose(F)
+    A = linalg.transpose(F)
     G = linalg.zeros(m, m)
     G[m - 1][m - 1] = 1.0 / r
     H = [row[:] for row in Q]
@@ -83,7 +78,7 @@ def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Mat
         both = linalg.solve(W, [ra + rg for ra, rg in zip(A, G)])
         WA = [row[:m] for row in both]
         WG = [row[m:] for row in both]
-        At = transpose(A)
+        At = linalg.transpose(A)
         H_next = linalg.add(H, linalg.matmul(At, linalg.matmul(H, WA)))
         G = linalg.add(G, linalg.matmul(linalg.matmul(A, WG), At))
         A = linalg.matmul(A, WA)
@@ -117,7 +112,7 @@ def step_model(
     Gamma = [row[:] for row in chain.Bd] + [[b * d[0], b * d[1]]]
     s2 = noise.theta_noise_std**2
     cov_w = [[s2, -s2 / h], [-s2 / h, 2.0 * s2 / (h * h)]]
-    Q = linalg.matmul(linalg.matmul(Gamma, cov_w), transpose(Gamma))
+    Q = linalg.matmul(linalg.matmul(Gamma, cov_w), linalg.transpose(Gamma))
     for i in range(n):
         Q[n + i][n + i] += (noise.torque_noise_std * h / J[i]) ** 2
     for i in range(m):  # keeps the Riccati equation regular when every noise is zero
