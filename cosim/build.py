@@ -1,9 +1,11 @@
-"""Build the project's FMUs with pythonfmu: ``arcosim build [--masses N] [--out DIR]``.
+"""Build the project's FMUs: ``arcosim build [--masses N] [--out DIR]``.
 
-Each FMU gets a generated script that fixes the number of load masses and a model
-identifier carrying it (``MotorChainPlant_n3``), and bundles the packages it needs
-(``fmukit`` and the algorithms) into ``resources/``. Nothing else is needed at run
-time but a Python 3 (standard library).
+The plant is compiled from C (:mod:`cosim.cplant`): no Python at run time. The
+observer and the excitation source are built with pythonfmu: each gets a generated
+script that fixes the number of load masses and a model identifier carrying it
+(``ReactionTorqueObserver_n3``), and bundles the packages it needs (``fmukit`` and
+the algorithms) into ``resources/``; they need nothing at run time but a Python 3
+(standard library).
 """
 
 from __future__ import annotations
@@ -31,20 +33,21 @@ class FmuRecipe:
         name: file name stem, e.g. ``MotorChainPlant`` → ``MotorChainPlant.fmu``.
         base: ``module:Class`` of the slave class the generated script subclasses.
         packages: importable packages bundled into ``resources/``.
+        language: ``"python"`` (pythonfmu) or ``"c"`` (compiled, :mod:`cosim.cplant`;
+            ``base`` then names the reference class whose interface it implements).
     """
 
     name: str
     base: str
     packages: tuple[str, ...]
+    language: str = "python"
 
     def identifier(self, n: int) -> str:
         """Model identifier for n load masses, e.g. ``MotorChainPlant_n3``."""
         return f"{self.name}_n{n}"
 
 
-PLANT = FmuRecipe(
-    "MotorChainPlant", "motorchain.fmu:MotorChainPlant", ("fmukit", "flexchain", "motorchain")
-)
+PLANT = FmuRecipe("MotorChainPlant", "motorchain.fmu:MotorChainPlant", (), "c")
 OBSERVER = FmuRecipe(
     "ReactionTorqueObserver",
     "arobserver.fmu:ReactionTorqueObserver",
@@ -93,9 +96,13 @@ def check_masses(n: int) -> int:
 
 def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
     """Build one FMU for n load masses into ``out``; return its path."""
+    check_masses(n)
+    if recipe.language == "c":
+        from cosim.cplant import build_c_plant
+
+        return build_c_plant(n, out / f"{recipe.name}.fmu")
     from pythonfmu import FmuBuilder  # deferred: importing it is slow and only builds need it
 
-    check_masses(n)
     module, cls = recipe.base.split(":")
     identifier = recipe.identifier(n)
     out.mkdir(parents=True, exist_ok=True)

@@ -13,6 +13,7 @@ import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (
@@ -21,6 +22,8 @@ from fmpy.fmi2 import (
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    fmi2Real,
+    fmi2ValueReference,
 )
 
 from cosim.errors import UserError
@@ -47,6 +50,36 @@ def extracted(path: Path) -> str:
         _EXTRACTED[key] = folder
         atexit.register(shutil.rmtree, folder, True)
     return folder
+
+
+class RealPort:
+    """One ``fmi2GetReal``/``fmi2SetReal`` of fixed value references, through fmpy's
+    raw ctypes functions and preallocated arrays: no allocation per call.
+
+    Attributes:
+        values: the ctypes ``fmi2Real`` array read into by :meth:`get` and sent by
+            :meth:`send`; a port's ``values`` may be another port's (connections).
+        array: numpy view of ``values`` (no copy).
+    """
+
+    def __init__(self, slave: FMU2Slave, vrs: Sequence[int]) -> None:
+        self.size = len(vrs)
+        self.vrs = (fmi2ValueReference * self.size)(*vrs)
+        self.values = (fmi2Real * self.size)()
+        self.array = np.ctypeslib.as_array(self.values) if self.size else np.empty(0)
+        self.component = slave.component
+        self.get_real = slave._functions["fmi2GetReal"]
+        self.set_real = slave._functions["fmi2SetReal"]
+
+    def get(self) -> int:
+        """Read the variables into :attr:`values`; return the FMI status."""
+        return self.get_real(self.component, self.vrs, self.size, self.values)
+
+    def send(self, values=None) -> int:
+        """Set the variables from ``values`` (a ctypes array; default :attr:`values`)."""
+        return self.set_real(
+            self.component, self.vrs, self.size, self.values if values is None else values
+        )
 
 
 class FmuInstance:
@@ -180,6 +213,10 @@ class FmuInstance:
             if self._variable(name).type != "Real":
                 raise UserError(f"{name} is a {self._variable(name).type}, not a Real variable")
         return self.vrs(names)
+
+    def real_port(self, names: Sequence[str]) -> RealPort:
+        """Preallocated buffers for one batched get or set of the Real variables ``names``."""
+        return RealPort(self.slave, self._real_vrs(names))
 
     def get(self, names: Sequence[str]) -> list[float]:
         """Values of ``names`` (Booleans and Integers converted to float)."""

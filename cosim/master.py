@@ -77,45 +77,52 @@ def cosimulate(
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
     if not (h > 0.0 and np.isfinite(h)):
         raise UserError(f"step size {h!r} s: it must be a finite number > 0")
-    plant.initialize(plant_parameters, t0)
-    read_measured = plant.reader(MEASURED)
-    write_measured = observer.real_writer(MEASURED)
-    write_measured(read_measured())
-    observer.initialize(observer_parameters, t0)
-    write_current = plant.real_writer(["i_ref"])
-    read_plant = plant.reader(record_plant)
-    read_observer = observer.reader(record_observer)
-    steps = len(i_ref)
     if record_every < 1:
         raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
+    currents = [float(x) for x in i_ref]
+    steps = len(currents)
+    plant.initialize(plant_parameters, t0)
+    measured = plant.real_port(MEASURED)
+    observer_in = observer.real_port(MEASURED)
+    _check(measured.get() | observer_in.send(measured.values), plant, "reading the sensors", t0)
+    observer.initialize(observer_parameters, t0)
     recorded = [0, *range(record_every, steps + 1, record_every)]
     if recorded[-1] != steps:
         recorded.append(steps)
     plant_log = np.empty((len(recorded), len(record_plant)))
     observer_log = np.empty((len(recorded), len(record_observer)))
-    plant_log[0] = read_plant() if record_plant else []
-    observer_log[0] = read_observer() if record_observer else []
-    row = 1
+    read_plant, read_observer = _recorder(plant, record_plant), _recorder(observer, record_observer)
+    plant_log[0], observer_log[0] = read_plant(), read_observer()
+    # The hot loop: fmpy's raw ctypes functions, preallocated arrays, no allocation.
+    i_port = plant.real_port(["i_ref"])
+    set_i, i_vr, i_value, plant_c = i_port.set_real, i_port.vrs, i_port.values, i_port.component
+    plant_step = plant.slave._functions["fmi2DoStep"]
+    observer_step = observer.slave._functions["fmi2DoStep"]
+    observer_c = observer.slave.component
+    get_measured, send_measured = measured.get, observer_in.send
+    values = measured.values
     gauss_seidel = ordering == "gauss-seidel"
+    next_record, row = recorded[1] if len(recorded) > 1 else -1, 1
     for k in range(steps):
         t = t0 + k * h
-        if not gauss_seidel:
-            write_measured(read_measured())
-        write_current([float(i_ref[k])])
-        _step(plant, t, h)
-        if gauss_seidel:
-            write_measured(read_measured())
-        _step(observer, t, h)
-        if row < len(recorded) and recorded[row] == k + 1:
-            if record_plant:
-                plant_log[row] = read_plant()
-            if record_observer:
-                observer_log[row] = read_observer()
+        if not gauss_seidel and get_measured() | send_measured(values) > 1:
+            _check(2, plant, "passing the sensors on", t)
+        i_value[0] = currents[k]
+        if set_i(plant_c, i_vr, 1, i_value) > 1 or plant_step(plant_c, t, h, 1) > 1:
+            _check(2, plant, "stepping", t)
+        if gauss_seidel and get_measured() | send_measured(values) > 1:
+            _check(2, plant, "passing the sensors on", t)
+        if observer_step(observer_c, t, h, 1) > 1:
+            _check(2, observer, "stepping", t)
+        if k + 1 == next_record:
+            plant_log[row], observer_log[row] = read_plant(), read_observer()
             row += 1
+            next_record = recorded[row] if row < len(recorded) else -1
         if progress is not None and (k + 1) % 1000 == 0:
             progress(1000)
     if progress is not None and steps % 1000:
         progress(steps % 1000)
+    plant.time = observer.time = t0 + steps * h
     recording = Recording(time=t0 + np.array(recorded) * h)
     for j, name in enumerate(record_plant):
         recording.signals[f"plant.{name}"] = plant_log[:, j]
@@ -124,8 +131,24 @@ def cosimulate(
     return recording
 
 
-def _step(fmu: FmuInstance, t: float, h: float) -> None:
-    status = fmu.do_step(t, h)
+def _recorder(fmu: FmuInstance, names: Sequence[str]) -> Callable[[], Sequence[float]]:
+    """Reads ``names`` as floats: one preallocated get when all are Real."""
+    if not names:
+        return lambda: ()
+    if all(fmu.variables[n].type == "Real" for n in names if n in fmu.variables):
+        port = fmu.real_port(names)
+
+        def read() -> np.ndarray:
+            _check(port.get(), fmu, "reading outputs", fmu.time)
+            return port.array
+
+        return read
+    return fmu.reader(names)
+
+
+def _check(status: int, fmu: FmuInstance, doing: str, t: float) -> None:
+    """Raise :class:`UserError` with the FMU's last log lines if ``status`` > warning."""
     if status > 1:
         log = "\n  ".join(fmu.messages[-5:])
-        raise UserError(f"{fmu.path.name} refused the step at t = {t!r} s:\n  {log}")
+        refused = "refused the step" if doing == "stepping" else f"failed {doing}"
+        raise UserError(f"{fmu.path.name} {refused} at t = {t!r} s:\n  {log}")

@@ -47,13 +47,13 @@ def test_fmu_runs_in_the_ecos_cpp_engine(build_fmus, tmp_path, name) -> None:
 def test_fmu_binary_carries_the_python_loader(build_fmus, tmp_path) -> None:
     import zipfile
 
-    with zipfile.ZipFile(build_fmus(3) / "MotorChainPlant.fmu") as z:
+    with zipfile.ZipFile(build_fmus(3) / "ReactionTorqueObserver.fmu") as z:
         names = z.namelist()
-        z.extract("binaries/linux64/MotorChainPlant_n3.so", tmp_path)
+        z.extract("binaries/linux64/ReactionTorqueObserver_n3.so", tmp_path)
     assert f"binaries/linux64/{LOADER}" in names
     if shutil.which("readelf"):
         dynamic = subprocess.run(
-            ["readelf", "-d", str(tmp_path / "binaries/linux64/MotorChainPlant_n3.so")],
+            ["readelf", "-d", str(tmp_path / "binaries/linux64/ReactionTorqueObserver_n3.so")],
             capture_output=True,
             text=True,
         ).stdout

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -240,3 +242,27 @@ def test_trace_file_holds_current_identification_outputs(fmus, tmp_path) -> None
     header, *rows = trace.read_text().splitlines()
     column = header.split(",").index("k_hat")
     assert k_hat != 0.0 and float(rows[-1].split(",")[column]) == k_hat
+
+
+def test_same_fmu_instantiates_again_and_again_in_one_process(fmus) -> None:
+    """pythonfmu 0.7 releases a reference to the script's namespace per
+    instantiation; the generated script takes one back each time (cosim/build.py).
+    The namespace's reference count must stay put however many instances come and
+    go, and the process must exit cleanly (a miscount is a use-after-free there)."""
+    script = (
+        "import gc, sys\n"
+        "from cosim.instance import FmuInstance\n"
+        "counts = []\n"
+        "for k in range(12):\n"
+        "    with FmuInstance(sys.argv[1], f'again-{k}') as observer:\n"
+        "        observer.initialize()\n"
+        "        assert observer.do_step(0.0, 1e-3) == 0\n"
+        "    gc.collect()\n"
+        "    counts.append(sys.getrefcount(sys.modules['ReactionTorqueObserver_n3'].__dict__))\n"
+        "assert len(set(counts)) == 1, counts\n"
+        "print(counts[0])\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", script, str(fmus[1])], capture_output=True, text=True
+    )
+    assert result.returncode == 0, result.stderr

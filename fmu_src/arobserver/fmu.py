@@ -230,25 +230,36 @@ class ReactionTorqueObserver(FmuSlave):
         self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
         self.out_theta = self.indices(indexed("theta_hat", n))
         self.out_omega = self.indices(indexed("omega_hat", n))
+        for block in (self.out_theta, self.out_omega):  # step() writes them as slices
+            assert block == list(range(block[0], block[0] + n)), "declare arrays contiguously"
+        # value references the step uses, in one tuple (unpacked once per step)
+        self.hot = (
+            *self.inputs,
+            *self.indices(["d_hat", "tau_reac_hat", "alpha_m_hat"]),
+            self.out_theta[0],
+            self.out_theta[0] + n,
+            self.out_omega[0],
+            self.out_omega[0] + n,
+        )
         self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
+
         if settings.mode == STATE_ESTIMATION:
             for i, x in zip(self.out_theta, self.observer.estimator.theta):
                 self.v[i] = x
 
     def step(self, t: float, h: float) -> None:
         v = self.v
-        i_a, omega, theta = (v[i] for i in self.inputs)
+        i_a, omega, theta, d, tau, alpha, t0, t1, w0, w1 = self.hot
         obs = self.observer
-        obs.step(h, i_a, omega, theta)
-        vr = self.vr
-        v[vr["d_hat"]] = obs.dob.d_hat
-        v[vr["tau_reac_hat"]] = obs.dob.tau_reac_hat
-        v[vr["alpha_m_hat"]] = obs.dob.alpha_hat
-        if obs.estimator is not None:
-            for i, x in zip(self.out_theta, obs.estimator.theta):
-                v[i] = x
-            for i, x in zip(self.out_omega, obs.estimator.omega):
-                v[i] = x
+        obs.step(h, v[i_a], v[omega], v[theta])
+        dob = obs.dob
+        v[d] = dob.d_hat
+        v[tau] = dob.tau_reac_hat
+        v[alpha] = dob.alpha_hat
+        estimator = obs.estimator
+        if estimator is not None:
+            v[t0:t1] = estimator.theta
+            v[w0:w1] = estimator.omega
         else:
             self.stale = True  # identification is solved when an output is read
 

@@ -106,8 +106,13 @@ class ReactionObserver:
         self.drive = 0.0
         self.friction_sign = 0.0
         self.sticking = False
+        # constants of the step, looked up once (the step runs at the control rate)
         self._kt = actuator.k_to + actuator.dkt
         self._jm = actuator.J_mo + actuator.dJm
+        self._k_to, self._J_mo = actuator.k_to, actuator.J_mo
+        self._D, self._f_c = actuator.D_m, actuator.f_c
+        self._h = 0.0  # step size the filter coefficient below was computed for
+        self._a = 1.0  # e^{−g h}
 
     def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
         """Take the sample (i_a, ω, θ) that ends a step of ``h`` seconds.
@@ -118,19 +123,28 @@ class ReactionObserver:
             omega: motor velocity at the sample (rad/s).
             theta: motor angle at the sample (rad).
         """
-        act = self.actuator
-        accel = (omega - self.omega) / h
-        velocity = (theta - self.theta) / h
-        a = math.exp(-self.g * h)
+        if h != self._h:
+            self._h = h
+            self._a = math.exp(-self.g * h)
+        a = self._a
         b = 1.0 - a
-        self.d_hat = a * self.d_hat + b * (act.k_to * i_a - act.J_mo * accel)
-        self.drive = drive = self._kt * i_a - self._jm * accel - act.D_m * velocity
-        self.friction_sign = mean_sign(self.omega, omega)
-        self.sticking = omega == 0.0 or self.omega == 0.0
-        if self.sticking:
-            torque = drive - clamp(drive - self.torque, act.f_c)
+        w0 = self.omega
+        accel = (omega - w0) / h
+        velocity = (theta - self.theta) / h
+        self.d_hat = a * self.d_hat + b * (self._k_to * i_a - self._J_mo * accel)
+        self.drive = drive = self._kt * i_a - self._jm * accel - self._D * velocity
+        if w0 > 0.0 and omega > 0.0:  # moving one way throughout: the common case, inline
+            friction_sign = 1.0
+        elif w0 < 0.0 and omega < 0.0:
+            friction_sign = -1.0
         else:
-            torque = drive - act.f_c * self.friction_sign
+            friction_sign = mean_sign(w0, omega)
+        self.friction_sign = friction_sign
+        self.sticking = sticking = omega == 0.0 or w0 == 0.0
+        if sticking:
+            torque = drive - clamp(drive - self.torque, self._f_c)
+        else:
+            torque = drive - self._f_c * friction_sign
         self.torque = torque
         self.tau_reac_hat = a * self.tau_reac_hat + b * torque
         self.alpha_hat = a * self.alpha_hat + b * accel

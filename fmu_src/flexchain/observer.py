@@ -103,13 +103,13 @@ class Observer:
         """Take the sample (i_a, ω, θ) that ends a step of ``h`` s (A, rad/s, rad)."""
         dob = self.dob
         dob.step(h, i_a, omega, theta)
-        mode = self.settings.mode
-        if mode == SELF_IDENTIFICATION:
+        estimator = self.estimator
+        if estimator is not None:  # mode 2, the one that runs in control loops: test it first
+            estimator.step(h, dob.tau_reac_hat, theta + self.offset)
+        elif self.settings.mode == SELF_IDENTIFICATION:
             self.identifier.step(h, i_a, dob.velocity, dob.accel, dob.friction_sign, dob.d_hat)
-        elif mode == RIGID_IDENTIFICATION:
-            self.identifier.step(h, dob.drive, dob.friction_sign, omega, theta, dob.sticking)
         else:
-            self.estimator.step(h, dob.tau_reac_hat, theta + self.offset)
+            self.identifier.step(h, dob.drive, dob.friction_sign, omega, theta, dob.sticking)
 
     def estimate(self) -> None:
         """Solve the identification's normal equations (modes 0 and 1)."""

@@ -17,6 +17,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+#: Per step size: e^{−g_dist h}, e^{−g_lpf h}, and per stage (i, e^{−k_i h/B_i}, gain, J_i).
+Coefficients = tuple[float, float, list[tuple[int, float, float, float]]]
+
 
 class ChainRecursion:
     """Angles and velocities of the n load masses from τ̂_reac and θ_m.
@@ -51,27 +54,36 @@ class ChainRecursion:
         self.omega = [0.0] * n
         self.torque_next = [0.0] * n  # G_lpf[τ_i − J_i θ̈_i], feeds stage i+1
         self.angle_next = [theta0] * n  # G_lpf[θ̂_i], feeds stage i+1
+        self._h = 0.0  # step size the coefficients below were computed for
+        self._coefficients: Coefficients = (1.0, 1.0, [])
+
+    def _coefficients_for(self, h: float) -> Coefficients:
+        """e^{−g_dist h}, e^{−g_lpf h}, and per stage ``(i, e, (1 − e)/k_i, J_i)`` with
+        e = e^{−k_i/B_i h} (0 when B_i = 0)."""
+        decay = [math.exp(-k / B * h) if B > 0.0 else 0.0 for k, B in zip(self.k, self.B)]
+        stages = [
+            (i, e, (1.0 - e) / k, J) for i, (e, k, J) in enumerate(zip(decay, self.k, self.J))
+        ]
+        self._h = h
+        self._coefficients = (math.exp(-self.g_dist * h), math.exp(-self.g_lpf * h), stages)
+        return self._coefficients
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
         """Take the sample that ends a step of ``h`` s."""
-        a0 = math.exp(-self.g_dist * h)
-        self.theta_m_filtered = a0 * self.theta_m_filtered + (1.0 - a0) * theta_m
-        a = math.exp(-self.g_lpf * h)
+        a0, a, stages = self._coefficients if h == self._h else self._coefficients_for(h)
+        self.theta_m_filtered = angle_before = a0 * self.theta_m_filtered + (1.0 - a0) * theta_m
         b = 1.0 - a
-        torque, angle_before = tau_reac_hat, self.theta_m_filtered
-        n = len(self.J)
-        for i in range(n):
-            k, B = self.k[i], self.B[i]
-            if B > 0.0:
-                e = math.exp(-k / B * h)
-                self.deflection[i] = e * self.deflection[i] + (1.0 - e) * torque / k
-            else:
-                self.deflection[i] = torque / k
-            theta = angle_before - self.deflection[i]
-            omega = (theta - self.theta[i]) / h
-            accel = (omega - self.omega[i]) / h
-            self.theta[i], self.omega[i] = theta, omega
-            if i + 1 < n:
-                self.torque_next[i] = a * self.torque_next[i] + b * (torque - self.J[i] * accel)
-                self.angle_next[i] = a * self.angle_next[i] + b * theta
-                torque, angle_before = self.torque_next[i], self.angle_next[i]
+        torque = tau_reac_hat
+        deflection, thetas, omegas = self.deflection, self.theta, self.omega
+        torque_next, angle_next = self.torque_next, self.angle_next
+        last = len(stages) - 1
+        for i, e, gain, J in stages:
+            deflection[i] = d = e * deflection[i] + gain * torque
+            theta = angle_before - d
+            omega = (theta - thetas[i]) / h
+            thetas[i] = theta
+            if i < last:  # the next stage's torque: this one's minus J_i θ̈_i, filtered
+                torque = a * torque_next[i] + b * (torque - J * ((omega - omegas[i]) / h))
+                torque_next[i] = torque
+                angle_next[i] = angle_before = a * angle_next[i] + b * theta
+            omegas[i] = omega

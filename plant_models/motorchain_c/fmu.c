@@ -1,0 +1,651 @@
+/* FMI 2.0 co-simulation interface of the motor-chain plant, in C.
+ *
+ * Same variables, value references, checks, messages, timing contract and trace
+ * file as the Python plant (plant_models/motorchain/fmu.py with fmu_src/fmukit),
+ * which is the reference its tests compare with. plant_variables.h is generated at
+ * build time from that class's variable list (cosim/cplant.py): names, types,
+ * causalities, start values, value-reference macros (VR_<name>, the first element
+ * for arrays) and the GUID; chain_size.h fixes n.
+ *
+ * Failure handling follows the project's convention: invalid parameters are
+ * logged at exitInitializationMode and every later doStep answers fmi2Discard
+ * with the same message; a bad step (non-finite input, step size <= 0,
+ * communication point other than the FMU's time) is refused with fmi2Discard and
+ * leaves the state untouched. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "physics.h"
+#include "plant_variables.h"
+
+#define TEXT 2048
+#define PATH 1024
+#define STATE_MAGIC 0x4d43504c414e5431ULL /* "MCPLANT1" */
+
+/* Everything an FMU state holds (copied whole by get/set/serialize). */
+typedef struct {
+    double v[N_VARS]; /* Real, Integer and Boolean values by value reference */
+    char trace_file[PATH];
+    double time;
+    int time_known, initialized;
+    char problems[TEXT];
+    Physics physics;
+    int64_t cpr;
+    double noise_std, theta_measured;
+    uint64_t seed, sample;
+} Core;
+
+typedef struct {
+    Core core;
+    PhysicsCache *cache;
+    FILE *trace;
+    fmi2CallbackFunctions callbacks;
+    char name[256];
+    int logging;
+} Plant;
+
+/* ---- messages ---- */
+
+/* Python's repr of a float: shortest digits that read back the same, with ".0" on
+ * integral values, so messages match the reference FMU word for word. */
+static void repr_double(char *out, size_t size, double x) {
+    if (isnan(x)) {
+        snprintf(out, size, "nan");
+        return;
+    }
+    if (isinf(x)) {
+        snprintf(out, size, x > 0 ? "inf" : "-inf");
+        return;
+    }
+    int digits = 1;
+    for (; digits < 17; digits++) {
+        snprintf(out, size, "%.*e", digits - 1, x);
+        if (strtod(out, NULL) == x) break;
+    }
+    snprintf(out, size, "%.*e", digits - 1, x);
+    int exponent = atoi(strchr(out, 'e') + 1);
+    if (exponent < -4 || exponent >= 16) return; /* Python's switch to 1e-05, 1e+16 */
+    int decimals = digits - 1 - exponent;
+    snprintf(out, size, "%.*f", decimals > 0 ? decimals : 0, x);
+    if (decimals <= 0) strncat(out, ".0", size - strlen(out) - 1);
+}
+
+static void log_message(Plant *p, fmi2Status status, const char *format, ...) {
+    if (!p->logging || p->callbacks.logger == NULL) return;
+    static const char *const category[] = {"logAll", "logStatusWarning", "logStatusDiscard",
+                                           "logStatusError", "logStatusFatal", "logAll"};
+    char text[TEXT + 512];
+    int used = snprintf(text, sizeof text, "%s: ", p->name);
+    va_list args;
+    va_start(args, format);
+    vsnprintf(text + used, sizeof text - used, format, args);
+    va_end(args);
+    /* the logger formats its message with printf rules: pass % through literally */
+    char escaped[2 * sizeof text];
+    size_t j = 0;
+    for (size_t i = 0; text[i] && j + 2 < sizeof escaped; i++) {
+        if (text[i] == '%') escaped[j++] = '%';
+        escaped[j++] = text[i];
+    }
+    escaped[j] = '\0';
+    p->callbacks.logger(p->callbacks.componentEnvironment, p->name, status,
+                        category[status <= fmi2Pending ? status : 0], escaped);
+}
+
+static void add_problem(Core *c, const char *format, ...) {
+    size_t used = strlen(c->problems);
+    if (used) used += (size_t)snprintf(c->problems + used, TEXT - used, "; ");
+    if (used >= TEXT) return;
+    va_list args;
+    va_start(args, format);
+    vsnprintf(c->problems + used, TEXT - used, format, args);
+    va_end(args);
+}
+
+/* ---- parameters ---- */
+
+static void check_range(Core *c, int vr, int count, int positive) {
+    for (int i = 0; i < count; i++) {
+        double x = c->v[vr + i];
+        char num[64];
+        repr_double(num, sizeof num, x);
+        if (!isfinite(x))
+            add_problem(c, "parameter %s = %s is not a finite number", VAR_NAME[vr + i], num);
+        else if (positive ? !(x > 0.0) : !(x >= 0.0))
+            add_problem(c, "parameter %s = %s must be %s", VAR_NAME[vr + i], num,
+                        positive ? "> 0" : ">= 0");
+    }
+}
+
+/* The reference's check_parameters, in the same order with the same sentences. */
+static void check_parameters(Core *c) {
+    check_range(c, VR_J_m, 1, 1);
+    check_range(c, VR_J, N_MASSES, 1);
+    check_range(c, VR_D_m, 1, 0);
+    check_range(c, VR_f_c, 1, 0);
+    check_range(c, VR_k, N_MASSES, 0);
+    check_range(c, VR_B, N_MASSES, 0);
+    check_range(c, VR_i_noise_std, 1, 0);
+    check_range(c, VR_current_bandwidth, 1, 0);
+    if (!isfinite(c->v[VR_k_t])) {
+        char num[64];
+        repr_double(num, sizeof num, c->v[VR_k_t]);
+        add_problem(c, "parameter k_t = %s is not a finite number", num);
+    }
+    if (c->v[VR_encoder_cpr] < 0)
+        add_problem(c, "parameter encoder_cpr = %lld must be >= 0 (0 = ideal)",
+                    (long long)c->v[VR_encoder_cpr]);
+}
+
+/* ---- outputs ---- */
+
+static void write_outputs(Core *c, double h /* <= 0: the sample at t0 */) {
+    const Physics *p = &c->physics;
+    const double *x = p->x;
+    double *v = c->v;
+    double theta_q = noise_quantize(x[0], c->cpr);
+    double i_true, omega_q, tau_mean, noise = 0.0;
+    if (h <= 0.0) {
+        i_true = 0.0;
+        omega_q = x[N_MASSES + 1];
+        tau_mean = physics_reaction_torque(p);
+    } else {
+        i_true = physics_average_current(p, h);
+        omega_q = c->cpr > 0 ? (theta_q - c->theta_measured) / h : x[N_MASSES + 1];
+        tau_mean = physics_average_reaction(p, h);
+        noise = c->noise_std * noise_gaussian(c->seed, c->sample);
+    }
+    c->theta_measured = theta_q;
+    v[VR_i_a] = i_true + noise;
+    v[VR_theta_m] = theta_q;
+    v[VR_omega_m] = omega_q;
+    v[VR_theta_m_true] = x[0];
+    v[VR_omega_m_true] = x[N_MASSES + 1];
+    for (int j = 0; j < N_MASSES; j++) {
+        v[VR_theta + j] = x[1 + j];
+        v[VR_omega + j] = x[N_MASSES + 2 + j];
+    }
+    v[VR_tau_reac] = physics_reaction_torque(p);
+    v[VR_tau_reac_mean] = tau_mean;
+    v[VR_i_true] = i_true;
+    v[VR_twist] = x[0] - x[1];
+}
+
+static void initialize(Core *c) {
+    const double *v = c->v;
+    physics_init(&c->physics, v[VR_J_m], v[VR_k_t], v[VR_D_m], v[VR_f_c], v + VR_J, v + VR_k,
+                 v + VR_B, v[VR_attached] != 0.0, v[VR_current_bandwidth]);
+    c->cpr = (int64_t)v[VR_encoder_cpr];
+    c->noise_std = v[VR_i_noise_std];
+    c->seed = (uint64_t)(int64_t)v[VR_seed];
+    c->sample = 0;
+    c->theta_measured = noise_quantize(0.0, c->cpr);
+    write_outputs(c, 0.0);
+}
+
+/* ---- trace file ---- */
+
+static void write_trace(Plant *p) {
+    char num[64];
+    repr_double(num, sizeof num, p->core.time_known ? p->core.time : 0.0);
+    fputs(num, p->trace);
+    for (int vr = 0; vr < N_VARS; vr++)
+        if (VAR_CAUSALITY[vr] == C_OUTPUT) {
+            repr_double(num, sizeof num, p->core.v[vr]);
+            fputc(',', p->trace);
+            fputs(num, p->trace);
+        }
+    fputc('\n', p->trace);
+    fflush(p->trace);
+}
+
+static void open_trace(Plant *p) {
+    const char *path = p->core.trace_file;
+    if (!path[0]) return;
+    FILE *f = fopen(path, "r");
+    if (f) {
+        fclose(f);
+        add_problem(&p->core, "trace_file '%s' exists; choose a new name (it is never overwritten)",
+                    path);
+        return;
+    }
+    p->trace = fopen(path, "wx");
+    if (!p->trace) {
+        add_problem(&p->core, "trace_file '%s' cannot be written", path);
+        return;
+    }
+    fputs("time", p->trace);
+    for (int vr = 0; vr < N_VARS; vr++)
+        if (VAR_CAUSALITY[vr] == C_OUTPUT) fprintf(p->trace, ",%s", VAR_NAME[vr]);
+    fputc('\n', p->trace);
+    write_trace(p);
+}
+
+/* ---- FMI: instance life cycle ---- */
+
+static void reset_core(Core *c) {
+    memset(c, 0, sizeof *c);
+    for (int vr = 0; vr < N_VARS; vr++) c->v[vr] = VAR_START[vr];
+}
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation,
+                              const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                              fmi2Boolean loggingOn) {
+    (void)fmuResourceLocation;
+    (void)visible;
+    Plant probe = {0};
+    if (functions) probe.callbacks = *functions;
+    snprintf(probe.name, sizeof probe.name, "%s", instanceName ? instanceName : "plant");
+    probe.logging = 1;
+    if (fmuType != fmi2CoSimulation) {
+        log_message(&probe, fmi2Error, "this FMU supports co-simulation only");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
+        log_message(&probe, fmi2Error, "GUID %s does not match this binary's %s",
+                    fmuGUID ? fmuGUID : "(null)", MODEL_GUID);
+        return NULL;
+    }
+    Plant *p = calloc(1, sizeof *p);
+    PhysicsCache *cache = calloc(1, sizeof *cache);
+    if (!p || !cache) {
+        free(p);
+        free(cache);
+        log_message(&probe, fmi2Error, "out of memory");
+        return NULL;
+    }
+    *p = probe;
+    p->logging = loggingOn;
+    p->cache = cache;
+    reset_core(&p->core);
+    return p;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    Plant *p = c;
+    if (!p) return;
+    if (p->trace) fclose(p->trace);
+    free(p->cache);
+    free(p);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t n,
+                               const fmi2String categories[]) {
+    (void)n;
+    (void)categories;
+    ((Plant *)c)->logging = loggingOn;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined,
+                               fmi2Real stopTime) {
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
+    Plant *p = c;
+    p->core.time = startTime;
+    p->core.time_known = 1;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    Plant *p = c;
+    Core *core = &p->core;
+    core->problems[0] = '\0';
+    check_parameters(core);
+    if (!core->problems[0]) {
+        initialize(core);
+        physics_cache_clear(p->cache);
+        open_trace(p);
+    }
+    if (core->problems[0]) log_message(p, fmi2Error, "%s", core->problems);
+    core->initialized = 1;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    Plant *p = c;
+    if (p->trace) {
+        fclose(p->trace);
+        p->trace = NULL;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c) {
+    Plant *p = c;
+    fmi2Terminate(c);
+    reset_core(&p->core);
+    physics_cache_clear(p->cache);
+    return fmi2OK;
+}
+
+/* ---- FMI: stepping ---- */
+
+static int step_problem(Plant *p, double t, double h) {
+    Core *c = &p->core;
+    char a[64], b[64];
+    if (!(isfinite(h) && h > 0.0)) {
+        repr_double(a, sizeof a, h);
+        log_message(p, fmi2Discard, "step size %s s refused: it must be a finite number > 0", a);
+        return 1;
+    }
+    if (!isfinite(t)) {
+        repr_double(a, sizeof a, t);
+        log_message(p, fmi2Discard, "communication point %s s refused: it must be finite", a);
+        return 1;
+    }
+    if (c->time_known && fabs(t - c->time) > 1e-9 * fmax(1.0, fabs(t))) {
+        repr_double(a, sizeof a, t);
+        repr_double(b, sizeof b, c->time);
+        log_message(p, fmi2Discard,
+                    "communication point %s s refused: the FMU is at t = %s s (restore a saved "
+                    "FMU state to step from another time)",
+                    a, b);
+        return 1;
+    }
+    for (int vr = 0; vr < N_VARS; vr++)
+        if (VAR_CAUSALITY[vr] == C_INPUT && !isfinite(c->v[vr])) {
+            repr_double(a, sizeof a, c->v[vr]);
+            log_message(p, fmi2Discard, "input %s = %s is not finite; step refused",
+                        VAR_NAME[vr], a);
+            return 1;
+        }
+    return 0;
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior) {
+    (void)noSetPrior;
+    Plant *p = c;
+    Core *core = &p->core;
+    if (!core->initialized) {
+        log_message(p, fmi2Discard,
+                    "doStep called before initialization finished; call "
+                    "fmi2EnterInitializationMode and fmi2ExitInitializationMode first");
+        return fmi2Discard;
+    }
+    if (core->problems[0]) {
+        log_message(p, fmi2Discard, "cannot step: %s", core->problems);
+        return fmi2Discard;
+    }
+    if (step_problem(p, t, h)) return fmi2Discard;
+    Physics saved = core->physics;
+    if (physics_advance(&core->physics, p->cache, h, core->v[VR_i_ref], core->v + VR_tau_ext)) {
+        core->physics = saved;
+        log_message(p, fmi2Discard,
+                    "internal error, step refused: the state is no longer finite (check the "
+                    "parameters and inputs)");
+        return fmi2Discard;
+    }
+    core->sample++;
+    write_outputs(core, h);
+    core->time = t + h;
+    core->time_known = 1;
+    if (p->trace) write_trace(p);
+    return fmi2OK;
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    (void)c;
+    return fmi2Error;
+}
+
+/* ---- FMI: values ---- */
+
+static const char *const TYPE_NAME[] = {"Real", "Integer", "Boolean", "String"};
+
+static fmi2Status check_refs(Plant *p, const fmi2ValueReference vr[], size_t n, int type,
+                             const char *call) {
+    for (size_t i = 0; i < n; i++)
+        if (vr[i] >= N_VARS || VAR_TYPE[vr[i]] != type) {
+            log_message(p, fmi2Error, "%s%s: value reference %u is not a %s variable", call,
+                        TYPE_NAME[type], vr[i], TYPE_NAME[type]);
+            return fmi2Error;
+        }
+    return fmi2OK;
+}
+
+static fmi2Status get_numbers(fmi2Component c, const fmi2ValueReference vr[], size_t n, int type,
+                              double *reals, int *ints) {
+    Plant *p = c;
+    if (check_refs(p, vr, n, type, "get") != fmi2OK) return fmi2Error;
+    for (size_t i = 0; i < n; i++) {
+        double x = p->core.v[vr[i]];
+        if (reals)
+            reals[i] = x;
+        else
+            ints[i] = (int)x;
+    }
+    return fmi2OK;
+}
+
+/* Whether a value may be set now; logs and returns the status when it may not. */
+static fmi2Status settable(Plant *p, fmi2ValueReference vr) {
+    if (VAR_CAUSALITY[vr] == C_OUTPUT) {
+        log_message(p, fmi2Warning, "%s is an output and cannot be set; ignored", VAR_NAME[vr]);
+        return fmi2Warning;
+    }
+    if (p->core.initialized && VAR_CAUSALITY[vr] == C_PARAMETER) {
+        log_message(p, fmi2Warning,
+                    "parameter %s is fixed after initialization; the new value is ignored (set "
+                    "it before exitInitializationMode)",
+                    VAR_NAME[vr]);
+        return fmi2Warning;
+    }
+    return fmi2OK;
+}
+
+static fmi2Status set_numbers(fmi2Component c, const fmi2ValueReference vr[], size_t n, int type,
+                              const double *reals, const int *ints) {
+    Plant *p = c;
+    if (check_refs(p, vr, n, type, "set") != fmi2OK) return fmi2Error;
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < n; i++) {
+        fmi2Status s = settable(p, vr[i]);
+        if (s != fmi2OK) {
+            status = s;
+            continue;
+        }
+        double x = reals ? reals[i] : (double)ints[i];
+        p->core.v[vr[i]] = type == T_BOOLEAN ? (x != 0.0) : x;
+    }
+    return status;
+}
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                       fmi2Real value[]) {
+    return get_numbers(c, vr, n, T_REAL, value, NULL);
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                          fmi2Integer value[]) {
+    return get_numbers(c, vr, n, T_INTEGER, NULL, value);
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                          fmi2Boolean value[]) {
+    return get_numbers(c, vr, n, T_BOOLEAN, NULL, value);
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                         fmi2String value[]) {
+    Plant *p = c;
+    if (check_refs(p, vr, n, T_STRING, "get") != fmi2OK) return fmi2Error;
+    for (size_t i = 0; i < n; i++) value[i] = p->core.trace_file; /* the only String */
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                       const fmi2Real value[]) {
+    return set_numbers(c, vr, n, T_REAL, value, NULL);
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                          const fmi2Integer value[]) {
+    return set_numbers(c, vr, n, T_INTEGER, NULL, value);
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                          const fmi2Boolean value[]) {
+    return set_numbers(c, vr, n, T_BOOLEAN, NULL, value);
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                         const fmi2String value[]) {
+    Plant *p = c;
+    if (check_refs(p, vr, n, T_STRING, "set") != fmi2OK) return fmi2Error;
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < n; i++) {
+        fmi2Status s = settable(p, vr[i]);
+        if (s != fmi2OK) {
+            status = s;
+            continue;
+        }
+        const char *text = value[i] ? value[i] : "";
+        if (strlen(text) >= PATH) {
+            log_message(p, fmi2Error, "%s: path longer than %d characters", VAR_NAME[vr[i]],
+                        PATH - 1);
+            return fmi2Error;
+        }
+        strcpy(p->core.trace_file, text);
+    }
+    return status;
+}
+
+/* ---- FMI: FMU state ---- */
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    Plant *p = c;
+    Core *copy = *state ? (Core *)*state : malloc(sizeof(Core));
+    if (!copy) return fmi2Error;
+    *copy = p->core;
+    *state = copy;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+    Plant *p = c;
+    if (!state) return fmi2Error;
+    p->core = *(const Core *)state;
+    physics_cache_clear(p->cache); /* derived data: rebuilt on demand */
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    (void)c;
+    free(*state);
+    *state = NULL;
+    return fmi2OK;
+}
+
+#define HEADER (2 * sizeof(uint64_t))
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
+    (void)c;
+    (void)state;
+    *size = HEADER + sizeof(Core);
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[],
+                                 size_t size) {
+    Plant *p = c;
+    if (size < HEADER + sizeof(Core)) {
+        log_message(p, fmi2Error, "serializeFMUstate: buffer of %zu bytes is too small",
+                    size);
+        return fmi2Error;
+    }
+    uint64_t header[2] = {STATE_MAGIC, sizeof(Core)};
+    memcpy(bytes, header, HEADER);
+    memcpy(bytes + HEADER, state, sizeof(Core));
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
+                                   fmi2FMUstate *state) {
+    Plant *p = c;
+    uint64_t header[2];
+    if (size != HEADER + sizeof(Core)) {
+        log_message(p, fmi2Error,
+                    "deSerializeFMUstate: %zu bytes is not a state of this FMU (%zu expected)",
+                    size, HEADER + sizeof(Core));
+        return fmi2Error;
+    }
+    memcpy(header, bytes, HEADER);
+    if (header[0] != STATE_MAGIC || header[1] != sizeof(Core)) {
+        log_message(p, fmi2Error, "deSerializeFMUstate: the bytes are not a state of this FMU");
+        return fmi2Error;
+    }
+    Core *copy = *state ? (Core *)*state : malloc(sizeof(Core));
+    if (!copy) return fmi2Error;
+    memcpy(copy, bytes + HEADER, sizeof(Core));
+    *state = copy;
+    return fmi2OK;
+}
+
+/* ---- FMI: not supported ---- */
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                        const fmi2ValueReference z[], size_t nz,
+                                        const fmi2Real du[], fmi2Real dz[]) {
+    (void)u, (void)nu, (void)z, (void)nz, (void)du, (void)dz;
+    log_message(c, fmi2Error, "directional derivatives are not provided");
+    return fmi2Error;
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    (void)vr, (void)n, (void)order, (void)value;
+    log_message(c, fmi2Error, "input derivatives are not supported (canInterpolateInputs=false)");
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                        size_t n, const fmi2Integer order[], fmi2Real value[]) {
+    (void)vr, (void)n, (void)order, (void)value;
+    log_message(c, fmi2Error, "output derivatives are not provided");
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
+    (void)c, (void)s, (void)value;
+    return fmi2Discard; /* doStep never runs asynchronously */
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
+    Plant *p = c;
+    if (s != fmi2LastSuccessfulTime) return fmi2Discard;
+    *value = p->core.time;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
+    (void)c, (void)s, (void)value;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
+    (void)c, (void)s, (void)value;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
+    (void)c, (void)s, (void)value;
+    return fmi2Discard;
+}

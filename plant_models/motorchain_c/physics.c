@@ -1,0 +1,457 @@
+/* The plant's physics in C; see physics.h. Every function mirrors one of
+ * plant_models/motorchain/physics.py, operation for operation, so that both give
+ * the same numbers to rounding. */
+#include "physics.h"
+
+#include <math.h>
+#include <string.h>
+
+#define N N_MASSES
+#define SIZE PH_SIZE
+#define M PH_INPUTS
+#define BIG (PH_SIZE + PH_INPUTS)
+#define CUR (2 * N + 2) /* index of the current in x */
+#define MAX_EVENTS_PER_STEP 16
+
+/* ---- small dense linear algebra (row-major, fixed leading dimension BIG) ---- */
+
+typedef double Square[BIG][BIG];
+
+/* c = a b (n × n); c may be a or b. t: scratch. */
+static void matmul(Square c, Square a, Square b, int n, Square t) {
+    for (int r = 0; r < n; r++)
+        for (int col = 0; col < n; col++) {
+            double s = 0.0;
+            for (int k = 0; k < n; k++) s += a[r][k] * b[k][col];
+            t[r][col] = s;
+        }
+    for (int r = 0; r < n; r++) memcpy(c[r], t[r], sizeof(double) * n);
+}
+
+/* Solve a x = b in place (b becomes x); Gaussian elimination, partial pivoting. */
+static int solve(Square a, Square b, int n) {
+    for (int col = 0; col < n; col++) {
+        int pivot = col;
+        for (int r = col + 1; r < n; r++)
+            if (fabs(a[r][col]) > fabs(a[pivot][col])) pivot = r;
+        if (a[pivot][col] == 0.0 || !isfinite(a[pivot][col])) return -1;
+        if (pivot != col) {
+            double tmp[BIG];
+            memcpy(tmp, a[col], sizeof tmp);
+            memcpy(a[col], a[pivot], sizeof tmp);
+            memcpy(a[pivot], tmp, sizeof tmp);
+            memcpy(tmp, b[col], sizeof tmp);
+            memcpy(b[col], b[pivot], sizeof tmp);
+            memcpy(b[pivot], tmp, sizeof tmp);
+        }
+        double inv = 1.0 / a[col][col];
+        for (int r = col + 1; r < n; r++) {
+            double f = a[r][col] * inv;
+            if (f != 0.0) {
+                for (int c = col; c < n; c++) a[r][c] -= f * a[col][c];
+                for (int c = 0; c < n; c++) b[r][c] -= f * b[col][c];
+            }
+        }
+    }
+    for (int col = n - 1; col >= 0; col--) {
+        double inv = 1.0 / a[col][col];
+        for (int c = 0; c < n; c++) b[col][c] *= inv;
+        for (int r = 0; r < col; r++) {
+            double f = a[r][col];
+            if (f != 0.0)
+                for (int c = 0; c < n; c++) b[r][c] -= f * b[col][c];
+        }
+    }
+    return 0;
+}
+
+/* e = expm(a), scaling and squaring with a (6, 6) Padé approximant (as linalg.expm). */
+static int expm(Square e, Square a_in, int n, Square *work) {
+    double(*a)[BIG] = work[0], (*x)[BIG] = work[1], (*num)[BIG] = work[2];
+    double(*den)[BIG] = work[3], (*t)[BIG] = work[4];
+    double norm = 0.0;
+    for (int r = 0; r < n; r++) {
+        double s = 0.0;
+        for (int c = 0; c < n; c++) s += fabs(a_in[r][c]);
+        if (s > norm || isnan(s)) norm = s;
+    }
+    if (!isfinite(norm)) return -1;
+    int s = norm > 0.5 ? (int)ceil(log2(norm / 0.5)) : 0;
+    if (s < 0) s = 0;
+    double scale = pow(0.5, s);
+    for (int r = 0; r < n; r++)
+        for (int c = 0; c < n; c++) {
+            a[r][c] = scale * a_in[r][c];
+            x[r][c] = a[r][c];
+        }
+    const int q = 6;
+    double coef = 0.5;
+    for (int r = 0; r < n; r++)
+        for (int c = 0; c < n; c++) {
+            double id = r == c ? 1.0 : 0.0;
+            num[r][c] = id + coef * a[r][c];
+            den[r][c] = id + -coef * a[r][c];
+        }
+    int positive = 1;
+    for (int k = 2; k <= q; k++) {
+        coef = coef * (q - k + 1) / (k * (2 * q - k + 1));
+        matmul(x, a, x, n, t);
+        double sign = positive ? coef : -coef;
+        for (int r = 0; r < n; r++)
+            for (int c = 0; c < n; c++) {
+                num[r][c] = num[r][c] + coef * x[r][c];
+                den[r][c] = den[r][c] + sign * x[r][c];
+            }
+        positive = !positive;
+    }
+    if (solve(den, num, n) != 0) return -1;
+    for (int r = 0; r < n; r++) memcpy(e[r], num[r], sizeof(double) * n);
+    for (int i = 0; i < s; i++) matmul(e, e, e, n, t);
+    return 0;
+}
+
+/* ---- the chain's matrices ---- */
+
+static void spring_matrix(double m[N + 1][N + 1], const double *g) {
+    memset(m, 0, sizeof(double) * (N + 1) * (N + 1));
+    for (int i = 1; i <= N; i++) {
+        m[i - 1][i - 1] += g[i - 1];
+        m[i][i] += g[i - 1];
+        m[i - 1][i] -= g[i - 1];
+        m[i][i - 1] -= g[i - 1];
+    }
+}
+
+void physics_init(Physics *p, double J_m, double k_t, double D_m, double f_c, const double *J,
+                  const double *k, const double *B, int attached, double current_bandwidth) {
+    memset(p, 0, sizeof *p);
+    p->k_t = k_t;
+    p->f_c = f_c;
+    p->k1 = attached ? k[0] : 0.0;
+    p->B1 = attached ? B[0] : 0.0;
+    p->ideal_current = current_bandwidth == 0.0;
+    double inertias[N + 1], ks[N], Bs[N];
+    inertias[0] = J_m;
+    for (int i = 0; i < N; i++) {
+        inertias[i + 1] = J[i];
+        ks[i] = i == 0 ? p->k1 : k[i];
+        Bs[i] = i == 0 ? p->B1 : B[i];
+    }
+    double stiffness[N + 1][N + 1], damping[N + 1][N + 1];
+    spring_matrix(stiffness, ks);
+    spring_matrix(damping, Bs);
+    damping[0][0] += D_m;
+    const int qi = CUR + 1, qtau = CUR + 2;
+    for (int j = 0; j <= N; j++) {
+        p->a[j][N + 1 + j] = 1.0;
+        double *row = p->a[N + 1 + j];
+        for (int col = 0; col <= N; col++) {
+            row[col] = -stiffness[j][col] / inertias[j];
+            row[N + 1 + col] = -damping[j][col] / inertias[j];
+        }
+        if (j == 0) {
+            row[CUR] = k_t / J_m;
+            p->b[N + 1][1] = 1.0 / J_m;
+        } else {
+            p->b[N + 1 + j][1 + j] = 1.0 / inertias[j];
+        }
+    }
+    p->a[CUR][CUR] = -current_bandwidth;
+    p->b[CUR][0] = current_bandwidth;
+    p->a[qi][CUR] = 1.0;
+    p->a[qtau][0] = ks[0];
+    p->a[qtau][1] = -ks[0];
+    p->a[qtau][N + 1] = Bs[0];
+    p->a[qtau][N + 2] = -Bs[0];
+    memcpy(p->a_stuck, p->a, sizeof p->a);
+    memcpy(p->b_stuck, p->b, sizeof p->b);
+    memset(p->a_stuck[N + 1], 0, sizeof p->a_stuck[N + 1]);
+    memset(p->b_stuck[N + 1], 0, sizeof p->b_stuck[N + 1]);
+    p->stuck = f_c > 0.0;
+    p->direction = 0.0;
+}
+
+/* ---- one step ---- */
+
+void physics_cache_clear(PhysicsCache *cache) {
+    cache->count = 0;
+    cache->ladder_h[0] = cache->ladder_h[1] = 0.0; /* no step has h = 0 */
+}
+
+static int discrete(const Physics *p, PhysicsCache *cache, double tau, int stuck, int *slot) {
+    for (int i = 0; i < cache->count; i++)
+        if (cache->tau[i] == tau && cache->stuck[i] == stuck) {
+            *slot = i;
+            return 0;
+        }
+    if (cache->count >= PH_CACHE) cache->count = 0;
+    double(*big)[BIG] = cache->work[5], (*e)[BIG] = cache->work[6];
+    const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
+    const double(*b)[M] = stuck ? p->b_stuck : p->b;
+    memset(big, 0, sizeof(Square));
+    for (int r = 0; r < SIZE; r++) {
+        for (int c = 0; c < SIZE; c++) big[r][c] = tau * a[r][c];
+        for (int c = 0; c < M; c++) big[r][SIZE + c] = tau * b[r][c];
+    }
+    if (expm(e, big, BIG, cache->work) != 0) return -1;
+    int i = cache->count++;
+    cache->tau[i] = tau;
+    cache->stuck[i] = stuck;
+    for (int r = 0; r < SIZE; r++) {
+        memcpy(cache->phi[i][r], e[r], sizeof(double) * SIZE);
+        memcpy(cache->gamma[i][r], e[r] + SIZE, sizeof(double) * M);
+    }
+    *slot = i;
+    return 0;
+}
+
+/* Build the ladder of regime `stuck` for step h: rung j = e^{M h / 2^(j+1)}, each by its
+ * own matrix exponential. (Squaring up from the smallest would be cheaper but doubles
+ * the rounding error of I + small with every squaring: 2^32 × 1e-16.) */
+static int build_ladder(const Physics *p, PhysicsCache *cache, double h, int stuck) {
+    double(*big)[BIG] = cache->work[5], (*e)[BIG] = cache->work[6];
+    const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
+    const double(*b)[M] = stuck ? p->b_stuck : p->b;
+    for (int j = 0; j < PH_LADDER; j++) {
+        const double tau = ldexp(h, -(j + 1));
+        memset(big, 0, sizeof(Square));
+        for (int r = 0; r < SIZE; r++) {
+            for (int c = 0; c < SIZE; c++) big[r][c] = tau * a[r][c];
+            for (int c = 0; c < M; c++) big[r][SIZE + c] = tau * b[r][c];
+        }
+        if (expm(e, big, BIG, cache->work) != 0) return -1;
+        for (int r = 0; r < SIZE; r++)
+            memcpy(cache->ladder[stuck][j][r], e[r], sizeof(double) * BIG);
+    }
+    cache->ladder_h[stuck] = h;
+    return 0;
+}
+
+/* out = state after a sub-step τ (0 < τ < h) of regime `stuck`, along the ladder of h. */
+static int propagate_part(const Physics *p, PhysicsCache *cache, const double *x, const double *u,
+                          double tau, double h, int stuck, double *out) {
+    if (cache->ladder_h[stuck] != h && build_ladder(p, cache, h, stuck) != 0) return -1;
+    double z[SIZE], y[SIZE];
+    memcpy(z, x, sizeof z);
+    double rest = tau / h;
+    for (int j = 0; j < PH_LADDER; j++) {
+        double digit = ldexp(1.0, -(j + 1));
+        if (rest < digit) continue;
+        rest -= digit;
+        const double(*E)[BIG] = cache->ladder[stuck][j];
+        for (int r = 0; r < SIZE; r++) {
+            double s = 0.0;
+            for (int c = 0; c < SIZE; c++) s += E[r][c] * z[c];
+            for (int c = 0; c < M; c++) s += E[r][SIZE + c] * u[c];
+            y[r] = s;
+        }
+        memcpy(z, y, sizeof z);
+    }
+    /* what is left, under h / 2^32, by one Euler step (its error is O((h/2^32)² ‖A‖²)) */
+    const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
+    const double(*b)[M] = stuck ? p->b_stuck : p->b;
+    double dt = rest * h;
+    for (int r = 0; r < SIZE; r++) {
+        double s = 0.0;
+        for (int c = 0; c < SIZE; c++) s += a[r][c] * z[c];
+        for (int c = 0; c < M; c++) s += b[r][c] * u[c];
+        y[r] = z[r] + dt * s;
+    }
+    memcpy(out, y, sizeof y);
+    return 0;
+}
+
+static int propagate(const Physics *p, PhysicsCache *cache, const double *x, const double *u,
+                     double tau, int stuck, double *out) {
+    int i;
+    if (discrete(p, cache, tau, stuck, &i) != 0) return -1;
+    double y[SIZE];
+    for (int r = 0; r < SIZE; r++) {
+        double s = 0.0, t = 0.0;
+        for (int c = 0; c < SIZE; c++) s += cache->phi[i][r][c] * x[c];
+        for (int c = 0; c < M; c++) t += cache->gamma[i][r][c] * u[c];
+        y[r] = s + t;
+    }
+    memcpy(out, y, sizeof y);
+    return 0;
+}
+
+/* A full step (τ = h) uses the cached exponential of h; a part of one, the ladder. */
+static int advance_by(const Physics *p, PhysicsCache *cache, const double *x, const double *u,
+                      double tau, double h, int stuck, double *out) {
+    if (tau == h) return propagate(p, cache, x, u, tau, stuck, out);
+    return propagate_part(p, cache, x, u, tau, h, stuck, out);
+}
+
+static double derivative_row(const Physics *p, const double *x, const double *u, int stuck,
+                             int row) {
+    const double *a = stuck ? p->a_stuck[row] : p->a[row];
+    const double *b = stuck ? p->b_stuck[row] : p->b[row];
+    double s = 0.0, t = 0.0;
+    for (int c = 0; c < SIZE; c++) s += a[c] * x[c];
+    for (int c = 0; c < M; c++) t += b[c] * u[c];
+    return s + t;
+}
+
+static double drive_torque(const Physics *p, const double *x) {
+    return p->k_t * x[CUR] - (p->k1 * (x[0] - x[1]) + p->B1 * (x[N + 1] - x[N + 2]));
+}
+
+static double hermite(double y0, double d0, double y1, double d1, double tau, double s) {
+    double r = s / tau;
+    double h00 = (1 + 2 * r) * ((1 - r) * (1 - r));
+    double h10 = r * ((1 - r) * (1 - r));
+    double h01 = r * r * (3 - 2 * r);
+    double h11 = r * r * (r - 1);
+    return h00 * y0 + h10 * tau * d0 + h01 * y1 + h11 * tau * d1;
+}
+
+/* An event on the Hermite interpolant: reversal (sign·y < 0) or breakaway (|y| > f_c). */
+typedef struct {
+    int breakaway;
+    double y0, d0, y1, d1, tau, sign, f_c;
+} Event;
+
+static int event_at(const Event *e, double s) {
+    double y = hermite(e->y0, e->d0, e->y1, e->d1, e->tau, s);
+    return e->breakaway ? fabs(y) > e->f_c : e->sign * y < 0.0;
+}
+
+/* Smallest s in (0, tau] where the event becomes true, or -1 (bisection on a grid). */
+static double first_root(const Event *e, double tau) {
+    const int samples = 32;
+    double lo = 0.0;
+    for (int j = 1; j <= samples; j++) {
+        double hi = tau * j / samples;
+        if (event_at(e, hi)) {
+            for (int it = 0; it < 60; it++) {
+                double mid = 0.5 * (lo + hi);
+                if (event_at(e, mid))
+                    hi = mid;
+                else
+                    lo = mid;
+                if (hi - lo <= 1e-15 * tau) break;
+            }
+            return hi;
+        }
+        lo = hi;
+    }
+    return -1.0;
+}
+
+static double first_reversal(const Physics *p, const double *x0, const double *x1,
+                             const double *u, double tau) {
+    const int w = N + 1;
+    Event e = {0, x0[w], derivative_row(p, x0, u, 0, w), x1[w], derivative_row(p, x1, u, 0, w),
+               tau, p->direction, 0.0};
+    return first_root(&e, tau);
+}
+
+static double drive_rate(const Physics *p, const double *x, const double *u) {
+    double fI = derivative_row(p, x, u, 1, CUR);
+    double f1 = derivative_row(p, x, u, 1, N + 1);
+    double f2 = derivative_row(p, x, u, 1, N + 2);
+    return p->k_t * fI - (p->k1 * (x[N + 1] - x[N + 2]) + p->B1 * (f1 - f2));
+}
+
+static double first_breakaway(const Physics *p, const double *x0, const double *x1,
+                              const double *u, double tau) {
+    Event e = {1,   drive_torque(p, x0), drive_rate(p, x0, u), drive_torque(p, x1),
+               drive_rate(p, x1, u), tau, 0.0, p->f_c};
+    return first_root(&e, tau);
+}
+
+static double copysign_one(double v) { return copysign(1.0, v); }
+
+int physics_advance(Physics *p, PhysicsCache *cache, double h, double i_ref,
+                    const double *tau_ext) {
+    double x[SIZE], end[SIZE], u[M];
+    memcpy(x, p->x, sizeof x);
+    if (p->ideal_current) x[CUR] = i_ref;
+    x[CUR + 1] = 0.0;
+    x[CUR + 2] = 0.0;
+    u[0] = i_ref;
+    for (int i = 0; i < N; i++) u[2 + i] = tau_ext[i];
+    if (p->f_c == 0.0) {
+        u[1] = 0.0;
+        return propagate(p, cache, x, u, h, 0, p->x);
+    }
+    double t = 0.0;
+    int events;
+    for (events = 0; events < MAX_EVENTS_PER_STEP; events++) {
+        double tau = h - t, s;
+        if (tau <= 1e-12 * h) break;
+        if (p->stuck) {
+            double drive = drive_torque(p, x);
+            if (fabs(drive) > p->f_c) {
+                p->stuck = 0;
+                p->direction = copysign_one(drive);
+                continue;
+            }
+            u[1] = 0.0;
+            if (advance_by(p, cache, x, u, tau, h, 1, end) != 0) return -1;
+            s = first_breakaway(p, x, end, u, tau);
+        } else {
+            u[1] = -p->f_c * p->direction;
+            if (advance_by(p, cache, x, u, tau, h, 0, end) != 0) return -1;
+            s = first_reversal(p, x, end, u, tau);
+        }
+        if (s < 0.0) {
+            memcpy(p->x, end, sizeof end);
+            return 0;
+        }
+        if (advance_by(p, cache, x, u, s, h, p->stuck, x) != 0) return -1;
+        t += s;
+        if (p->stuck) {
+            double drive = drive_torque(p, x);
+            p->stuck = 0;
+            p->direction = copysign_one(drive);
+        } else {
+            x[N + 1] = 0.0;
+            double drive = drive_torque(p, x);
+            if (fabs(drive) <= p->f_c)
+                p->stuck = 1;
+            else
+                p->direction = copysign_one(drive);
+        }
+    }
+    if (events == MAX_EVENTS_PER_STEP) { /* pathological chatter: finish in this regime */
+        u[1] = p->stuck ? 0.0 : -p->f_c * p->direction;
+        if (advance_by(p, cache, x, u, h - t, h, p->stuck, x) != 0) return -1;
+    }
+    memcpy(p->x, x, sizeof x);
+    return 0;
+}
+
+double physics_reaction_torque(const Physics *p) {
+    const double *x = p->x;
+    return p->k1 * (x[0] - x[1]) + p->B1 * (x[N + 1] - x[N + 2]);
+}
+
+double physics_average_current(const Physics *p, double h) { return p->x[CUR + 1] / h; }
+
+double physics_average_reaction(const Physics *p, double h) { return p->x[CUR + 2] / h; }
+
+/* ---- noise and encoder (flexchain/noise.py) ---- */
+
+static uint64_t splitmix64(uint64_t z) {
+    z += 0x9E3779B97F4A7C15ULL;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+double noise_gaussian(uint64_t seed, uint64_t k) {
+    uint64_t base = splitmix64(seed ^ 0x5DEECE66DULL);
+    uint64_t a = splitmix64(base + 2 * k);
+    uint64_t b = splitmix64(base + 2 * k + 1);
+    double u1 = (double)((a >> 11) + 1) * 0x1p-53;
+    double u2 = (double)(b >> 11) * 0x1p-53;
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
+}
+
+double noise_quantize(double theta, int64_t counts_per_rev) {
+    if (counts_per_rev <= 0) return theta;
+    double step = 2.0 * M_PI / (double)counts_per_rev;
+    return floor(theta / step) * step;
+}
