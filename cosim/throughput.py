@@ -22,10 +22,12 @@ figures are not the ones to quote.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import functools
 import json
 import statistics
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,6 +38,7 @@ from cosim.errors import UserError
 from cosim.instance import FmuInstance
 from cosim.master import MEASURED, cosimulate
 from cosim.scenarios import SCENARIOS
+from flexchain.observer import STATE_ESTIMATION
 
 H = 1e-3
 OBSERVER_SETTINGS = {"mode": 2}
@@ -57,6 +60,17 @@ class Figure:
         return f"{self.median:.{digits}f} ({self.low:.{digits}f}–{self.high:.{digits}f})"
 
 
+@contextlib.contextmanager
+def _bench_pair(n: int) -> Iterator[tuple[FmuInstance, FmuInstance]]:
+    """The plant and the observer FMUs for n masses, instantiated (closed on exit)."""
+    folder = ensure_built(n)
+    with (
+        FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as plant,
+        FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as obs,
+    ):
+        yield plant, obs
+
+
 def _current(duration: float) -> np.ndarray:
     t = np.arange(round(duration / H)) * H
     return SCENARIOS["flexible"].current(t)
@@ -64,12 +78,8 @@ def _current(duration: float) -> np.ndarray:
 
 def whole_loop(n: int, duration: float, observer: dict | None = None) -> float:
     """µs per step of one :func:`cosimulate` run of ``duration`` s with n masses."""
-    folder = ensure_built(n)
     current = _current(duration)
-    with (
-        FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as plant,
-        FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as obs,
-    ):
+    with _bench_pair(n) as (plant, obs):
         started = time.perf_counter()
         cosimulate(
             plant,
@@ -87,13 +97,9 @@ def whole_loop(n: int, duration: float, observer: dict | None = None) -> float:
 def split_loop(duration: float) -> dict[str, float]:
     """µs per step of each part of the bench loop: the master's raw calls timed one by
     one, plus the read of the estimates a controller would make every step."""
-    folder = ensure_built(3)
     current = _current(duration).tolist()
     clock = time.perf_counter_ns
-    with (
-        FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as plant,
-        FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as obs,
-    ):
+    with _bench_pair(3) as (plant, obs):
         plant.initialize()
         measured, observer_in = plant.real_port(MEASURED), obs.real_port(MEASURED)
         measured.get()
@@ -143,31 +149,23 @@ def split_loop(duration: float) -> dict[str, float]:
     }
 
 
+@functools.lru_cache(maxsize=2)
+def _bench_sensors(duration: float) -> tuple[list[float], list[float], list[float]]:
+    """i_a, ω_m, θ_m of the bench co-simulation of ``duration`` s (simulated once)."""
+    with _bench_pair(3) as (plant, obs):
+        rec = cosimulate(
+            plant, obs, _current(duration), H, list(MEASURED), [], None, OBSERVER_SETTINGS
+        )
+    i_a, w, th = (rec[f"plant.{c}"].tolist() for c in MEASURED)
+    return i_a, w, th
+
+
 def plain_python_step(duration: float) -> float:
     """µs per step of the observer's algorithms (flexchain) with no FMI in between."""
-    from cosim.accuracy import ACTUATOR, G_DIST, Observer, ObserverSettings
+    from cosim.accuracy import CASES, Observer, settings_for
 
-    folder = ensure_built(3)
-    current = _current(duration)
-    with (
-        FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as plant,
-        FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as obs,
-    ):
-        rec = cosimulate(plant, obs, current, H, list(MEASURED), [], None, OBSERVER_SETTINGS)
-    i_a, w, th = (rec[f"plant.{c}"].tolist() for c in MEASURED)
-    from flexchain import bench
-
-    settings = ObserverSettings(
-        mode=2,
-        actuator=ACTUATOR,
-        g_dist=G_DIST,
-        g_lpf=G_DIST,
-        J=tuple(bench.inertias(3)),
-        k=(bench.K,) * 3,
-        B=(bench.B,) * 3,
-        encoder_cpr=2000,
-    )
-    observer = Observer(settings, th[0], w[0])
+    i_a, w, th = _bench_sensors(duration)
+    observer = Observer(settings_for(CASES[0], STATE_ESTIMATION), th[0], w[0])
     step = observer.step
     started = time.perf_counter()
     for k in range(1, len(th)):

@@ -20,7 +20,6 @@ Conventions it settles (see README, "FMU conventions"):
 from __future__ import annotations
 
 import math
-import sys
 import traceback
 from collections.abc import Sequence
 from operator import itemgetter
@@ -212,36 +211,28 @@ class FmuSlave(Fmi2Slave):
         self._ready = not self.problems and self.time is not None
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        if (  # the common case in few operations; any doubt takes the checks below
+        if not (  # the common case in few operations; any doubt takes the full checks
             self._ready
             and 0.0 < step_size < _INF
             and -1e-9 <= current_time - self.time <= 1e-9
             and isfinite(sum(self._read_inputs(self.v)))
-        ):
-            try:
-                self.step(current_time, step_size)
-            except Exception:
-                return self._failed_step()
-            self.time = current_time + step_size
-            if self._trace is not None:
-                self._write_trace()
-            return True
-        return self._checked_step(current_time, step_size)
-
-    def _failed_step(self) -> bool:
-        """Report the exception :meth:`step` raised (call inside ``except``); False.
-
-        A refusal becomes fmi2Discard with its message; a bug too, with its
-        traceback, instead of fmi2Fatal in the user's host."""
-        refusal = sys.exc_info()[1]
-        if isinstance(refusal, StepRefusedError):
+        ) and not self._step_allowed(current_time, step_size):
+            return False
+        try:
+            self.step(current_time, step_size)
+        except StepRefusedError as refusal:
             self.report(str(refusal), Fmi2Status.discard)
-        else:
+            return False
+        except Exception:  # a bug must not become fmi2Fatal in the user's host
             self.report("internal error, step refused:\n" + traceback.format_exc())
-        return False
+            return False
+        self.time = current_time + step_size
+        if self._trace is not None:
+            self._write_trace()
+        return True
 
-    def _checked_step(self, current_time: float, step_size: float) -> bool:
-        """:meth:`do_step` with every check spelt out and a message for each refusal."""
+    def _step_allowed(self, current_time: float, step_size: float) -> bool:
+        """Every check of a step spelt out; a refusal is logged with its reason."""
         if not self.initialized:
             self.report(
                 "doStep called before initialization finished; call "
@@ -256,13 +247,6 @@ class FmuSlave(Fmi2Slave):
         if problem is not None:
             self.report(problem, Fmi2Status.discard)
             return False
-        try:
-            self.step(current_time, step_size)
-        except Exception:
-            return self._failed_step()
-        self.time = current_time + step_size
-        if self._trace is not None:
-            self._write_trace()
         return True
 
     def terminate(self) -> None:

@@ -178,13 +178,9 @@ void physics_cache_clear(PhysicsCache *cache) {
     cache->ladder_h[0] = cache->ladder_h[1] = 0.0; /* no step has h = 0 */
 }
 
-static int discrete(const Physics *p, PhysicsCache *cache, double tau, int stuck, int *slot) {
-    for (int i = 0; i < cache->count; i++)
-        if (cache->tau[i] == tau && cache->stuck[i] == stuck) {
-            *slot = i;
-            return 0;
-        }
-    if (cache->count >= PH_CACHE) cache->count = 0;
+/* The exponential of the augmented system over tau, e^{[A B; 0 0] τ}, into work[6]
+ * (its first SIZE rows are [Φ | Γ]); NULL if it failed. */
+static double (*exponential(const Physics *p, PhysicsCache *cache, double tau, int stuck))[BIG] {
     double(*big)[BIG] = cache->work[5], (*e)[BIG] = cache->work[6];
     const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
     const double(*b)[M] = stuck ? p->b_stuck : p->b;
@@ -193,15 +189,46 @@ static int discrete(const Physics *p, PhysicsCache *cache, double tau, int stuck
         for (int c = 0; c < SIZE; c++) big[r][c] = tau * a[r][c];
         for (int c = 0; c < M; c++) big[r][SIZE + c] = tau * b[r][c];
     }
-    if (expm(e, big, BIG, cache->work) != 0) return -1;
-    int i = cache->count++;
-    cache->tau[i] = tau;
-    cache->stuck[i] = stuck;
+    return expm(e, big, BIG, cache->work) == 0 ? e : NULL;
+}
+
+/* out = Φ x + Γ u, with E's rows [Φ | Γ] (the sums in the reference's order). */
+static void apply(const double (*E)[BIG], const double *x, const double *u, double *out) {
+    double y[SIZE];
     for (int r = 0; r < SIZE; r++) {
-        memcpy(cache->phi[i][r], e[r], sizeof(double) * SIZE);
-        memcpy(cache->gamma[i][r], e[r] + SIZE, sizeof(double) * M);
+        double s = 0.0, t = 0.0;
+        for (int c = 0; c < SIZE; c++) s += E[r][c] * x[c];
+        for (int c = 0; c < M; c++) t += E[r][SIZE + c] * u[c];
+        y[r] = s + t;
     }
-    *slot = i;
+    memcpy(out, y, sizeof y);
+}
+
+static double derivative_row(const Physics *p, const double *x, const double *u, int stuck,
+                             int row) {
+    const double *a = stuck ? p->a_stuck[row] : p->a[row];
+    const double *b = stuck ? p->b_stuck[row] : p->b[row];
+    double s = 0.0, t = 0.0;
+    for (int c = 0; c < SIZE; c++) s += a[c] * x[c];
+    for (int c = 0; c < M; c++) t += b[c] * u[c];
+    return s + t;
+}
+
+/* out = state after tau, with the exponential of tau cached by (tau, regime). */
+static int propagate(const Physics *p, PhysicsCache *cache, const double *x, const double *u,
+                     double tau, int stuck, double *out) {
+    int i = 0;
+    while (i < cache->count && !(cache->tau[i] == tau && cache->stuck[i] == stuck)) i++;
+    if (i == cache->count) {
+        double(*e)[BIG] = exponential(p, cache, tau, stuck);
+        if (!e) return -1;
+        if (cache->count >= PH_CACHE) cache->count = 0;
+        i = cache->count++;
+        cache->tau[i] = tau;
+        cache->stuck[i] = stuck;
+        memcpy(cache->step[i], e, sizeof cache->step[i]);
+    }
+    apply((const double(*)[BIG])cache->step[i], x, u, out);
     return 0;
 }
 
@@ -209,19 +236,10 @@ static int discrete(const Physics *p, PhysicsCache *cache, double tau, int stuck
  * own matrix exponential. (Squaring up from the smallest would be cheaper but doubles
  * the rounding error of I + small with every squaring: 2^32 × 1e-16.) */
 static int build_ladder(const Physics *p, PhysicsCache *cache, double h, int stuck) {
-    double(*big)[BIG] = cache->work[5], (*e)[BIG] = cache->work[6];
-    const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
-    const double(*b)[M] = stuck ? p->b_stuck : p->b;
     for (int j = 0; j < PH_LADDER; j++) {
-        const double tau = ldexp(h, -(j + 1));
-        memset(big, 0, sizeof(Square));
-        for (int r = 0; r < SIZE; r++) {
-            for (int c = 0; c < SIZE; c++) big[r][c] = tau * a[r][c];
-            for (int c = 0; c < M; c++) big[r][SIZE + c] = tau * b[r][c];
-        }
-        if (expm(e, big, BIG, cache->work) != 0) return -1;
-        for (int r = 0; r < SIZE; r++)
-            memcpy(cache->ladder[stuck][j][r], e[r], sizeof(double) * BIG);
+        double(*e)[BIG] = exponential(p, cache, ldexp(h, -(j + 1)), stuck);
+        if (!e) return -1;
+        memcpy(cache->ladder[stuck][j], e, sizeof cache->ladder[stuck][j]);
     }
     cache->ladder_h[stuck] = h;
     return 0;
@@ -236,42 +254,14 @@ static int propagate_part(const Physics *p, PhysicsCache *cache, const double *x
     double rest = tau / h;
     for (int j = 0; j < PH_LADDER; j++) {
         double digit = ldexp(1.0, -(j + 1));
-        if (rest < digit) continue;
-        rest -= digit;
-        const double(*E)[BIG] = cache->ladder[stuck][j];
-        for (int r = 0; r < SIZE; r++) {
-            double s = 0.0;
-            for (int c = 0; c < SIZE; c++) s += E[r][c] * z[c];
-            for (int c = 0; c < M; c++) s += E[r][SIZE + c] * u[c];
-            y[r] = s;
+        if (rest >= digit) {
+            rest -= digit;
+            apply((const double(*)[BIG])cache->ladder[stuck][j], z, u, z);
         }
-        memcpy(z, y, sizeof z);
     }
     /* what is left, under h / 2^32, by one Euler step (its error is O((h/2^32)² ‖A‖²)) */
-    const double(*a)[SIZE] = stuck ? p->a_stuck : p->a;
-    const double(*b)[M] = stuck ? p->b_stuck : p->b;
-    double dt = rest * h;
-    for (int r = 0; r < SIZE; r++) {
-        double s = 0.0;
-        for (int c = 0; c < SIZE; c++) s += a[r][c] * z[c];
-        for (int c = 0; c < M; c++) s += b[r][c] * u[c];
-        y[r] = z[r] + dt * s;
-    }
-    memcpy(out, y, sizeof y);
-    return 0;
-}
-
-static int propagate(const Physics *p, PhysicsCache *cache, const double *x, const double *u,
-                     double tau, int stuck, double *out) {
-    int i;
-    if (discrete(p, cache, tau, stuck, &i) != 0) return -1;
-    double y[SIZE];
-    for (int r = 0; r < SIZE; r++) {
-        double s = 0.0, t = 0.0;
-        for (int c = 0; c < SIZE; c++) s += cache->phi[i][r][c] * x[c];
-        for (int c = 0; c < M; c++) t += cache->gamma[i][r][c] * u[c];
-        y[r] = s + t;
-    }
+    const double dt = rest * h;
+    for (int r = 0; r < SIZE; r++) y[r] = z[r] + dt * derivative_row(p, z, u, stuck, r);
     memcpy(out, y, sizeof y);
     return 0;
 }
@@ -281,16 +271,6 @@ static int advance_by(const Physics *p, PhysicsCache *cache, const double *x, co
                       double tau, double h, int stuck, double *out) {
     if (tau == h) return propagate(p, cache, x, u, tau, stuck, out);
     return propagate_part(p, cache, x, u, tau, h, stuck, out);
-}
-
-static double derivative_row(const Physics *p, const double *x, const double *u, int stuck,
-                             int row) {
-    const double *a = stuck ? p->a_stuck[row] : p->a[row];
-    const double *b = stuck ? p->b_stuck[row] : p->b[row];
-    double s = 0.0, t = 0.0;
-    for (int c = 0; c < SIZE; c++) s += a[c] * x[c];
-    for (int c = 0; c < M; c++) t += b[c] * u[c];
-    return s + t;
 }
 
 static double drive_torque(const Physics *p, const double *x) {

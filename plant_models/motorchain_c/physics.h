@@ -31,8 +31,7 @@ typedef struct {
     int count;
     double tau[PH_CACHE];
     int stuck[PH_CACHE];
-    double phi[PH_CACHE][PH_SIZE][PH_SIZE];
-    double gamma[PH_CACHE][PH_SIZE][PH_INPUTS];
+    double step[PH_CACHE][PH_SIZE][PH_SIZE + PH_INPUTS]; /* rows [Φ | Γ] */
     /* Sub-steps of any length τ < h (friction events): the exponentials of h/2^j,
      * j = 1 … PH_LADDER, for one step size and regime each, applied along the
      * binary digits of τ/h (a matrix-vector product per digit instead of a new
