@@ -11,6 +11,7 @@ import atexit
 import contextlib
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
+from ctypes import CFUNCTYPE, c_int, c_size_t, c_void_p, cast
 from pathlib import Path
 
 import numpy as np
@@ -52,33 +53,49 @@ def extracted(path: Path) -> str:
     return folder
 
 
+def raw_function(slave: FMU2Slave, name: str):
+    """The FMI function ``name`` of ``slave`` as a bare ctypes pointer returning int.
+
+    fmpy's own functions convert every argument through their ``argtypes`` (about
+    0.5 µs a call); this one takes ctypes objects as they are, so the caller passes
+    exactly the C types (``c_void_p`` component, arrays, ``c_size_t``, ``c_double``,
+    int for ``fmi2Boolean``). For the per-step calls of a master only; the slave
+    must outlive it (it points into the slave's loaded binary).
+    """
+    return CFUNCTYPE(c_int)(cast(slave._functions[name], c_void_p).value)
+
+
 class RealPort:
-    """One ``fmi2GetReal``/``fmi2SetReal`` of fixed value references, through fmpy's
-    raw ctypes functions and preallocated arrays: no allocation per call.
+    """One ``fmi2GetReal``/``fmi2SetReal`` of fixed value references, through
+    :func:`raw_function` and preallocated arrays: no allocation, no conversion per call.
 
     Attributes:
         values: the ctypes ``fmi2Real`` array read into by :meth:`get` and sent by
             :meth:`send`; a port's ``values`` may be another port's (connections).
         array: numpy view of ``values`` (no copy).
+        get_real, set_real, component, vrs, count: the call's function and
+            arguments, for masters that make the call themselves
+            (``get_real(component, vrs, count, values)``).
     """
 
     def __init__(self, slave: FMU2Slave, vrs: Sequence[int]) -> None:
         self.size = len(vrs)
+        self.count = c_size_t(self.size)
         self.vrs = (fmi2ValueReference * self.size)(*vrs)
         self.values = (fmi2Real * self.size)()
         self.array = np.ctypeslib.as_array(self.values) if self.size else np.empty(0)
-        self.component = slave.component
-        self.get_real = slave._functions["fmi2GetReal"]
-        self.set_real = slave._functions["fmi2SetReal"]
+        self.component = c_void_p(slave.component)
+        self.get_real = raw_function(slave, "fmi2GetReal")
+        self.set_real = raw_function(slave, "fmi2SetReal")
 
     def get(self) -> int:
         """Read the variables into :attr:`values`; return the FMI status."""
-        return self.get_real(self.component, self.vrs, self.size, self.values)
+        return self.get_real(self.component, self.vrs, self.count, self.values)
 
     def send(self, values=None) -> int:
         """Set the variables from ``values`` (a ctypes array; default :attr:`values`)."""
         return self.set_real(
-            self.component, self.vrs, self.size, self.values if values is None else values
+            self.component, self.vrs, self.count, self.values if values is None else values
         )
 
 
@@ -217,6 +234,12 @@ class FmuInstance:
     def real_port(self, names: Sequence[str]) -> RealPort:
         """Preallocated buffers for one batched get or set of the Real variables ``names``."""
         return RealPort(self.slave, self._real_vrs(names))
+
+    def step_call(self) -> tuple:
+        """``(do_step, component)`` for a master's hot loop: call
+        ``do_step(component, t, h, 1)`` with ``t`` and ``h`` as ``c_double`` (see
+        :func:`raw_function`); it returns the FMI status."""
+        return raw_function(self.slave, "fmi2DoStep"), c_void_p(self.slave.component)
 
     def get(self, names: Sequence[str]) -> list[float]:
         """Values of ``names`` (Booleans and Integers converted to float)."""

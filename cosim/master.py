@@ -16,6 +16,7 @@ Orderings (both honour the timing contract of shared/METHOD.md):
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from ctypes import c_double
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -93,26 +94,40 @@ def cosimulate(
     observer_log = np.empty((len(recorded), len(record_observer)))
     read_plant, read_observer = _recorder(plant, record_plant), _recorder(observer, record_observer)
     plant_log[0], observer_log[0] = read_plant(), read_observer()
-    # The hot loop: fmpy's raw ctypes functions, preallocated arrays, no allocation.
+    # The hot loop: bare ctypes calls with ctypes arguments made once, no allocation.
     i_port = plant.real_port(["i_ref"])
-    set_i, i_vr, i_value, plant_c = i_port.set_real, i_port.vrs, i_port.values, i_port.component
-    plant_step = plant.slave._functions["fmi2DoStep"]
-    observer_step = observer.slave._functions["fmi2DoStep"]
-    observer_c = observer.slave.component
-    get_measured, send_measured = measured.get, observer_in.send
-    values = measured.values
+    set_i, i_vr, i_value, one = i_port.set_real, i_port.vrs, i_port.values, i_port.count
+    plant_step, plant_c = plant.step_call()
+    observer_step, observer_c = observer.step_call()
+    get_sensors, sensors_in = measured.get_real, observer_in.set_real
+    vrs_out, vrs_in, count, values = measured.vrs, observer_in.vrs, measured.count, measured.values
+    t_c, h_c = c_double(t0), c_double(h)
     gauss_seidel = ordering == "gauss-seidel"
     next_record, row = recorded[1] if len(recorded) > 1 else -1, 1
     for k in range(steps):
-        t = t0 + k * h
-        if not gauss_seidel and get_measured() | send_measured(values) > 1:
+        t_c.value = t = t0 + k * h
+        if (
+            not gauss_seidel
+            and (
+                get_sensors(plant_c, vrs_out, count, values)
+                | sensors_in(observer_c, vrs_in, count, values)
+            )
+            > 1
+        ):
             _check(2, plant, "passing the sensors on", t)
         i_value[0] = currents[k]
-        if set_i(plant_c, i_vr, 1, i_value) > 1 or plant_step(plant_c, t, h, 1) > 1:
+        if set_i(plant_c, i_vr, one, i_value) > 1 or plant_step(plant_c, t_c, h_c, 1) > 1:
             _check(2, plant, "stepping", t)
-        if gauss_seidel and get_measured() | send_measured(values) > 1:
+        if (
+            gauss_seidel
+            and (
+                get_sensors(plant_c, vrs_out, count, values)
+                | sensors_in(observer_c, vrs_in, count, values)
+            )
+            > 1
+        ):
             _check(2, plant, "passing the sensors on", t)
-        if observer_step(observer_c, t, h, 1) > 1:
+        if observer_step(observer_c, t_c, h_c, 1) > 1:
             _check(2, observer, "stepping", t)
         if k + 1 == next_record:
             plant_log[row], observer_log[row] = read_plant(), read_observer()

@@ -28,6 +28,7 @@ import json
 import statistics
 import time
 from collections.abc import Callable, Iterator, Sequence
+from ctypes import c_double
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -107,25 +108,35 @@ def split_loop(duration: float) -> dict[str, float]:
         obs.initialize(OBSERVER_SETTINGS)
         estimates = obs.real_port(["tau_reac_hat", "theta_hat[1]", "theta_hat[2]", "theta_hat[3]"])
         i_port = plant.real_port(["i_ref"])
-        plant_step = plant.slave._functions["fmi2DoStep"]
-        observer_step = obs.slave._functions["fmi2DoStep"]
-        pc, oc = plant.slave.component, obs.slave.component
+        set_i, i_vr, i_value, one = i_port.set_real, i_port.vrs, i_port.values, i_port.count
+        plant_step, pc = plant.step_call()
+        observer_step, oc = obs.step_call()
+        get_sensors, sensors_in = measured.get_real, observer_in.set_real
+        vrs_out, vrs_in, values = measured.vrs, observer_in.vrs, measured.values
+        count = measured.count
+        get_estimates, vrs_est, n_est, est = (
+            estimates.get_real,
+            estimates.vrs,
+            estimates.count,
+            estimates.values,
+        )
+        t_c, h_c = c_double(0.0), c_double(H)
         totals = [0] * 6
-        for k, i_ref in enumerate(current):
-            t = k * H
+        for k, i_ref in enumerate(current):  # the calls of cosimulate's loop, timed apart
+            t_c.value = k * H
             t0 = clock()
-            i_port.values[0] = i_ref
-            i_port.send()
+            i_value[0] = i_ref
+            set_i(pc, i_vr, one, i_value)
             t1 = clock()
-            plant_step(pc, t, H, 1)
+            plant_step(pc, t_c, h_c, 1)
             t2 = clock()
-            measured.get()
+            get_sensors(pc, vrs_out, count, values)
             t3 = clock()
-            observer_in.send(measured.values)
+            sensors_in(oc, vrs_in, count, values)
             t4 = clock()
-            observer_step(oc, t, H, 1)
+            observer_step(oc, t_c, h_c, 1)
             t5 = clock()
-            estimates.get()
+            get_estimates(oc, vrs_est, n_est, est)
             t6 = clock()
             for j, (a, b) in enumerate(
                 ((t0, t1), (t1, t2), (t2, t3), (t3, t4), (t4, t5), (t5, t6))

@@ -15,7 +15,7 @@ from fmpy.validation import validate_fmu
 from scipy.signal import lfilter
 
 from cosim.excitation import multisine, rigid_maneuver
-from cosim.instance import FmuInstance
+from cosim.instance import FmuInstance, RealPort
 from cosim.master import cosimulate
 from tests.fmu_checks import step_from_resources
 
@@ -266,3 +266,33 @@ def test_same_fmu_instantiates_again_and_again_in_one_process(fmus) -> None:
         [sys.executable, "-c", script, str(fmus[1])], capture_output=True, text=True
     )
     assert result.returncode == 0, result.stderr
+
+
+def test_per_step_set_and_get_fast_paths_agree_with_the_checked_ones(fmus) -> None:
+    """A master's per-step calls (all inputs in one set, the same outputs read every
+    step) take short paths in the FMU; they must read fresh values and still refuse
+    what the checked paths refuse."""
+    _, observer_fmu = fmus
+    with FmuInstance(observer_fmu, "observer") as o:
+        block = o.real_port(["i_a", "omega_m", "theta_m"])  # every input, in order
+        some = o.real_port(["theta_m", "i_a"])  # a subset, out of order
+        block.values[:] = [0.1, 2.0, 0.3]
+        assert block.send() == 0
+        some.values[:] = [0.5, 0.2]
+        assert some.send() == 0
+        assert o.get(["i_a", "omega_m", "theta_m"]) == [0.2, 2.0, 0.5]
+        o.initialize({"mode": 2})
+        estimates = o.real_port(["tau_reac_hat", "theta_hat[1]"])
+        seen = []
+        for k in range(3):
+            block.values[:] = [0.1, 2.0 + k, 0.3 + 0.002 * (k + 1)]
+            assert block.send() == 0 and o.do_step(k * 1e-3, 1e-3) == 0, o.messages
+            assert estimates.get() == 0
+            seen.append(list(estimates.values))
+        assert seen[0] != seen[1] != seen[2]  # the repeated read is not a stale copy
+        mixed = [o.variables[n].valueReference for n in ("tau_reac_hat", "id_valid")]
+        RealPort(o.slave, mixed).get()  # a Boolean among Reals: logged
+        assert "not all Real" in o.messages[-1]
+        assert o.real_port(["i_a", "tau_reac_hat"]).send() == 0  # an output among inputs
+        assert "is an output and cannot be set" in o.messages[-1]
+        assert estimates.get() == 0 and list(estimates.values) == seen[2]

@@ -131,6 +131,13 @@ class FmuSlave(Fmi2Slave):
         # the hot path: Real inputs as one tuple, and the Reals settable without a word
         self._read_inputs = _tuple_getter(self._real_inputs)
         self._inputs = frozenset(self._real_inputs)
+        self._reals = self._vrs_of_type["Real"]
+        lo, hi = (self._real_inputs[0], self._real_inputs[-1] + 1) if self._real_inputs else (0, 0)
+        # every Real input at once, when they are declared together: set as one slice
+        self._input_block = self._real_inputs if self._real_inputs == list(range(lo, hi)) else None
+        self._input_slice = slice(lo, hi)
+        self._last_read: list[int] = []  # the last Reals read, and their getter
+        self._read_last = _tuple_getter([])
         self.time: float | None = None
         self.stale = False
         self.lazy: frozenset[int] = frozenset()
@@ -303,6 +310,12 @@ class FmuSlave(Fmi2Slave):
     # -- value access (called by pythonfmu's binary) -------------------------------
 
     def get_real(self, vrs: Sequence[int]) -> list[float]:
+        if not self.stale:  # the per-step read of a master, inline
+            if vrs == self._last_read:
+                return list(self._read_last(self.v))
+            if self._reals.issuperset(vrs):
+                self._last_read, self._read_last = list(vrs), _tuple_getter(vrs)
+                return list(self._read_last(self.v))
         return self._get(vrs, "Real", float)
 
     def get_integer(self, vrs: Sequence[int]) -> list[int]:
@@ -315,12 +328,14 @@ class FmuSlave(Fmi2Slave):
         return self._get(vrs, "String", str)
 
     def set_real(self, vrs: Sequence[int], values: Sequence[float]) -> None:
-        if self._inputs.issuperset(vrs):  # inputs: always settable, already floats
+        if vrs == self._input_block:  # the per-step write of every input, in order
+            self.v[self._input_slice] = values
+        elif self._inputs.issuperset(vrs):  # inputs: always settable, already floats
             v = self.v
             for i, x in zip(vrs, values):
                 v[i] = x
-            return
-        self._set(vrs, values, "Real", float)
+        else:
+            self._set(vrs, values, "Real", float)
 
     def set_integer(self, vrs: Sequence[int], values: Sequence[int]) -> None:
         self._set(vrs, values, "Integer", int)
