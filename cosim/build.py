@@ -11,6 +11,7 @@ the algorithms) into ``resources/``; they need nothing at run time but a Python 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import importlib
 import sys
 import tempfile
@@ -143,14 +144,47 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
     check_masses(n)
     target = out if out is not None else default_out_dir(n)
     built = [build_fmu(recipe, n, target) for recipe in RECIPES]
-    return [*built, write_ssp(target / "ActionReaction.ssp", target)]
+    built.append(write_ssp(target / "ActionReaction.ssp", target))
+    (target / DIGEST_FILE).write_text(source_digest(n) + "\n", encoding="utf-8")
+    return built
+
+
+#: Written beside the FMUs: the digest of the sources they were built from.
+DIGEST_FILE = ".source-digest"
+
+
+def source_digest(n: int) -> str:
+    """SHA-256 of everything the FMUs for n masses are built from: the bundled
+    packages, the plant's C and Python sources, and the build code itself."""
+    digest = hashlib.sha256(f"{__version__} n={n}".encode())
+    folders = {_package_dir(p) for r in RECIPES for p in r.packages}
+    folders |= {_package_dir("motorchain"), _package_dir("motorchain").parent / "motorchain_c"}
+    files = sorted(
+        f for folder in folders for f in folder.rglob("*") if f.suffix in {".py", ".c", ".h"}
+    )
+    files += [
+        Path(__file__),
+        Path(__file__).with_name("cplant.py"),
+        Path(__file__).with_name("ssp.py"),
+    ]
+    for f in files:
+        digest.update(f.name.encode())
+        digest.update(f.read_bytes())
+    return digest.hexdigest()
 
 
 def ensure_built(n: int = 3, out: Path | None = None) -> Path:
-    """Folder holding the FMUs for n masses, building them first if any is missing."""
+    """Folder holding the FMUs for n masses, building them first if any is missing or
+    was built from other sources than the current ones (no stale FMU is ever run)."""
     target = out if out is not None else default_out_dir(n)
     wanted = [target / f"{r.name}.fmu" for r in RECIPES] + [target / "ActionReaction.ssp"]
-    if not all(path.is_file() for path in wanted):
+    stamp = target / DIGEST_FILE
+    current = (
+        all(path.is_file() for path in wanted)
+        and stamp.is_file()
+        and stamp.read_text(encoding="utf-8").strip() == source_digest(n)
+    )
+    if not current:
         build_all(n, target)
     return target
 

@@ -62,3 +62,21 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     mean_row = next(line for line in result.stdout.splitlines() if line.strip().startswith("mean"))
     k_error = float(mean_row.split()[2])  # "k err" column, in %
     assert abs(k_error) < 3.0  # measured −0.92 % with realistic sensors
+
+
+def test_fmus_built_from_other_sources_are_rebuilt_not_run(build_fmus, tmp_path: Path) -> None:
+    """A stale dist/ (sources edited since the build) must never be simulated."""
+    import shutil
+
+    from cosim.build import DIGEST_FILE, ensure_built, source_digest
+
+    folder = tmp_path / "n1"
+    shutil.copytree(build_fmus(1), folder)
+    assert (folder / DIGEST_FILE).read_text().strip() == source_digest(1)
+    plant = folder / "MotorChainPlant.fmu"
+    before = plant.stat().st_mtime_ns
+    assert ensure_built(1, folder) == folder and plant.stat().st_mtime_ns == before  # current
+    (folder / DIGEST_FILE).write_text("built from older sources\n")
+    ensure_built(1, folder)
+    assert plant.stat().st_mtime_ns != before
+    assert (folder / DIGEST_FILE).read_text().strip() == source_digest(1)

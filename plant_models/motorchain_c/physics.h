@@ -14,7 +14,7 @@
 #define PH_SIZE (2 * N_MASSES + 5) /* state length */
 #define PH_INPUTS (N_MASSES + 2)   /* i_ref, τ_fric, τ_ext,1 … τ_ext,n */
 #define PH_CACHE 16                /* discretized matrices kept, by (step, regime) */
-#define PH_LADDER 32               /* binary digits of a sub-step: resolution h / 2^32 */
+#define PH_LADDER 20               /* binary digits of a sub-step: resolution h / 2^20 */
 
 typedef struct {
     double k_t, f_c, k1, B1;
