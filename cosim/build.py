@@ -11,6 +11,7 @@ the algorithms) into ``resources/``; they need nothing at run time but a Python 
 from __future__ import annotations
 
 import argparse
+import functools
 import hashlib
 import importlib
 import sys
@@ -153,9 +154,13 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
 DIGEST_FILE = ".source-digest"
 
 
+@functools.cache
 def source_digest(n: int) -> str:
     """SHA-256 of everything the FMUs for n masses are built from: the bundled
-    packages, the plant's C and Python sources, and the build code itself."""
+    packages, the plant's C and Python sources, and the build code itself.
+
+    Computed once per process (a process runs one version of the sources; the
+    accuracy benchmark asks for its FMUs a hundred times)."""
     digest = hashlib.sha256(f"{__version__} n={n}".encode())
     folders = {_package_dir(p) for r in RECIPES for p in r.packages}
     folders |= {_package_dir("motorchain"), _package_dir("motorchain").parent / "motorchain_c"}
