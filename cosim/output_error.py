@@ -292,36 +292,109 @@ def clamped_frequencies(J: Sequence[float], k: Sequence[float]) -> np.ndarray:
     return np.sqrt(np.sort(np.linalg.eigvals(K / np.asarray(J)[:, None]).real))
 
 
-def resonance_peaks(record: MotorRecord, count: int, band: tuple[float, float]) -> np.ndarray:
-    """Frequencies (rad/s) of the ``count`` strongest peaks of ``|τ̂ / θ_m|``.
+#: Length (s) of the record's opening the start scan runs on: the cost's basin around the
+#: truth narrows as the record grows (a mode's phase error grows as δω·t), so the scan
+#: and the first fit use a short opening and :func:`continued_fit` lengthens it.
+SCAN_SECONDS = 2.5
+#: Damping ratio of the first clamped mode for the scan's chains.
+SCAN_ZETA = 1e-3
 
-    The driving-point response of the load chain (motor angle in, reaction torque
-    out) peaks at the chain's natural frequencies with the motor held still. Welch
-    estimate (Hann windows of a quarter of the record), peaks refined by a parabola
-    through the log-magnitude. Returns no peak for a record without torque or motion.
+
+def opening(record: MotorRecord, seconds: float) -> MotorRecord:
+    """The first ``seconds`` of ``record`` (the whole record if it is shorter)."""
+    count = min(len(record.theta_m), round(seconds / record.h) + 1)
+    return MotorRecord(
+        record.h,
+        record.theta_m[:count],
+        record.tau_hat[:count],
+        record.g_dist,
+        record.velocity_source,
+    )
+
+
+def check_excited(record: MotorRecord) -> None:
+    """Refuse a record whose motor never moved or whose reaction torque never changed.
+
+    Raises:
+        UserError: naming what is missing and what to do.
     """
-    fs = 1.0 / record.h
-    nper = min(len(record.theta_m), max(256, len(record.theta_m) // 4))
-    f, s_uy = signal.csd(record.theta_m, record.tau_hat, fs=fs, nperseg=nper, detrend="linear")
-    _, s_uu = signal.welch(record.theta_m, fs=fs, nperseg=nper, detrend="linear")
-    w = 2 * np.pi * f
-    mag = np.log(np.abs(s_uy) / np.maximum(s_uu, 1e-300) + 1e-300)
-    inside = (w >= band[0]) & (w <= band[1])
     if not np.any(record.tau_hat) or np.ptp(record.theta_m) == 0.0:
-        return np.array([])
-    peaks, props = signal.find_peaks(np.where(inside, mag, -np.inf), prominence=0.5)
-    if peaks.size == 0:
-        return np.array([])
-    order = np.argsort(props["prominences"])[::-1][:count]
-    found = []
-    for p in peaks[order]:
-        if 0 < p < len(mag) - 1:
-            y0, y1, y2 = mag[p - 1 : p + 2]
-            shift = 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2) if (y0 - 2 * y1 + y2) != 0 else 0.0
-            found.append(w[p] + shift * (w[1] - w[0]))
-        else:
-            found.append(w[p])
-    return np.sort(np.array(found))
+        raise UserError(
+            "the log shows no resonance of the chain (its reaction torque or motor angle "
+            "never changes): excite it (a multi-sine or chirp across the modes, see "
+            "`arcosim simulate --scenario flexible`) or give a start with --start-k"
+        )
+
+
+def scan_first_mode(
+    record: MotorRecord,
+    chain_at: Callable[[float], tuple[list[float], list[float], list[float]]],
+    free_scale: bool,
+    count: int = 100,
+) -> tuple[float, float, str]:
+    """Pick the chain whose first clamped mode best explains the record's opening.
+
+    ``chain_at(w1)`` gives the chain whose first clamped mode is ``w1`` (rad/s); ``w1``
+    runs over ``count`` log-spaced values from 2 rad/s to 0.3/h (the band G(s) and the
+    sample rate leave). With ``free_scale`` the prediction is also scaled by the
+    least-squares factor ``s ≥ 0`` (a common scale on J, k and B scales the torque):
+    how the whole-chain fit learns the inertias' size.
+
+    Returns:
+        ``(w1, s, note)``: the best first mode (rad/s), the scale (1 without
+        ``free_scale``) and a line for the report.
+    """
+    check_excited(record)
+    short = opening(record, SCAN_SECONDS)
+    data = short.tau_hat
+    best = (np.inf, 0.0, 1.0)
+    for w1 in np.geomspace(2.0, 0.3 / record.h, count):
+        model = predict(short, *chain_at(float(w1)))
+        scale = 1.0
+        if free_scale:
+            power = float(model @ model)
+            scale = max(float(model @ data) / power, 0.0) if power > 0.0 else 0.0
+        cost = float(np.sum((data - scale * model) ** 2))
+        if cost < best[0]:
+            best = (cost, float(w1), scale)
+    _, w1, scale = best
+    if scale == 0.0:
+        raise UserError("the log's reaction torque is not explained by any chain: check its sign")
+    note = (
+        f"scan of the cost over the first clamped mode (2 … {0.3 / record.h:.0f} rad/s) on "
+        f"the first {short.duration:g} s: {w1:.4g} rad/s"
+    )
+    return w1, scale, note
+
+
+def continued_fit(
+    record: MotorRecord,
+    names: Sequence[str],
+    start: np.ndarray,
+    model: Callable[[np.ndarray], tuple[list[float], list[float], list[float]]],
+    start_note: str,
+    lower: Callable[[np.ndarray], np.ndarray],
+) -> Fit:
+    """:func:`fit` on the record's opening of :data:`SCAN_SECONDS`, then on openings
+    twice as long, each starting from the last, up to the whole record.
+
+    A lightly damped chain's cost has local minima spaced by about π / T in each mode's
+    frequency (T the record length), so a start good enough for a short record may not
+    be for a long one; the short fit moves it into the long record's basin.
+    ``lower(start)`` gives each stage's lower bounds. Damping-like parameters that
+    reached 0 restart the next stage from 1e-3 of their first start.
+    """
+    first = start = np.asarray(start, dtype=float)
+    floor = 1e-3 * start
+    seconds = SCAN_SECONDS
+    while True:
+        part = opening(record, seconds)
+        result = fit(part, names, start, model, start_note, lower(start))
+        if part.duration >= record.duration:
+            result.start = first
+            return result
+        start = np.maximum(result.values, floor)
+        seconds *= 2.0
 
 
 def uniform_chain(
@@ -329,64 +402,48 @@ def uniform_chain(
     J: Sequence[float],
     fit_inertia_scale: bool = False,
     k_start: float | None = None,
-    zeta_start: float = 1e-3,
+    zeta_start: float = SCAN_ZETA,
 ) -> Fit:
     """Fit the paper's uniform chain: common k and B (and a common scale on the J_i).
 
-    Start: ``k_start`` if given, else from the lowest resonance of the data (the
-    first clamped mode of a uniform chain scales as √k), refined by a scan of the cost
-    over k from 0.3 to 3 times that (the cost has local minima); B from
-    ``zeta_start`` on the first mode.
+    Start: ``k_start`` if given, else :func:`scan_first_mode` (the first clamped mode
+    of a uniform chain scales as √k); B from ``zeta_start`` on the first mode. The fit
+    then runs on longer and longer openings of the record (:func:`continued_fit`).
 
     Raises:
-        UserError: when the data show no resonance and no ``k_start`` is given.
+        UserError: when the record shows no motion or no reaction torque.
     """
     J = [float(x) for x in J]
-    unit = clamped_frequencies(J, [1.0] * len(J))  # frequencies at k = 1
+    n = len(J)
+    unit = float(clamped_frequencies(J, [1.0] * n)[0])  # first mode at k = 1
+
+    def chain_at(w1: float) -> tuple[list[float], list[float], list[float]]:
+        k = (w1 / unit) ** 2
+        return J, [k] * n, [2.0 * zeta_start * k / w1] * n
+
     if k_start is None:
-        peaks = resonance_peaks(record, len(J), (0.5 * np.pi / record.duration, 0.3 / record.h))
-        if peaks.size == 0:
-            raise UserError(
-                "the log shows no resonance of the chain: excite it (a multi-sine or chirp "
-                "across the modes, see `arcosim simulate --scenario flexible`) or give a start "
-                "with --start-k"
-            )
-        k_peak = (peaks[0] / unit[0]) ** 2
-        scan = k_peak * np.geomspace(0.3, 3.0, 41)
-        costs = [
-            float(
-                np.sum(
-                    (
-                        predict(record, J, [kk] * len(J), [_damping(kk, J, zeta_start)] * len(J))
-                        - record.tau_hat
-                    )
-                    ** 2
-                )
-            )
-            for kk in scan
-        ]
-        k0 = float(scan[int(np.argmin(costs))])
-        note = (
-            f"resonance at {peaks[0]:.3g} rad/s (k = {k_peak:.4g} N.m/rad), refined by a "
-            f"scan of the cost: k = {k0:.4g} N.m/rad"
-        )
+        w1, _, note = scan_first_mode(record, chain_at, free_scale=False)
+        k0 = (w1 / unit) ** 2
+        note += f" (k = {k0:.4g} N.m/rad)"
     else:
+        check_excited(record)
         k0, note = float(k_start), f"given: k = {k_start:.4g} N.m/rad"
     B0 = _damping(k0, J, zeta_start)
     names = ["k", "B"]
     start = [k0, B0]
-    lower = [1e-3 * k0, 0.0]
     if fit_inertia_scale:
         names.append("J_scale")
         start.append(1.0)
-        lower.append(1e-2)
 
     def model(p: np.ndarray) -> tuple[list[float], list[float], list[float]]:
         scale = p[2] if fit_inertia_scale else 1.0
-        n = len(J)
         return [scale * x for x in J], [p[0]] * n, [p[1]] * n
 
-    return fit(record, names, np.array(start), model, note, np.array(lower))
+    def lower(p: np.ndarray) -> np.ndarray:
+        bounds = [1e-3 * p[0], 0.0]
+        return np.array(bounds + ([1e-2] if fit_inertia_scale else []))
+
+    return continued_fit(record, names, np.array(start), model, note, lower)
 
 
 def _damping(k: float, J: Sequence[float], zeta: float) -> float:

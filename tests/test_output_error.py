@@ -47,7 +47,7 @@ def test_fit_recovers_k_and_b_with_an_honest_standard_error() -> None:
     assert k == pytest.approx(bench.K, rel=1e-3)
     assert abs(B - bench.B) <= 3 * fit.std[1]
     assert fit.std[0] > 0 and fit.std[1] > 0
-    assert "resonance" in fit.start_note
+    assert "scan of the cost" in fit.start_note
 
 
 def test_noise_free_fit_is_exact() -> None:
