@@ -166,7 +166,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--start-k",
         type=float,
-        help="output-error: start from this stiffness (N.m/rad) instead of the resonance",
+        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan",
     )
     p.set_defaults(execute=_execute)
 

@@ -381,8 +381,9 @@ def continued_fit(
     A lightly damped chain's cost has local minima spaced by about π / T in each mode's
     frequency (T the record length), so a start good enough for a short record may not
     be for a long one; the short fit moves it into the long record's basin.
-    ``lower(start)`` gives each stage's lower bounds. Damping-like parameters that
-    reached 0 restart the next stage from 1e-3 of their first start.
+    ``lower(start)`` gives each stage's lower bounds. A parameter that fell below a
+    thousandth of its first start (a damping at its bound 0) restarts the next stage
+    from there (the fit's start must be > 0).
     """
     first = start = np.asarray(start, dtype=float)
     floor = 1e-3 * start
