@@ -27,6 +27,7 @@ within 10 %.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import time
@@ -39,7 +40,7 @@ import numpy as np
 from cosim import excitation
 from cosim.errors import UserError
 from cosim.metrics import flexible_score, percent_error
-from cosim.output_error import MotorRecord, motor_record, uniform_chain
+from cosim.output_error import Fit, MotorRecord, motor_record, uniform_chain
 from cosim.scenarios import Scenario, run_scenario
 from flexchain import bench
 from flexchain.chain import spring_matrix
@@ -65,6 +66,8 @@ BROADBAND_DURATION = 10.0
 #: B̂ by +56 % (rows "weak excitation").
 BROADBAND_AMPLITUDE = 1.0
 WEAK_AMPLITUDE = 0.48
+#: Suffix of the method names scored on the weak excitation.
+WEAK = f", weak excitation ({WEAK_AMPLITUDE:g} A)"
 #: Record lengths (s) for the B-versus-record-length rows (bench).
 RECORD_LENGTHS = (2.5, 5.0, 10.0, 20.0)
 
@@ -217,6 +220,20 @@ def fit_broadband(case: Case, log: dict[str, np.ndarray]) -> tuple[MotorRecord, 
     return record, uniform_chain(record, case.J)
 
 
+@functools.cache
+def broadband_fit(
+    case: Case,
+    seed: int,
+    duration: float = BROADBAND_DURATION,
+    amplitude: float = BROADBAND_AMPLITUDE,
+) -> tuple[dict[str, np.ndarray], Fit]:
+    """:func:`broadband` and its uniform output-error fit, once per argument set: the
+    table, B's check and the record lengths share the bench's runs (seeds 1 … 5 at
+    10 s would otherwise be simulated and fitted up to three times). Read-only."""
+    log = broadband(case, seed, duration, amplitude)
+    return log, fit_broadband(case, log)[1]
+
+
 def score_case(case: Case, seeds: Sequence[int], progress: Callable[[str], None]) -> CaseResult:
     """Every method on one case, over ``seeds``."""
     result = CaseResult()
@@ -230,24 +247,19 @@ def score_case(case: Case, seeds: Sequence[int], progress: Callable[[str], None]
             result.add(result.k_error, method, percent_error(ident.identifier.k, k_true))
             result.add(result.B_error, method, percent_error(ident.identifier.B, B_true))
         progress(f"{case.name}: seed {seed}, broadband")
-        score_broadband(case, broadband(case, seed), result, "")
+        score_broadband(case, *broadband_fit(case, seed), result, "")
         if case is CASES[0]:
             progress(f"{case.name}: seed {seed}, weak broadband")
-            weak = broadband(case, seed, amplitude=WEAK_AMPLITUDE)
-            score_broadband(case, weak, result, WEAK)
+            weak = broadband_fit(case, seed, BROADBAND_DURATION, WEAK_AMPLITUDE)
+            score_broadband(case, *weak, result, WEAK)
     return result
 
 
-#: Suffix of the method names scored on the weak excitation.
-WEAK = f", weak excitation ({WEAK_AMPLITUDE:g} A)"
-
-
 def score_broadband(
-    case: Case, log: dict[str, np.ndarray], result: CaseResult, suffix: str
+    case: Case, log: dict[str, np.ndarray], oe: Fit, result: CaseResult, suffix: str
 ) -> None:
-    """Output error, then the state estimators with its k̂, B̂, on one broadband log;
-    method names get ``suffix``."""
-    _, oe = fit_broadband(case, log)
+    """Output error (``oe``, fitted on ``log``), then the state estimators with its
+    k̂, B̂, on one broadband log; method names get ``suffix``."""
     k_hat, B_hat = oe.values[0], oe.values[1]
     method = "output error" + suffix
     result.add(result.k_error, method, percent_error(k_hat, float(np.mean(case.k))))
@@ -270,7 +282,7 @@ def b_honesty(seeds: Sequence[int], progress: Callable[[str], None]) -> dict[str
     inside, sigmas, errors = 0, [], []
     for seed in seeds:
         progress(f"B's standard error: seed {seed}")
-        _, oe = fit_broadband(case, broadband(case, seed))
+        _, oe = broadband_fit(case, seed)
         inside += abs(oe.values[1] - bench.B) <= 2 * oe.std[1]
         sigmas.append(100 * oe.std[1] / bench.B)
         errors.append(percent_error(oe.values[1], bench.B))
@@ -291,7 +303,7 @@ def record_lengths(
         errors, sigmas = [], []
         for seed in seeds:
             progress(f"bench broadband record of {duration:g} s, seed {seed}")
-            _, oe = fit_broadband(CASES[0], broadband(CASES[0], seed, duration))
+            _, oe = broadband_fit(CASES[0], seed, duration)
             errors.append(percent_error(oe.values[1], bench.B))
             sigmas.append(100 * oe.std[1] / bench.B)
         rows.append({"duration_s": duration, "B_error_percent": errors, "B_std_percent": sigmas})
@@ -394,6 +406,7 @@ def run(
             if shortest is not None
             else "\nB not within 10 % on any record length tried.\n"
         )
+    broadband_fit.cache_clear()
     summary["seconds"] = time.perf_counter() - started
     out.mkdir(parents=True, exist_ok=True)
     (out / "accuracy.md").write_text(text, encoding="utf-8")
