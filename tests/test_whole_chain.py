@@ -1,31 +1,52 @@
-"""Whole-chain identification (cosim/whole_chain.py): every J_i, k_i, B_i from the
-motor side alone."""
+"""Whole-chain identification (cosim/whole_chain.py, cosim/modal_start.py,
+cosim/chain_modes.py): every J_i, k_i, B_i from the motor side alone."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from cosim.chain_modes import chain_from_modes, driving_point_modes
 from cosim.errors import UserError
 from cosim.output_error import MotorRecord, predict
-from cosim.whole_chain import fit_chain, names, split
+from cosim.whole_chain import fit_chain, identify, names, split
 
 H = 1e-3
 J = (4e-4, 8e-4)
 K = (0.3, 0.2)
 B = (2e-5, 1.5e-5)
+#: The identification excitation's lines (rad/s): 40, log-spaced over 3 … 150.
+LINES = np.geomspace(3.0, 150.0, 40)
 
 
-def record(seconds: float) -> MotorRecord:
+def record(seconds: float, lines: np.ndarray = LINES) -> MotorRecord:
     """A two-mass chain with unequal springs, driven by a broadband motor angle;
     τ̂ = the model's (noise-free)."""
     t = np.arange(round(seconds / H) + 1) * H
     rng = np.random.default_rng(3)
-    theta = sum(
-        0.05 / w * np.sin(w * t + rng.uniform(0, 2 * np.pi)) for w in (3, 7, 13, 17, 30, 41, 60)
-    )
+    theta = sum(0.02 / w * np.sin(w * t + rng.uniform(0, 2 * np.pi)) for w in lines)
     clean = MotorRecord(H, theta, np.zeros_like(t), 100.0)
     return MotorRecord(H, theta, predict(clean, J, K, B), 100.0)
+
+
+def test_a_chain_is_rebuilt_from_its_clamped_modes_and_residues() -> None:
+    """Five unequal masses and springs → (p_i, r_i) → the same chain (Lanczos)."""
+    inertias = (2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4)
+    springs = (0.4, 0.3, 0.5, 0.35, 0.45)
+    p, r = driving_point_modes(inertias, springs)
+    rebuilt_J, rebuilt_k = chain_from_modes(p, r)
+    np.testing.assert_allclose(rebuilt_J, inertias, rtol=1e-9)
+    np.testing.assert_allclose(rebuilt_k, springs, rtol=1e-9)
+    # the static torque of a free chain is zero: k_1 = Σ r_i / p_i²
+    assert np.sum(r / p**2) == pytest.approx(springs[0], rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "p, r", [((10.0, 10.0), (1.0, 1.0)), ((10.0, 20.0), (1.0, 0.0)), ((-1.0,), (1.0,))]
+)
+def test_modes_no_chain_has_are_refused(p: tuple, r: tuple) -> None:
+    with pytest.raises(ValueError):
+        chain_from_modes(p, r)
 
 
 def test_every_inertia_stiffness_and_damping_of_an_unequal_chain_is_recovered() -> None:
@@ -36,8 +57,32 @@ def test_every_inertia_stiffness_and_damping_of_an_unequal_chain_is_recovered() 
     np.testing.assert_allclose(fitted_J, J, rtol=1e-4)
     np.testing.assert_allclose(fitted_k, K, rtol=1e-4)
     np.testing.assert_allclose(fitted_B, B, rtol=1e-2)
-    assert "uniform chain" in result.start_note
-    assert set(result.extra["uniform"]) == {"J", "k", "B"}
+    # the start already holds the modes: the chain's clamped frequencies within 1 %
+    np.testing.assert_allclose(result.extra["modes_rad_s"], driving_point_modes(J, K)[0], rtol=1e-2)
+    assert "subspace" in result.start_note
+
+
+def test_auto_reads_the_number_of_masses_from_the_record() -> None:
+    choice = identify(record(10.0), "auto")
+    assert choice.n == 2 and choice.seen == 2
+    assert set(choice.criterion) | set(choice.refused) == {1, 2, 3}
+    assert "3 masses has 3" in choice.refused[3]
+    assert all(choice.criterion[2] <= c for c in choice.criterion.values())
+
+
+def test_a_record_that_cannot_determine_the_chain_is_refused_with_what_to_do() -> None:
+    """τ̂ unrelated to the motor's motion. (A single sine is not such a record: its
+    start rings the modes, and with ζ ≈ 1e-3 the ringing determines the chain.)"""
+    good = record(10.0)
+    noise = np.random.default_rng(1).normal(0.0, 1e-3, len(good.theta_m))
+    with pytest.raises(UserError, match=r"lightly damped mode|carry no reaction torque"):
+        fit_chain(MotorRecord(H, good.theta_m, noise, 100.0), 2)
+
+
+@pytest.mark.parametrize("masses", ["0", "two", "-1", "2.5"])
+def test_a_bad_number_of_masses_is_refused(masses: str) -> None:
+    with pytest.raises(UserError, match="masses"):
+        identify(record(3.0), masses)
 
 
 def test_a_chain_without_masses_is_refused() -> None:
