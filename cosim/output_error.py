@@ -11,7 +11,8 @@ Two parameterizations share one fit (:func:`fit`):
 
 * the paper's uniform chain: k and B common to every spring, J_i known (optionally a
   common scale on the J_i) — :func:`uniform_chain`;
-* the whole chain: every J_i, k_i, B_i (``cosim/whole_chain.py``).
+* the whole chain: every J_i, k_i, B_i (``cosim/whole_chain.py``, started from the
+  record's modes, ``cosim/modal_start.py``).
 
 Standard errors come from a Newey–West (Bartlett) long-run covariance of the score
 ``J_t r_t``: the residuals are low-passed by G(s) and coloured by the chain, so the
@@ -329,42 +330,31 @@ def check_excited(record: MotorRecord) -> None:
 def scan_first_mode(
     record: MotorRecord,
     chain_at: Callable[[float], tuple[list[float], list[float], list[float]]],
-    free_scale: bool,
     count: int = 100,
-) -> tuple[float, float, str]:
+) -> tuple[float, str]:
     """Pick the chain whose first clamped mode best explains the record's opening.
 
     ``chain_at(w1)`` gives the chain whose first clamped mode is ``w1`` (rad/s); ``w1``
     runs over ``count`` log-spaced values from 2 rad/s to 0.3/h (the band G(s) and the
-    sample rate leave). With ``free_scale`` the prediction is also scaled by the
-    least-squares factor ``s ≥ 0`` (a common scale on J, k and B scales the torque):
-    how the whole-chain fit learns the inertias' size.
+    sample rate leave).
 
     Returns:
-        ``(w1, s, note)``: the best first mode (rad/s), the scale (1 without
-        ``free_scale``) and a line for the report.
+        ``(w1, note)``: the best first mode (rad/s) and a line for the report.
     """
     check_excited(record)
     short = opening(record, SCAN_SECONDS)
     data = short.tau_hat
-    best = (np.inf, 0.0, 1.0)
+    best = (np.inf, 0.0)
     for w1 in np.geomspace(2.0, 0.3 / record.h, count):
-        model = predict(short, *chain_at(float(w1)))
-        scale = 1.0
-        if free_scale:
-            power = float(model @ model)
-            scale = max(float(model @ data) / power, 0.0) if power > 0.0 else 0.0
-        cost = float(np.sum((data - scale * model) ** 2))
+        cost = float(np.sum((data - predict(short, *chain_at(float(w1)))) ** 2))
         if cost < best[0]:
-            best = (cost, float(w1), scale)
-    _, w1, scale = best
-    if scale == 0.0:
-        raise UserError("the log's reaction torque is not explained by any chain: check its sign")
+            best = (cost, float(w1))
+    w1 = best[1]
     note = (
         f"scan of the cost over the first clamped mode (2 … {0.3 / record.h:.0f} rad/s) on "
         f"the first {short.duration:g} s: {w1:.4g} rad/s"
     )
-    return w1, scale, note
+    return w1, note
 
 
 def continued_fit(
@@ -423,7 +413,7 @@ def uniform_chain(
         return J, [k] * n, [2.0 * zeta_start * k / w1] * n
 
     if k_start is None:
-        w1, _, note = scan_first_mode(record, chain_at, free_scale=False)
+        w1, note = scan_first_mode(record, chain_at)
         k0 = (w1 / unit) ** 2
         note += f" (k = {k0:.4g} N.m/rad)"
     else:
