@@ -4,8 +4,8 @@ Contract (scripts rely on it)::
 
     arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
                              [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
-                             [--method observer|output-error] [--fit-inertia-scale]
-                             [--start-k K]
+                             [--method observer|output-error|whole-chain]
+                             [--fit-inertia-scale] [--start-k K]
 
 * the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
@@ -21,6 +21,14 @@ Contract (scripts rely on it)::
   what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
   standard errors under ``std``, and the evidence (start, residual, velocity used).
   Needs a constant sample step.
+* ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
+  damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
+  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist). ``--masses auto`` reads the number of
+  masses from the record. ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
+  own parameter names: pass them back with ``--set`` in mode 2), their standard errors
+  under ``std``, and the evidence (modes seen, singular values, criterion per n).
+  Needs a constant sample step and an excitation that rings every mode (``arcosim
+  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
 
 A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
 error naming the row or column, and exit status 2.
@@ -42,6 +50,7 @@ from cosim.logs import DriveLog, parse_scales, read_log, write_csv
 from cosim.master import MEASURED, Recording
 from cosim.output_error import Fit, MotorRecord, motor_record, uniform_chain
 from cosim.overrides import check_name, parse_assignment, typed_value
+from cosim.whole_chain import identify as identify_chain
 from flexchain.dob import Actuator
 
 
@@ -132,7 +141,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("log", type=Path, help="CSV log with time, i_a, omega_m, theta_m")
-    p.add_argument("--masses", type=int, default=3, help="number of load masses (default 3)")
+    p.add_argument(
+        "--masses",
+        default="3",
+        help="number of load masses (default 3); with --method whole-chain also 'auto'",
+    )
     p.add_argument(
         "--mode", type=int, choices=(0, 1, 2), help="observer mode (default: the FMU's, 2)"
     )
@@ -154,9 +167,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, help="write every output over time to this CSV file")
     p.add_argument(
         "--method",
-        choices=("observer", "output-error"),
+        choices=("observer", "output-error", "whole-chain"),
         default="observer",
-        help="observer: replay the observer FMU (default); output-error: fit k and B offline",
+        help="observer: replay the observer FMU (default); output-error: fit k and B "
+        "offline; whole-chain: fit every J[i], k[i], B[i] offline",
     )
     p.add_argument(
         "--fit-inertia-scale",
@@ -173,7 +187,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
-    n = check_masses(args.masses)
+    if args.method == "whole-chain":
+        masses = args.masses if args.masses == "auto" else _masses(args.masses)
+        return _whole_chain(args, log, ensure_built(), masses)
+    n = _masses(args.masses)
     folder = ensure_built(n)
     if args.method == "output-error":
         return _output_error(args, log, folder, n)
@@ -244,6 +261,55 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
             print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
         for key in ("start", "velocity", "rms_residual", "rms_data", "newey_west_lag"):
             print(f"  {key}: {report[key]}")
+    return 0
+
+
+def _masses(text: str) -> int:
+    """``--masses`` as a supported number of masses."""
+    try:
+        n = int(text)
+    except ValueError:
+        what = " ('auto' needs --method whole-chain)" if text == "auto" else ""
+        raise UserError(f"--masses {text}: not a whole number{what}") from None
+    return check_masses(n)
+
+
+def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: int | str) -> int:
+    values = known_parameters(folder, args.set)
+    c = log.columns
+    record = motor_record(
+        log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
+    )
+    choice = identify_chain(record, masses)
+    result = choice.fit
+    report: dict[str, object] = {"masses": choice.n, **result.as_dict()}
+    report["std"] = result.std_dict()
+    report.update(evidence(result, record), method="whole-chain")
+    report.update(
+        modes_rad_s=result.extra["modes_rad_s"],
+        damping_ratios=result.extra["damping_ratios"],
+        criterion={str(n): v for n, v in choice.criterion.items()},
+        rms_residual_per_masses={str(n): v for n, v in choice.rms_residual.items()},
+        refused={str(n): why for n, why in choice.refused.items()},
+    )
+    if choice.singular_values is not None:
+        report["masses_seen"] = choice.seen
+        report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
+    if args.json:
+        print(json.dumps(report, indent=2))
+        return 0
+    print(f"{len(log)} samples, whole-chain fit ({choice.n} masses):")
+    for key in result.names:
+        print(f"  {key:6s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
+    for key in ("start", "rms_residual", "rms_data", "criterion", "refused"):
+        print(f"  {key}: {report[key]}")
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.as_dict().items())
+    print(f"observer in mode 2 with this chain: --masses {choice.n} {settings}")
+    if values["D_m"] == 0.0 and values["f_c"] == 0.0:
+        print(
+            "note: the motor's friction is taken as zero (D_m = f_c = 0); give it with "
+            "--set D_m=… --set f_c=… (mode 0 measures it), or the fit may add a mode for it"
+        )
     return 0
 
 

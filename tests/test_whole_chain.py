@@ -3,13 +3,17 @@ cosim/chain_modes.py): every J_i, k_i, B_i from the motor side alone."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 from cosim.chain_modes import chain_from_modes, driving_point_modes
+from cosim.cli import main
 from cosim.errors import UserError
 from cosim.output_error import MotorRecord, predict
 from cosim.whole_chain import fit_chain, identify, names, split
+from flexchain import bench
 
 H = 1e-3
 J = (4e-4, 8e-4)
@@ -88,3 +92,28 @@ def test_a_bad_number_of_masses_is_refused(masses: str) -> None:
 def test_a_chain_without_masses_is_refused() -> None:
     with pytest.raises(UserError, match="at least one load mass"):
         fit_chain(record(3.0), 0)
+
+
+def test_identify_whole_chain_cli_finds_the_bench_from_the_motor_alone(
+    build_fmus, tmp_path, capsys
+) -> None:
+    """The identification scenario, realistic sensors; only the actuator is given."""
+    log = tmp_path / "identification.csv"
+    assert main(["simulate", "--scenario", "identification", "--out", str(log)]) == 0
+    capsys.readouterr()
+    args = ["identify", str(log), "--method", "whole-chain", "--masses", "auto", "--json"]
+    assert main([*args, "--set", "D_m=2e-5", "--set", "f_c=2e-3"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["masses"] == report["masses_seen"] == 3
+    for i in range(3):
+        assert report[f"J[{i + 1}]"] == pytest.approx(bench.J[i], rel=0.02)
+        assert report[f"k[{i + 1}]"] == pytest.approx(bench.K, rel=0.02)
+        assert report["std"][f"B[{i + 1}]"] > 0
+    assert set(report["criterion"]) | set(report["refused"]) == {"2", "3", "4"}
+
+
+def test_masses_auto_needs_the_whole_chain_method(build_fmus, tmp_path, capsys) -> None:
+    log = tmp_path / "log.csv"
+    log.write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0.001,0,0,0\n0.002,0,0,0\n")
+    assert main(["identify", str(log), "--masses", "auto"]) == 2
+    assert "'auto' needs --method whole-chain" in capsys.readouterr().err
