@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from cosim import excitation
-from cosim.accuracy import ACTUATOR, CASES, G_DIST, _run
+from cosim.accuracy import ACTUATOR, CASES, G_DIST, run_case
 from cosim.output_error import MotorRecord, motor_record, uniform_chain
 from cosim.scenarios import Scenario
 from flexchain.excitation import log_spaced
@@ -59,7 +59,7 @@ def record(plant: dict[str, float]) -> dict[str, np.ndarray]:
         def plant_values(self) -> dict[str, float]:
             return {**super().plant_values(), **plant}
 
-    return _run(Overridden(BENCH.name, BENCH.J, BENCH.k, BENCH.B), ONE_WAY, 1)
+    return run_case(Overridden(BENCH.name, BENCH.J, BENCH.k, BENCH.B), ONE_WAY, 1)
 
 
 def fit_errors(log, observer_angle: str, model_angle: str, f_c: float) -> str:
