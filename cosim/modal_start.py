@@ -70,7 +70,7 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     band = min(BAND_PER_G * record.g_dist, 0.3 / record.h)
     u, y, step = _decimated(record, band)
     rows = max(2 * n + 4, min(ROWS, len(u) // 8))
-    if len(u) < 4 * rows or rows < 2 * n + 4:
+    if len(u) < 8 * (2 * n + 4):
         raise UserError(
             f"the record ({record.duration:g} s) is too short to find {n} modes below "
             f"{band:.0f} rad/s; record at least {8 * (2 * n + 4) * step:.1f} s (20 s advised)"

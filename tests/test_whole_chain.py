@@ -83,6 +83,11 @@ def test_a_record_that_cannot_determine_the_chain_is_refused_with_what_to_do() -
         fit_chain(MotorRecord(H, good.theta_m, noise, 100.0), 2)
 
 
+def test_a_record_too_short_for_its_modes_is_refused() -> None:
+    with pytest.raises(UserError, match=r"too short to find 5 modes.*record at least 1\.1 s"):
+        fit_chain(record(1.0), 5)
+
+
 @pytest.mark.parametrize("masses", ["0", "two", "-1", "2.5"])
 def test_a_bad_number_of_masses_is_refused(masses: str) -> None:
     with pytest.raises(UserError, match="masses"):
