@@ -14,7 +14,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from cosim.accuracy import ACTUATOR, CASES, G_DIST, Case, run_case
+from cosim.accuracy import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
+from cosim.encoder_fit import encoder_record
 from cosim.metrics import percent_error
 from cosim.output_error import motor_record
 from cosim.scenarios import SCENARIOS
@@ -43,7 +44,8 @@ def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None
             log["time"], log["i_a"], log["omega_m"], log["theta_m"], ACTUATOR, G_DIST
         )
         started = time.perf_counter()
-        choice = identify(record, "auto")
+        encoder = encoder_record(log["time"], log["i_a"], log["theta_m"], ACTUATOR, ENCODER_CPR)
+        choice = identify(record, "auto", encoder)
         seconds.append(time.perf_counter() - started)
         chosen.append(choice.n)
         if choice.n != case.n:

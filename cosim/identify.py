@@ -23,7 +23,8 @@ Contract (scripts rely on it)::
   Needs a constant sample step.
 * ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
   damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
-  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist). ``--masses auto`` reads the number of
+  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, encoder_cpr: with counts, the fit is refined
+  from the current to the encoder). ``--masses auto`` reads the number of
   masses from the record. ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
   own parameter names: pass them back with ``--set`` in mode 2), their standard errors
   under ``std``, and the evidence (modes seen, singular values, criterion per n).
@@ -44,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from cosim.build import OBSERVER, check_masses, ensure_built, fmu_variables
+from cosim.encoder_fit import encoder_record
 from cosim.errors import UserError
 from cosim.instance import FmuInstance
 from cosim.logs import DriveLog, parse_scales, read_log, write_csv
@@ -280,7 +282,13 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
-    choice = identify_chain(record, masses)
+    cpr = int(values["encoder_cpr"])
+    encoder = (
+        encoder_record(log.time, c["i_a"], c["theta_m"], actuator_of(values), cpr)
+        if cpr > 0
+        else None
+    )
+    choice = identify_chain(record, masses, encoder)
     result = choice.fit
     report: dict[str, object] = {"masses": choice.n, **result.as_dict()}
     report["std"] = result.std_dict()

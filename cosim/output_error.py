@@ -259,11 +259,14 @@ def fit(
 
 
 def newey_west_lag(residual: np.ndarray, record: MotorRecord) -> int:
-    """Bandwidth (samples) for the long-run covariance.
+    """Bandwidth (samples) for the long-run covariance: :func:`decorrelation_lag`
+    with a floor of five time constants of G(s)."""
+    return decorrelation_lag(residual, int(np.ceil(5.0 / (record.g_dist * record.h))))
 
-    Three times the lag where the residual's autocorrelation first falls below 0.1,
-    and at least five time constants of G(s); at most a tenth of the record.
-    """
+
+def decorrelation_lag(residual: np.ndarray, floor: int) -> int:
+    """Three times the lag where the residual's autocorrelation first falls below 0.1,
+    at least ``floor`` and at most a tenth of the record (samples)."""
     r = residual - residual.mean()
     n = len(r)
     spectrum = np.fft.rfft(r, 2 * n)
@@ -271,7 +274,6 @@ def newey_west_lag(residual: np.ndarray, record: MotorRecord) -> int:
     acf = acf / max(acf[0], 1e-300)
     below = np.flatnonzero(np.abs(acf) < 0.1)
     first = int(below[0]) if below.size else n
-    floor = int(np.ceil(5.0 / (record.g_dist * record.h)))
     return int(min(max(3 * first, floor), n // 10))
 
 

@@ -29,7 +29,8 @@ import numpy as np
 from scipy.signal import lfilter
 
 from cosim import __version__
-from cosim.build import ensure_built
+from cosim.build import ensure_built, fmu_variables
+from cosim.encoder_fit import encoder_record
 from cosim.logs import write_csv
 from cosim.master import Recording
 from cosim.metrics import flexible_score, percent_error
@@ -136,7 +137,8 @@ def reproduce(out: Path, ideal: bool = False, show_progress: bool = True) -> Res
             write_csv(out / "identification.csv", recording_columns(identification))
         )
         bar.set_postfix_str("whole-chain fit")
-        choice = _whole_chain(identification, results.actuator)
+        cpr = 0 if ideal else int(fmu_variables(folder)["plant"]["encoder_cpr"].start)
+        choice = _whole_chain(identification, results.actuator, cpr)
         results.masses = choice.n
         results.whole_chain = choice.fit.as_dict()
         if choice.n == N_MASSES:  # the plant has three masses: n must match to co-simulate
@@ -162,7 +164,7 @@ def reproduce(out: Path, ideal: bool = False, show_progress: bool = True) -> Res
     return results
 
 
-def _whole_chain(identification: Recording, actuator: dict[str, float]) -> Choice:
+def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> Choice:
     """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
     terms = Actuator(
         bench.J_M,
@@ -174,7 +176,10 @@ def _whole_chain(identification: Recording, actuator: dict[str, float]) -> Choic
     )
     signals = [identification[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
     record = motor_record(identification.time, *signals, terms, G_DIST)
-    return identify_chain(record, "auto")
+    encoder = None
+    if cpr > 0:  # ideal sensors: no counts
+        encoder = encoder_record(identification.time, signals[0], signals[2], terms, cpr)
+    return identify_chain(record, "auto", encoder)
 
 
 def whole_chain_rows(results: Results) -> list[list[str]]:

@@ -6,7 +6,9 @@ inertia, stiffness and damping. The fit is the output-error fit of
 :mod:`cosim.output_error` with all 3n parameters free, started from the chain whose
 clamped modes and residues the record shows (:mod:`cosim.modal_start`: subspace
 identification, no search), on longer and longer openings of the record
-(:func:`~cosim.output_error.continued_fit`).
+(:func:`~cosim.output_error.continued_fit`); given the log's current and encoder
+counts, a prediction-error fit from the current to the encoder refines it
+(:mod:`cosim.encoder_fit`: the counts bias the output-error B_i).
 
 ``masses="auto"`` reads n from the record's modes (the subspace singular values) and
 checks it with the Bayesian information criterion of the n − 1, n, n + 1 fits,
@@ -23,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cosim.encoder_fit import EncoderRecord, refine
 from cosim.errors import UserError
 from cosim.modal_start import masses_seen, record_modes, singular_values
 from cosim.output_error import Fit, MotorRecord, check_excited, continued_fit
@@ -112,7 +115,9 @@ class Choice:
     singular_values: np.ndarray | None = None
 
 
-def identify(record: MotorRecord, masses: int | str) -> Choice:
+def identify(
+    record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
+) -> Choice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
     With ``"auto"``: the record's subspace singular values show n modes
@@ -120,6 +125,10 @@ def identify(record: MotorRecord, masses: int | str) -> Choice:
     fitted and the smallest criterion wins (one lag for all, the largest: the residual
     of a good fit is the most correlated). An n the record cannot support (fewer modes
     seen, or a mode that carries no reaction torque) is refused and reported.
+
+    With ``encoder`` (the same log's current and encoder counts), the chosen fit is
+    refined by the prediction-error fit (:mod:`cosim.encoder_fit`), which takes the
+    counts for what they are; without it the output-error fit is the result.
 
     Raises:
         UserError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
@@ -129,7 +138,7 @@ def identify(record: MotorRecord, masses: int | str) -> Choice:
         n = _masses(masses)
         result = fit_chain(record, n)
         ic = information_criterion(result, record)
-        return Choice(n, result, {n: ic}, {n: result.rms_residual})
+        return Choice(n, _refined(result, record, encoder, n), {n: ic}, {n: result.rms_residual})
     check_excited(record)
     singular = singular_values(record)
     seen = masses_seen(singular, MAX_AUTO_MASSES)
@@ -146,7 +155,12 @@ def identify(record: MotorRecord, masses: int | str) -> Choice:
     criterion = {n: information_criterion(f, record, lag) for n, f in fits.items()}
     best = min(criterion, key=criterion.__getitem__)
     residual = {n: f.rms_residual for n, f in fits.items()}
-    return Choice(best, fits[best], criterion, residual, refused, seen, singular)
+    chosen = _refined(fits[best], record, encoder, best)
+    return Choice(best, chosen, criterion, residual, refused, seen, singular)
+
+
+def _refined(result: Fit, record: MotorRecord, encoder: EncoderRecord | None, n: int) -> Fit:
+    return result if encoder is None else refine(encoder, record, result, n)
 
 
 def _masses(masses: int | str) -> int:
