@@ -136,16 +136,17 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     rng = np.random.default_rng(5)
     current = sum(0.1 * np.sin(w * t + rng.uniform(0, 2 * np.pi)) for w in LINES)
     count = 2 * np.pi / 2000
+    zeros = np.zeros_like(t)
     exact = EncoderRecord(
-        H, bench.K_T * current, np.zeros_like(t), count, bench.J_M, bench.D_M, 1e-4
+        H, bench.K_T * current, zeros, zeros, count, bench.J_M, bench.D_M, 0.0, 1e-4
     )
     A, Bd = encoder_fit._discrete(exact, J, K, B)
     x = np.zeros(len(Bd))
-    theta = np.empty_like(t)
+    theta, velocity = np.empty_like(t), np.empty_like(t)
     for step, torque in enumerate(exact.torque):
         if step:
             x = A @ x + Bd * torque
-        theta[step] = x[0]
+        theta[step], velocity[step] = x[0], x[3]
     counts = np.floor(theta / count) * count
     record = encoder_record(t, current, counts, actuator, 2000)
     start_values = np.array([*J, *K, *B]) * np.array([1.01, 0.99, 1.01, 0.99, 1.3, 0.7])
@@ -157,6 +158,13 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     assert np.all(np.abs(refined.values - truth) <= 3 * refined.std)
     assert refined.extra["output_error"]["B[1]"] == start_values[4]
     assert 0.8 < refined.extra["innovation_variance"] < 1.2  # the counts' q²/12, as assumed
+    # the smoother's motor velocity (the friction's sign) beats the smoothed derivative
+    smoothed = encoder_fit._Kalman.of(record, (J, K, B)).smoothed(record, 2)
+    assert smoothed.shape == (len(t), 6)
+    derivative_error = np.sqrt(np.mean((record.velocity - velocity) ** 2))
+    smoother_error = np.sqrt(np.mean((smoothed[:, 3] - velocity) ** 2))
+    assert smoother_error < 0.5 * derivative_error
+    np.testing.assert_allclose(smoothed[:, 0], theta, atol=count / 2)  # finer than a count
 
 
 def test_an_encoder_without_counts_is_refused() -> None:
