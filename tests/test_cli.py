@@ -63,7 +63,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     mean_row = next(line for line in result.stdout.splitlines() if line.strip().startswith("mean"))
     k_error = float(mean_row.split()[2])  # "k err" column, in %
     assert abs(k_error) < 3.0  # measured −0.92 % with realistic sensors
-    # experiment 4: n read from the record, every J_i and k_i within 2 % (measured ≤ 0.5 %)
+    # experiment 4: n read from the record, every J_i and k_i within 2 % (measured ≤ 0.15 %)
     assert "n = 3 read from the record" in result.stdout
     errors = [
         float(line.split()[-2])
