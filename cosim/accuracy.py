@@ -21,7 +21,8 @@ then run again on the recorded logs, offline, in every configuration (the same
 
 The bench also gets the honesty check of B's standard error (over ``--b-seeds`` seeds)
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
-within 10 %.
+within 10 %. Last, the whole-chain identification rows (``cosim/chain_accuracy.py``:
+three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
 """
 
 from __future__ import annotations
