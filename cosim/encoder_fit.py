@@ -4,9 +4,10 @@ The output-error fit (:mod:`cosim.output_error`) drives the chain model with the
 encoder's angle, so the counts are an error in the model's *input*: they bias every
 B_i by tens of percent (the same on every seed) and pull J_i, k_i low by up to 1 %.
 Here the counts are where they belong, in the *output*: motor and chain are one
-linear model driven by the motor torque ``k_t i_a − f_c sgn(ω)`` (ω: the angle's
-derivative smoothed without lag, as for the DOB), the encoder measures the motor
-angle with a uniform error of one count (variance q²/12), and an unmodelled torque on
+linear model driven by the motor torque ``k_t i_a − f_c sgn(ω)`` (ω: first the
+angle's derivative smoothed without lag, then the Kalman smoother's motor velocity),
+the encoder measures the motor angle with a uniform error of one count (variance
+q²/12), and an unmodelled torque on
 the motor (the friction's error while the motor sticks, current noise; standard
 deviation :func:`torque_std`) is the process noise. The steady-state Kalman predictor
 gives the innovations, and least squares on them is the prediction-error estimate
@@ -22,7 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
-from scipy import optimize, signal
+from scipy import optimize
 
 from cosim.errors import UserError
 from cosim.output_error import (
@@ -30,6 +31,7 @@ from cosim.output_error import (
     MotorRecord,
     constant_step,
     decorrelation_lag,
+    linear_recursion,
     newey_west_covariance,
     predict,
     smooth_velocity,
@@ -37,6 +39,9 @@ from cosim.output_error import (
 from flexchain.chain import spring_matrix
 from flexchain.dob import Actuator
 
+#: Cutoff (rad/s) of the lag-free smoothing whose derivative gives the first pass its
+#: friction sign: the DOB's 4·g_dist at the default g_dist of 100 rad/s.
+SIGN_VELOCITY_CUTOFF = 400.0
 #: Floor of the process noise's standard deviation (N·m per step): the observer FMU's
 #: default unmodelled torque.
 TORQUE_STD_FLOOR = 1e-4
@@ -78,7 +83,8 @@ def encoder_record(
     time: np.ndarray, i_a: np.ndarray, theta_m: np.ndarray, actuator: Actuator, cpr: int
 ) -> EncoderRecord:
     """Build the record from a log (``theta_m`` as the encoder gives it: whole counts);
-    the friction's sign from the angle's derivative smoothed without lag (as the DOB's).
+    the friction's sign from the angle's derivative smoothed without lag at
+    :data:`SIGN_VELOCITY_CUTOFF` (the second pass of :func:`refine` replaces it).
 
     Raises:
         UserError: for an encoder without counts (``cpr`` ≤ 0) or a varying step.
@@ -91,7 +97,7 @@ def encoder_record(
     return EncoderRecord(
         h=h,
         drive=(actuator.k_to + actuator.dkt) * np.asarray(i_a, dtype=float),
-        velocity=smooth_velocity(theta, h, 400.0),
+        velocity=smooth_velocity(theta, h, SIGN_VELOCITY_CUTOFF),
         theta_m=theta,
         count=count,
         J_m=actuator.J_mo + actuator.dJm,
@@ -135,10 +141,10 @@ class _Kalman:
         y = record.theta_m
         gain = self.A @ self.gain
         F = self.A - np.outer(gain, np.eye(len(gain))[0])  # x⁻_{k+1} = F x⁻_k + …
-        forcing = np.outer(y[:-1], gain) + np.outer(record.torque[1:], self.Bd)
+        inputs = np.vstack([y[:-1], record.torque[1:]])
         start = np.zeros(len(gain))
         start[: n + 1] = y[0]
-        return _linear_recursion(F, forcing, start)
+        return linear_recursion(F, np.column_stack([gain, self.Bd]), inputs, start).T
 
     def smoothed(self, record: EncoderRecord, n: int) -> np.ndarray:
         """Rauch–Tung–Striebel smoothed states x_0 … x_{N−1}, shape (N, 2n + 2)."""
@@ -147,23 +153,9 @@ class _Kalman:
         posterior = self.prior - np.outer(self.gain, self.prior[0])
         G = posterior @ self.A.T @ np.linalg.inv(self.prior)
         # backward: xs_k = G xs_{k+1} + (x_k − G x⁻_{k+1}), from xs_{N−1} = x_{N−1}
-        forcing = (after[:-1] - before[1:] @ G.T)[::-1]
-        return _linear_recursion(G, forcing, after[-1])[::-1]
-
-
-def _linear_recursion(F: np.ndarray, forcing: np.ndarray, first: np.ndarray) -> np.ndarray:
-    """``x_0 = first``, ``x_{j+1} = F x_j + forcing_j`` in modal coordinates with
-    ``lfilter`` (no Python loop per sample); returns x_0 … x_M, shape (M + 1, size)."""
-    lam, V = np.linalg.eig(F)
-    modal_forcing = np.linalg.solve(V, forcing.T.astype(complex))
-    modal_first = np.linalg.solve(V, first.astype(complex))
-    modal = np.empty((len(lam), forcing.shape[0] + 1), dtype=complex)
-    for j, root in enumerate(lam):
-        modal[j, 0] = modal_first[j]
-        modal[j, 1:], _ = signal.lfilter(
-            [1.0], [1.0, -root], modal_forcing[j], zi=[root * modal_first[j]]
-        )
-    return (V @ modal).real.T
+        inputs = np.hstack([after[:-1], before[1:]])[::-1].T
+        both = np.hstack([np.eye(len(G)), -G])
+        return linear_recursion(G, both, inputs, after[-1]).T[::-1]
 
 
 def innovations(

@@ -278,16 +278,14 @@ def _masses(text: str) -> int:
 
 def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: int | str) -> int:
     values = known_parameters(folder, args.set)
+    actuator = actuator_of(values)
     c = log.columns
-    record = motor_record(
-        log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
-    )
+    g_dist = values["g_dist"]
+    record = motor_record(log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
     cpr = int(values["encoder_cpr"])
-    encoder = (
-        encoder_record(log.time, c["i_a"], c["theta_m"], actuator_of(values), cpr)
-        if cpr > 0
-        else None
-    )
+    encoder = None
+    if cpr > 0:
+        encoder = encoder_record(log.time, c["i_a"], c["theta_m"], actuator, cpr)
     choice = identify_chain(record, masses, encoder)
     result = choice.fit
     report: dict[str, object] = {"masses": choice.n, **result.as_dict()}

@@ -67,7 +67,7 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     Raises:
         UserError: when the record is too short, or shows fewer than n modes.
     """
-    band = min(BAND_PER_G * record.g_dist, 0.3 / record.h)
+    band = _band(record)
     u, y, step = _decimated(record, band)
     rows = max(2 * n + 4, min(ROWS, len(u) // 8))
     if len(u) < 8 * (2 * n + 4):
@@ -97,7 +97,7 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
 def singular_values(record: MotorRecord) -> np.ndarray:
     """Singular values of the subspace step (relative to the first, shape (rows,)):
     each lightly damped mode the record shows adds a pair above the noise floor."""
-    band = min(BAND_PER_G * record.g_dist, 0.3 / record.h)
+    band = _band(record)
     u, y, _ = _decimated(record, band)
     rows = min(ROWS, len(u) // 8)
     if rows < 4:
@@ -110,6 +110,12 @@ def masses_seen(singular: np.ndarray, largest: int) -> int:
     """The n ≤ ``largest`` after whose 2n-th singular value the largest drop comes."""
     pairs = range(1, min(largest, (len(singular) - 1) // 2) + 1)
     return max(pairs, key=lambda n: singular[2 * n - 1] / max(singular[2 * n], 1e-300))
+
+
+def _band(record: MotorRecord) -> float:
+    """Highest clamped frequency sought (rad/s): :data:`BAND_PER_G` · g_dist, at most
+    0.3/h (the band the sample rate leaves)."""
+    return min(BAND_PER_G * record.g_dist, 0.3 / record.h)
 
 
 def chain_of(n: int) -> str:

@@ -150,17 +150,36 @@ def predict(
     c, d = (np.asarray(r) for r in chain.torque_row())
     u = record.theta_m - record.theta_m[0]  # a common offset of all angles is an equilibrium
     w = np.vstack([u[:-1], np.diff(u) / record.h])  # inputs of steps 1 … N−1
-    lam, V = np.linalg.eig(Ad)
-    forcing = np.linalg.solve(V, Bd.astype(complex)) @ w
-    modal = np.empty_like(forcing)
-    for j, root in enumerate(lam):
-        modal[j] = signal.lfilter([1.0], [1.0, -root], forcing[j])
-    x_after = (V @ modal).real  # x_1 … x_{N−1}
-    x_before = np.hstack([np.zeros((len(c), 1)), x_after[:, :-1]])
-    torque = c @ x_before + d @ w
+    x = linear_recursion(Ad, Bd, w, np.zeros(len(c)))  # x_0 … x_{N−1}
+    torque = c @ x[:, :-1] + d @ w
     a = np.exp(-record.g_dist * record.h)
     filtered = signal.lfilter([1.0 - a], [1.0, -a], torque)
     return np.concatenate([[0.0], filtered])
+
+
+def linear_recursion(F: np.ndarray, G: np.ndarray, u: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """``x_0 = first``, ``x_{j+1} = F x_j + G u_j``, in modal coordinates with ``lfilter``
+    (no Python loop per sample).
+
+    Args:
+        F: state matrix, shape (S, S), diagonalizable.
+        G: input matrix, shape (S, I).
+        u: inputs, shape (I, M).
+        first: x_0, shape (S,).
+
+    Returns:
+        x_0 … x_M as columns, shape (S, M + 1).
+    """
+    lam, V = np.linalg.eig(F)
+    forcing = np.linalg.solve(V, np.asarray(G, dtype=complex)) @ u
+    modal_first = np.linalg.solve(V, first.astype(complex))
+    modal = np.empty((len(lam), u.shape[1] + 1), dtype=complex)
+    modal[:, 0] = modal_first
+    for j, root in enumerate(lam):
+        modal[j, 1:], _ = signal.lfilter(
+            [1.0], [1.0, -root], forcing[j], zi=[root * modal_first[j]]
+        )
+    return (V @ modal).real
 
 
 @dataclass
