@@ -1,5 +1,5 @@
 # The README's two commands: `make demo` and `make test`. Each creates or refreshes
-# .venv, installs the project with its test extra, builds the FMUs and runs.
+# .venv, installs the project with its test extra, builds the FMUs into dist/ and runs.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -14,13 +14,13 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 build: $(STAMP)
-	$(BIN)/arcosim build
+	$(BIN)/arcosim build --out dist
 
 demo: build
-	$(BIN)/arcosim reproduce
+	$(BIN)/arcosim reproduce --fmus dist
 
 test: build
-	$(BIN)/arcosim validate
+	$(BIN)/arcosim validate dist/*.fmu
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/python -m pytest

@@ -24,11 +24,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from cosim import excitation
-from cosim.accuracy import ACTUATOR, CASES, G_DIST, run_case
-from cosim.output_error import MotorRecord, motor_record, uniform_chain
-from cosim.scenarios import Scenario
-from flexchain.excitation import log_spaced
+from arcosim.experiments import excitation
+from arcosim.experiments.scenarios import Scenario
+from arcosim.fmu.flexchain.excitation import log_spaced
+from arcosim.identification.output_error import MotorRecord, motor_record, uniform_chain
+from benchmarks.accuracy import ACTUATOR, CASES, G_DIST, run_case
 
 BENCH = CASES[0]
 LINES = np.array(log_spaced(2.0, 300.0, 40))

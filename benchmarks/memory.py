@@ -16,8 +16,9 @@ import sys
 import time
 from pathlib import Path
 
-from cosim.build import OBSERVER, ensure_built
-from cosim.instance import FmuInstance
+from arcosim.build.builder import ensure_built
+from arcosim.build.recipes import OBSERVER
+from arcosim.host.instance import FmuInstance
 
 
 def rss_mib() -> float:

@@ -1,7 +1,7 @@
-"""``python -m cosim`` is the same as the ``arcosim`` command."""
+"""``python -m arcosim`` is the same as the ``arcosim`` command."""
 
 import sys
 
-from cosim.cli import main
+from arcosim.cli import main
 
 sys.exit(main())

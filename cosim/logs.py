@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cosim.errors import UserError
+from arcosim.errors import UserError
 
 LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cosim.instance import FmuInstance
+from arcosim.host.instance import FmuInstance
 
 
 def run_plant(

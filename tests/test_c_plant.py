@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.cplant import plant_class
-from cosim.instance import FmuInstance
+from arcosim.build.cplant import plant_class
+from arcosim.host.instance import FmuInstance
 
 CASES = [
     (3, {}),  # the bench: Coulomb friction, 2000-count encoder, current noise

@@ -6,13 +6,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-from cosim import __version__
-from cosim.cli import main
+from arcosim import __version__
+from arcosim.cli import main
 
 
 def arcosim(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd
+        [sys.executable, "-m", "arcosim", *args], capture_output=True, text=True, cwd=cwd
     )
 
 
@@ -35,16 +35,32 @@ def test_no_command_prints_help(capsys) -> None:
     assert "build" in capsys.readouterr().out
 
 
-def test_build_writes_into_dist_by_default(tmp_path: Path) -> None:
-    result = arcosim("build", "--masses", "2", cwd=tmp_path)
+def test_build_writes_into_the_user_cache_by_default(tmp_path: Path, monkeypatch) -> None:
+    from arcosim.build.cache import default_folder
+
+    monkeypatch.setenv("ARCOSIM_CACHE", str(tmp_path / "cache"))
+    work = tmp_path / "work"
+    work.mkdir()
+    result = arcosim("build", "--masses", "2", cwd=work)
     assert result.returncode == 0, result.stderr
-    assert (tmp_path / "dist" / "n2" / "MotorChainPlant.fmu").is_file()
-    assert (tmp_path / "dist" / "n2" / "ReactionTorqueObserver.fmu").is_file()
+    folder = default_folder(2)
+    assert folder.is_relative_to(tmp_path / "cache")
+    assert (folder / "MotorChainPlant.fmu").is_file()
+    assert (folder / "ReactionTorqueObserver.fmu").is_file()
+    assert str(folder / "MotorChainPlant.fmu") in result.stdout
+    assert list(work.iterdir()) == []  # nothing written where the command ran
+
+
+def test_build_writes_into_the_folder_named(tmp_path: Path) -> None:
+    result = arcosim("build", "--masses", "2", "--out", str(tmp_path / "mine"), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "mine" / "MotorChainPlant.fmu").is_file()
+    assert (tmp_path / "mine" / "ActionReaction.ssp").is_file()
 
 
 def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path) -> None:
     """The paper's three experiments and the fourth end to end (about 60 s)."""
-    (tmp_path / "dist").symlink_to(build_fmus(3), target_is_directory=True)
+    build_fmus(3)  # into the session cache, where reproduce finds them current
     result = arcosim("reproduce", "--out", "report", "--no-progress", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     out = tmp_path / "report"
@@ -74,10 +90,11 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
 
 
 def test_fmus_built_from_other_sources_are_rebuilt_not_run(build_fmus, tmp_path: Path) -> None:
-    """A stale dist/ (sources edited since the build) must never be simulated."""
+    """A stale folder of FMUs (sources edited since the build) must never be simulated."""
     import shutil
 
-    from cosim.build import DIGEST_FILE, ensure_built, source_digest
+    from arcosim.build.builder import ensure_built
+    from arcosim.build.cache import DIGEST_FILE, source_digest
 
     folder = tmp_path / "n1"
     shutil.copytree(build_fmus(1), folder)

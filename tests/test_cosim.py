@@ -11,26 +11,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim import excitation
-from cosim.instance import FmuInstance
-from cosim.master import cosimulate
-from cosim.scenarios import SCENARIOS, run_scenario
+from arcosim.experiments import excitation
+from arcosim.experiments.scenarios import SCENARIOS, run_scenario
+from arcosim.host.instance import FmuInstance
+from arcosim.host.master import cosimulate
 
 IDEAL = {"encoder_cpr": 0, "i_noise_std": 0.0}
 
 
 def arcosim(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd
+        [sys.executable, "-m", "arcosim", *args], capture_output=True, text=True, cwd=cwd
     )
 
 
 @pytest.fixture(scope="module")
 def workdir(build_fmus, tmp_path_factory) -> Path:
-    """A folder whose dist/ holds the FMUs for n = 3, as after `arcosim build`."""
-    folder = tmp_path_factory.mktemp("work")
-    (folder / "dist").symlink_to(build_fmus(3), target_is_directory=True)
-    return folder
+    """A working folder, with the FMUs for n = 3 built into the session cache."""
+    build_fmus(3)
+    return tmp_path_factory.mktemp("work")
 
 
 def spectrum(x: np.ndarray, h: float, window: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -69,7 +68,7 @@ def test_master_counts_steps_sets_parameters_and_records(build_fmus) -> None:
 
 
 def test_master_refuses_bad_arguments(build_fmus) -> None:
-    from cosim.errors import UserError
+    from arcosim.errors import UserError
 
     folder = build_fmus(3)
     with (
@@ -83,7 +82,7 @@ def test_master_refuses_bad_arguments(build_fmus) -> None:
 
 
 def test_a_refused_step_stops_the_run_with_the_fmu_log(build_fmus) -> None:
-    from cosim.errors import UserError
+    from arcosim.errors import UserError
 
     folder = build_fmus(3)
     with (

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from cosim.exit_fix import UNLOAD_SYMBOL, fini_functions, has_exit_bug, remove_exit_bug
+from arcosim.build.exit_fix import UNLOAD_SYMBOL, fini_functions, has_exit_bug, remove_exit_bug
 
 
 def pythonfmu_binary() -> bytes:
@@ -81,7 +81,7 @@ def test_no_invalid_memory_access_at_exit_under_valgrind(build_fmus, tmp_path: P
         pytest.skip("needs the Debian package valgrind (.ci/run installs it)")
     script = (
         "import sys\n"
-        "from cosim.instance import FmuInstance\n"
+        "from arcosim.host.instance import FmuInstance\n"
         "for k in range(3):\n"
         "    with FmuInstance(sys.argv[1], f'exit-{k}') as observer,"
         " FmuInstance(sys.argv[2], f'plant-{k}') as plant:\n"

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from cosim.instance import FmuInstance
+from arcosim.host.instance import FmuInstance
 
 
 def outputs(fmu: FmuInstance) -> list[str]:

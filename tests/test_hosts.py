@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from cosim.ecos import ecos_binary, run_ecos
-from cosim.native_loader import LOADER
+from arcosim.build.native_loader import LOADER
+from arcosim.host.ecos import ecos_binary, run_ecos
 
 
 def ecos_executable() -> Path:
@@ -68,7 +68,8 @@ def test_ssp_in_ecos_matches_the_fmpy_jacobi_run(build_fmus, tmp_path) -> None:
     (``trace_file``) at full precision."""
     import numpy as np
 
-    from cosim.ssp import BENCH, run_ssp, write_ssp
+    from arcosim.build.ssp import BENCH, write_ssp
+    from arcosim.host.ssp import run_ssp
 
     ecos = ecos_executable()
     traced = {

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm as scipy_expm
 
-from flexchain.linalg import expm, matmul, matvec, solve
+from arcosim.fmu.flexchain.linalg import expm, matmul, matvec, solve
 
 
 @pytest.mark.parametrize("scale", [1e-3, 0.3, 5.0, 400.0])

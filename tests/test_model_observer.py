@@ -10,8 +10,13 @@ import pytest
 import scipy.linalg
 from scipy.integrate import solve_ivp
 
-from flexchain.driven_chain import continuous_matrices, discretize
-from flexchain.model_observer import ModelObserver, NoiseModel, filter_riccati, step_model
+from arcosim.fmu.flexchain.driven_chain import continuous_matrices, discretize
+from arcosim.fmu.flexchain.model_observer import (
+    ModelObserver,
+    NoiseModel,
+    filter_riccati,
+    step_model,
+)
 
 J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
 K = (0.12, 0.1627, 0.21)

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from flexchain.dob import Actuator, ReactionObserver, mean_sign
-from flexchain.filters import LowPassBank
-from flexchain.least_squares import NormalEquations
-from flexchain.recursion import ChainRecursion
-from flexchain.rigid_identification import SETTLE, RigidChainIdentifier, kappa
-from flexchain.self_identification import ActuatorIdentifier
+from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver, mean_sign
+from arcosim.fmu.flexchain.filters import LowPassBank
+from arcosim.fmu.flexchain.least_squares import NormalEquations
+from arcosim.fmu.flexchain.recursion import ChainRecursion
+from arcosim.fmu.flexchain.rigid_identification import SETTLE, RigidChainIdentifier, kappa
+from arcosim.fmu.flexchain.self_identification import ActuatorIdentifier
 
 BENCH_J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
 

@@ -14,9 +14,9 @@ import pytest
 from fmpy.validation import validate_fmu
 from scipy.signal import lfilter
 
-from cosim.excitation import multisine, rigid_maneuver
-from cosim.instance import FmuInstance, RealPort
-from cosim.master import cosimulate
+from arcosim.experiments.excitation import multisine, rigid_maneuver
+from arcosim.host.instance import FmuInstance, RealPort
+from arcosim.host.master import cosimulate
 from tests.fmu_checks import step_from_resources
 
 IDEAL = {"encoder_cpr": 0, "i_noise_std": 0.0}
@@ -251,7 +251,7 @@ def test_same_fmu_instantiates_again_and_again_in_one_process(fmus) -> None:
     go, and the process must exit cleanly (a miscount is a use-after-free there)."""
     script = (
         "import gc, sys\n"
-        "from cosim.instance import FmuInstance\n"
+        "from arcosim.host.instance import FmuInstance\n"
         "counts = []\n"
         "for k in range(12):\n"
         "    with FmuInstance(sys.argv[1], f'again-{k}') as observer:\n"

@@ -10,18 +10,18 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from cosim.accuracy import ACTUATOR
-from cosim.cli import main
-from cosim.errors import UserError
-from cosim.output_error import (
+from arcosim.cli import main
+from arcosim.errors import UserError
+from arcosim.experiments.scenarios import SCENARIOS, run_scenario
+from arcosim.fmu.flexchain import bench
+from arcosim.identification.output_error import (
     MotorRecord,
     constant_step,
     motor_record,
     predict,
     uniform_chain,
 )
-from cosim.scenarios import SCENARIOS, run_scenario
-from flexchain import bench
+from benchmarks.accuracy import ACTUATOR
 
 H = 1e-3
 

@@ -13,8 +13,8 @@ import pytest
 from fmpy.validation import validate_fmu
 from scipy.linalg import eig
 
-from cosim import __version__
-from cosim.instance import FmuInstance
+from arcosim import __version__
+from arcosim.host.instance import FmuInstance
 from tests.plant_runs import IDEAL, run_plant
 
 BENCH_J = [2.09e-5, 5.15299e-4, 5.15299e-4, 6.192707e-4]

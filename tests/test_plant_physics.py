@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from motorchain.physics import PlantPhysics
+from arcosim.plant.motorchain.physics import PlantPhysics
 
 BENCH = {
     "J_m": 2.09e-5,

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
-from cosim import excitation
-from cosim.instance import FmuInstance
-from flexchain.excitation import log_spaced
+from arcosim.experiments import excitation
+from arcosim.fmu.flexchain.excitation import log_spaced
+from arcosim.host.instance import FmuInstance
 
 
 @pytest.fixture(scope="module")

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from cosim.cli import main
-from cosim.errors import UserError
-from cosim.ssp import BENCH, CONNECTIONS, read_ssp, run_ssp
+from arcosim.build.ssp import BENCH, CONNECTIONS
+from arcosim.cli import main
+from arcosim.errors import UserError
+from arcosim.host.ssp import read_ssp, run_ssp
 
 
 def test_build_writes_an_ssp_with_connections_and_the_bench_set(build_fmus) -> None:

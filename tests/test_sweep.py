@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from cosim.cli import main
-from cosim.errors import UserError
-from cosim.sweep import draw_runs, load_spec, read_results, sweep
+from arcosim.cli import main
+from arcosim.errors import UserError
+from arcosim.sweeps.runner import draw_runs, load_spec, read_results, sweep
 
 SMALL = """
 name = "small"
@@ -25,8 +25,8 @@ metrics = ["D_m_error", "f_c_error", "runtime"]
 
 @pytest.fixture()
 def workdir(build_fmus, tmp_path: Path, monkeypatch) -> Path:
-    """A folder whose dist/ holds the FMUs for n = 3; the current directory."""
-    (tmp_path / "dist").symlink_to(build_fmus(3), target_is_directory=True)
+    """The current directory, with the FMUs for n = 3 built into the session cache."""
+    build_fmus(3)
     monkeypatch.chdir(tmp_path)
     return tmp_path
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import json
 
-from cosim.cli import main
+from arcosim.cli import main
 
 
 def test_speed_benchmark_runs_in_quick_mode(build_fmus, tmp_path, monkeypatch, capsys) -> None:
     folder = build_fmus(3)
-    monkeypatch.setattr("cosim.throughput.ensure_built", lambda n=3: build_fmus(n))
+    monkeypatch.setattr("benchmarks.speed.ensure_built", lambda n=3: build_fmus(n))
     assert main(["bench", "speed", "--quick", "--out", str(tmp_path)]) == 0
     table = (tmp_path / "throughput.md").read_text()
     for row in ("whole loop", "observer doStep", "plain Python", "| 1 s |", "Output-error"):

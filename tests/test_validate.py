@@ -5,7 +5,7 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
-from cosim.cli import main
+from arcosim.cli import main
 
 
 def test_validate_passes_the_built_fmus(build_fmus, capsys) -> None:

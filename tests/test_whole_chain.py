@@ -8,15 +8,15 @@ import json
 import numpy as np
 import pytest
 
-from cosim import encoder_fit
-from cosim.chain_modes import chain_from_modes, driving_point_modes
-from cosim.cli import main
-from cosim.encoder_fit import EncoderRecord, encoder_record
-from cosim.errors import UserError
-from cosim.output_error import Fit, MotorRecord, predict
-from cosim.whole_chain import fit_chain, identify, names, split
-from flexchain import bench
-from flexchain.dob import Actuator
+from arcosim.cli import main
+from arcosim.errors import UserError
+from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification import encoder_fit
+from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
+from arcosim.identification.encoder_fit import EncoderRecord, encoder_record
+from arcosim.identification.output_error import Fit, MotorRecord, predict
+from arcosim.identification.whole_chain import fit_chain, identify, names, split
 
 H = 1e-3
 J = (4e-4, 8e-4)

@@ -10,16 +10,26 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from flexchain import bench
-from flexchain.dob import Actuator
-from flexchain.observer import (
+from ..flexchain import bench
+from ..flexchain.dob import Actuator
+from ..flexchain.observer import (
     RIGID_IDENTIFICATION,
     SELF_IDENTIFICATION,
     STATE_ESTIMATION,
     Observer,
     ObserverSettings,
 )
-from fmukit import FmuSlave, Variable, array, choice_problem, indexed, inp, out, par, range_problems
+from ..fmukit import (
+    FmuSlave,
+    Variable,
+    array,
+    choice_problem,
+    indexed,
+    inp,
+    out,
+    par,
+    range_problems,
+)
 
 MODES = {
     0: "actuator self-identification",

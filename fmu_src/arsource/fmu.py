@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from flexchain import excitation
-from fmukit import FmuSlave, Variable, choice_problem, out, par, range_problems
+from ..flexchain import excitation
+from ..fmukit import FmuSlave, Variable, choice_problem, out, par, range_problems
 
 RIGID, MULTISINE, CHIRP, RANDOM = 0, 1, 2, 3
 SIGNALS = {

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from flexchain.linalg import Matrix, zeros
+from .linalg import Matrix, zeros
 
 
 def spring_matrix(gains: Sequence[float]) -> Matrix:

@@ -25,8 +25,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from flexchain import linalg
-from flexchain.linalg import Matrix
+from . import linalg
+from .linalg import Matrix
 
 
 def continuous_matrices(

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from flexchain.noise import gaussian, uniform
+from .noise import gaussian, uniform
 
 
 def raised_cosine_window(t: float, duration: float, ramp: float, derivative: int = 0) -> float:

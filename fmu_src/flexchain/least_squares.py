@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from flexchain.linalg import solve
+from .linalg import solve
 
 #: Below this reciprocal condition number (of the normal matrix scaled to unit
 #: diagonal) a fit is called ill-conditioned.

@@ -26,9 +26,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from operator import mul
 
-from flexchain import linalg
-from flexchain.driven_chain import discretize
-from flexchain.linalg import Matrix
+from . import linalg
+from .driven_chain import discretize
+from .linalg import Matrix
 
 #: Discretizations kept for distinct step sizes (a variable-step master may use a few).
 CACHE_SIZE = 8

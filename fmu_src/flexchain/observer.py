@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flexchain.dob import Actuator, ReactionObserver
-from flexchain.model_observer import ModelObserver, NoiseModel
-from flexchain.recursion import ChainRecursion
-from flexchain.rigid_identification import RigidChainIdentifier
-from flexchain.self_identification import ActuatorIdentifier
+from .dob import Actuator, ReactionObserver
+from .model_observer import ModelObserver, NoiseModel
+from .recursion import ChainRecursion
+from .rigid_identification import RigidChainIdentifier
+from .self_identification import ActuatorIdentifier
 
 SELF_IDENTIFICATION, RIGID_IDENTIFICATION, STATE_ESTIMATION = 0, 1, 2
 RECURSION, MODEL_BASED = 0, 1

@@ -36,9 +36,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from flexchain.dob import sign
-from flexchain.filters import LowPassBank
-from flexchain.least_squares import RCOND_MIN, NormalEquations
+from .dob import sign
+from .filters import LowPassBank
+from .least_squares import RCOND_MIN, NormalEquations
 
 #: Rows start this many filter time constants (1/g) after the start.
 SETTLE = 10.0

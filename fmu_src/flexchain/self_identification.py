@@ -30,8 +30,8 @@ last ``5 / g + 5 / g_id`` seconds: a stuck motor's friction is not ``f_c sgn Î¸Ì
 
 from __future__ import annotations
 
-from flexchain.filters import LowPassBank
-from flexchain.least_squares import RCOND_MIN, NormalEquations
+from .filters import LowPassBank
+from .least_squares import RCOND_MIN, NormalEquations
 
 #: A four-regressor fit this close to singular is taken as the rank deficiency
 #: that the free motor's equation of motion implies.

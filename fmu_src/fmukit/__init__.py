@@ -5,10 +5,10 @@ Standard library (plus the pythonfmu runtime that every FMU carries) only: this
 package is bundled into each FMU's ``resources/`` folder.
 """
 
-from fmukit.checks import choice_problem, range_problems
-from fmukit.model_description import model_description
-from fmukit.slave import FmuSlave
-from fmukit.variables import Variable, array, indexed, inp, out, par
+from .checks import choice_problem, range_problems
+from .model_description import model_description
+from .slave import FmuSlave
+from .variables import Variable, array, indexed, inp, out, par
 
 __all__ = [
     "FmuSlave",

@@ -14,8 +14,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from xml.etree.ElementTree import Element, SubElement
 
-from fmukit.units import UNITS
-from fmukit.variables import Variable
+from .units import UNITS
+from .variables import Variable
 
 LOG_CATEGORIES = {
     "logStatusWarning": "Log messages with fmi2Warning status.",

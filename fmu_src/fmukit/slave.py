@@ -30,9 +30,9 @@ from xml.etree.ElementTree import Element
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
-from fmukit.model_description import ModelInfo, model_description
-from fmukit.state import restore, snapshot
-from fmukit.variables import Value, Variable, par
+from .model_description import ModelInfo, model_description
+from .state import restore, snapshot
+from .variables import Value, Variable, par
 
 #: Every FMU's last parameter: a CSV of its outputs after every step, at full
 #: precision, written from inside whatever host runs it ("" = off).

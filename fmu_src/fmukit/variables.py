@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from fmukit.units import check_unit
+from .units import check_unit
 
 VarType = Literal["Real", "Integer", "Boolean", "String"]
 Causality = Literal["parameter", "input", "output"]

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from flexchain import bench
-from flexchain.noise import gaussian, quantize
-from fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
-from motorchain.physics import PlantPhysics
+from ...fmu.flexchain import bench
+from ...fmu.flexchain.noise import gaussian, quantize
+from ...fmu.fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
+from .physics import PlantPhysics
 
 
 class MotorChainPlant(FmuSlave):

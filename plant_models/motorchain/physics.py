@@ -23,8 +23,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from flexchain.chain import spring_matrix
-from flexchain.linalg import Matrix, Vector, expm, zeros
+from ...fmu.flexchain.chain import spring_matrix
+from ...fmu.flexchain.linalg import Matrix, Vector, expm, zeros
 
 _MAX_EVENTS_PER_STEP = 16
 _CACHE_SIZE = 16

@@ -1,0 +1,33 @@
+"""The project's benchmarks (a source checkout's, not installed with the wheel).
+
+- :mod:`benchmarks.accuracy`: every method on several chains against the truth
+  (``arcosim bench accuracy``, or ``python -m benchmarks.accuracy``);
+- :mod:`benchmarks.speed`: µs per co-simulation step and seconds per fit
+  (``arcosim bench speed``, or ``python -m benchmarks.speed``);
+- :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`: one-off measurements, run as
+  scripts.
+
+They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+from arcosim.errors import ArcosimError
+
+
+def main(
+    name: str, add_parser: Callable[[argparse._SubParsersAction], None], argv: Sequence[str]
+) -> int:
+    """Run benchmark ``name`` (registered by ``add_parser``) with ``argv``; the exit code."""
+    parser = argparse.ArgumentParser(prog="arcosim bench")
+    add_parser(parser.add_subparsers(dest="benchmark", required=True))
+    args = parser.parse_args([name, *argv])
+    try:
+        return int(args.execute(args) or 0)
+    except ArcosimError as error:
+        print(f"benchmark: error: {error}", file=sys.stderr)
+        return 2

@@ -1,0 +1,52 @@
+"""``arcosim bench accuracy|speed [ARGS...]``: run a benchmark of a source checkout.
+
+The benchmarks live in the repository's ``benchmarks/`` folder (they are not part of
+the installed package); this command finds that folder from the current directory
+upwards and runs ``benchmarks/<name>.py`` with ``ARGS`` (``--help`` lists them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from pathlib import Path
+
+from arcosim.errors import UserError
+
+#: Benchmark name → module of the ``benchmarks`` package.
+BENCHMARKS = {"accuracy": "accuracy", "speed": "speed"}
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``arcosim bench``."""
+    p = subparsers.add_parser(
+        "bench",
+        help="run a benchmark of the source checkout (accuracy, speed)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
+    p.add_argument("args", nargs=argparse.REMAINDER, help="the benchmark's own arguments")
+    p.set_defaults(execute=_execute)
+
+
+def checkout_root(start: Path) -> Path:
+    """The source checkout holding ``start``: the nearest folder upwards with
+    ``pyproject.toml`` and ``benchmarks/__init__.py``."""
+    for folder in (start, *start.parents):
+        if (folder / "pyproject.toml").is_file() and (folder / "benchmarks/__init__.py").is_file():
+            return folder
+    raise UserError(
+        f"no arcosim source checkout at or above {start}: the benchmarks are part of the "
+        "repository, not of the installed package; run `arcosim bench` inside a clone"
+    )
+
+
+def _execute(args: argparse.Namespace) -> int:
+    root = checkout_root(Path.cwd().resolve())
+    if str(root) not in sys.path:
+        sys.path.insert(0, str(root))
+    package = importlib.import_module("benchmarks")
+    module = importlib.import_module(f"benchmarks.{BENCHMARKS[args.name]}")
+    return package.main(args.name, module.add_parser, args.args)

@@ -1,0 +1,73 @@
+"""``arcosim sweep SPEC.toml``: Monte Carlo and grid sweeps of co-simulations on Dask.
+
+    arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
+
+The spec (format in :mod:`cosim.sweep_spec`) names the scenario, the parameters to
+vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of
+runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of
+``--workers`` processes runs here; with it the same tasks go to that cluster. Each run
+is a task that builds nothing: the FMUs are built once and shipped as bytes. Rows are
+appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
+finished run and ``--resume`` runs only the others; a failed run records its error and
+the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
+parameter and the PNGs the error histograms and the errors against each parameter
+(:mod:`cosim.sweep_summary`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from arcosim.cli.options import add_fmus_option
+from arcosim.errors import UserError
+from arcosim.sweeps.runner import sweep
+from arcosim.sweeps.spec import load_spec
+from arcosim.sweeps.summary import read_results
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``arcosim sweep``."""
+    p = subparsers.add_parser(
+        "sweep",
+        help="run a parameter sweep on Dask",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("spec", type=Path, help="the sweep specification (TOML)")
+    p.add_argument(
+        "--scheduler", help="address of an existing Dask scheduler (default: a local cluster)"
+    )
+    p.add_argument(
+        "--workers", type=int, default=2, help="worker processes of the local cluster (default 2)"
+    )
+    p.add_argument("--out", type=Path, help="output folder (default sweeps/<name>)")
+    p.add_argument("--resume", action="store_true", help="finish an interrupted sweep in --out")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_fmus_option(p)
+    p.set_defaults(execute=_execute)
+
+
+def _execute(args: argparse.Namespace) -> int:
+    spec = load_spec(args.spec)
+    if args.workers < 1:
+        raise UserError(f"--workers {args.workers}: at least one worker")
+    out = args.out or Path("sweeps") / spec.name
+    start = time.perf_counter()
+    results = sweep(
+        spec,
+        out,
+        args.scheduler,
+        args.workers,
+        args.resume,
+        not args.no_progress,
+        fmu_dir=args.fmus,
+    )
+    rows = read_results(results)
+    failed = sum(1 for r in rows if r["error"])
+    print(
+        f"{len(rows)} runs ({failed} failed) in {time.perf_counter() - start:.1f} s; "
+        f"wrote {results} and {out / 'summary.md'}"
+    )
+    return 0

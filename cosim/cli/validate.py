@@ -1,0 +1,51 @@
+"""``arcosim validate [FMU ...]``: check built FMUs the way a strict FMI host would.
+
+For each FMU (default: every ``.fmu`` in ``dist/``) it runs fmpy's validation and
+then checks what fmpy does not: a unit from ``<UnitDefinitions>`` on every Real, a
+description on every variable, the project as ``generationTool``, a
+DefaultExperiment, state save/restore declared; then it runs the FMU: a clean
+start and 20 steps with a silent log, a refused NaN input, step size 0, a wrong
+communication point and a ``doStep`` before initialization (each fmi2Discard
+with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and
+its ``libtbb12`` are installed, a run in that C++ engine with a bare environment.
+Prints the problems and exits 1 if there are any.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from arcosim.build.builder import ensure_built
+from arcosim.errors import UserError
+from arcosim.host.validate import validate
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``arcosim validate``."""
+    p = subparsers.add_parser(
+        "validate", help="check built FMUs for FMI compliance and behaviour", description=__doc__
+    )
+    p.add_argument(
+        "fmus",
+        nargs="*",
+        type=Path,
+        help="FMU files (default: the FMUs for 3 masses in the per-user cache, built if needed)",
+    )
+    p.set_defaults(execute=_execute)
+
+
+def _execute(args: argparse.Namespace) -> int:
+    fmus = args.fmus or sorted(ensure_built(3).glob("*.fmu"))
+    failed = 0
+    for fmu in fmus:
+        if not fmu.is_file():
+            raise UserError(f"{fmu}: no such file")
+        problems, notes = validate(fmu)
+        print(f"{fmu}: {'OK' if not problems else f'{len(problems)} problem(s)'}")
+        for line in problems:
+            print(f"  problem: {line}")
+        for line in notes:
+            print(f"  note: {line}")
+        failed += bool(problems)
+    return 1 if failed else 0

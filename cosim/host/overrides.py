@@ -1,0 +1,84 @@
+"""Parameter overrides named by FMU and variable: ``plant.k[2]=0.2``, ``observer.g_dist=200``.
+
+Values are typed from the FMU's model description (Real, Integer, Boolean), and an
+unknown name is refused with the names that come closest.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Iterable, Mapping
+
+from arcosim.errors import UserError
+
+Value = float | int | bool | str
+
+
+def parse_assignment(text: str) -> tuple[str, str]:
+    """``"NAME=VALUE"`` → ``(NAME, VALUE)``; refuses text without ``=``."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise UserError(f"--set {text!r}: write NAME=VALUE, e.g. observer.g_dist=200")
+    return name.strip(), value.strip()
+
+
+def typed_value(name: str, text: str, vtype: str) -> Value:
+    """Convert ``text`` to the FMI type ``vtype`` of variable ``name``."""
+    if vtype == "String":
+        return text
+    try:
+        if vtype == "Boolean":
+            lowered = text.lower()
+            if lowered in ("1", "true", "yes", "on"):
+                return True
+            if lowered in ("0", "false", "no", "off"):
+                return False
+            raise ValueError
+        if vtype == "Integer":
+            return int(text)
+        value = float(text)
+    except ValueError:
+        kind = {"Boolean": "true or false", "Integer": "a whole number"}.get(vtype, "a number")
+        raise UserError(f"{name}={text}: {name} takes {kind}") from None
+    if not math.isfinite(value):
+        raise UserError(f"{name}={text}: {name} must be a finite number")
+    return value
+
+
+def check_name(name: str, variables: Mapping[str, object], fmu: str) -> None:
+    """Raise :class:`UserError` naming close matches if ``name`` is not a variable of ``fmu``."""
+    if name in variables:
+        return
+    close = difflib.get_close_matches(name, list(variables), n=4, cutoff=0.5)
+    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+    raise UserError(f"{fmu} has no variable {name!r}{hint}")
+
+
+def split_overrides(
+    assignments: Iterable[str], fmus: Mapping[str, Mapping[str, object]]
+) -> dict[str, dict[str, Value]]:
+    """Sort ``fmu.name=value`` assignments by FMU, typed and checked.
+
+    Args:
+        assignments: texts such as ``"plant.k[2]=0.2"``.
+        fmus: for each FMU prefix (``"plant"``, ``"observer"``), its variables by
+            name (fmpy ``ScalarVariable`` objects, which carry ``type`` and ``causality``).
+    """
+    result: dict[str, dict[str, Value]] = {prefix: {} for prefix in fmus}
+    for text in assignments:
+        qualified, value = parse_assignment(text)
+        prefix, dot, name = qualified.partition(".")
+        if not dot or prefix not in fmus:
+            raise UserError(
+                f"--set {text!r}: name the FMU first: {', '.join(p + '.NAME' for p in fmus)}"
+            )
+        variables = fmus[prefix]
+        check_name(name, variables, prefix)
+        var = variables[name]
+        if var.causality != "parameter":
+            raise UserError(
+                f"--set {text!r}: {prefix}.{name} is an {var.causality}, not a parameter"
+            )
+        result[prefix][name] = typed_value(qualified, value, var.type)
+    return result

@@ -1,0 +1,126 @@
+"""``arcosim identify LOG.csv``: drive the observer FMU with a recorded log.
+
+Contract (scripts rely on it)::
+
+    arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
+                             [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
+                             [--method observer|output-error|whole-chain]
+                             [--fit-inertia-scale] [--start-k K]
+
+* the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
+  converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
+  of shared/METHOD.md); the step may vary, and the observer gets the step taken;
+* ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
+* ``--json``: one JSON object, the final value of every observer output keyed by its
+  FMU name (Booleans as true/false);
+* ``--out FILE``: every output over time as CSV (``time`` first).
+* ``--method output-error``: instead of replaying the observer FMU, fit the uniform
+  chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
+  from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
+  observer's parameters (``--set``: J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, J[i]) say
+  what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
+  standard errors under ``std``, and the evidence (start, residual, velocity used).
+  Needs a constant sample step.
+* ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
+  damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
+  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, encoder_cpr: with counts, the fit is refined
+  from the current to the encoder). ``--masses auto`` reads the number of
+  masses from the record. ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
+  own parameter names: pass them back with ``--set`` in mode 2), their standard errors
+  under ``std``, and the evidence (modes seen, singular values, criterion per n).
+  Needs a constant sample step and an excitation that rings every mode (``arcosim
+  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
+
+A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
+error naming the row or column, and exit status 2.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from arcosim.errors import UserError
+from arcosim.host.instance import FmuInstance
+from arcosim.host.master import MEASURED, Recording
+from arcosim.host.overrides import check_name, parse_assignment, typed_value
+from arcosim.logs import DriveLog
+
+
+def replay_log(
+    observer: FmuInstance,
+    log: DriveLog,
+    parameters: Mapping[str, float | int | bool] | None = None,
+    outputs: Sequence[str] | None = None,
+) -> Recording:
+    """Feed every sample of ``log`` to a fresh observer instance; record ``outputs``.
+
+    The first row is the initial sample (set before initialization); row k ends the
+    step from row k−1, so ``doStep(t_{k−1}, t_k − t_{k−1})`` receives it, as with a
+    Gauss–Seidel master.
+
+    Returns:
+        The recording, one sample per log row, signals named ``"observer.<name>"``.
+    """
+    if outputs is None:
+        outputs = output_names(observer)
+    write = observer.real_writer(list(MEASURED))
+    read = observer.reader(outputs)
+    inputs = np.column_stack([log.columns[c] for c in MEASURED])
+    t = log.time
+    write(list(inputs[0]))
+    observer.initialize(parameters, float(t[0]))
+    samples = np.empty((len(t), len(outputs)))
+    samples[0] = read()
+    for k in range(1, len(t)):
+        write(list(inputs[k]))
+        status = observer.do_step(float(t[k - 1]), float(t[k] - t[k - 1]))
+        if status > 1:
+            raise UserError(
+                f"{log.path}, sample at t = {t[k]!r} s: the observer refused it: "
+                + (observer.messages[-1] if observer.messages else f"status {status}")
+            )
+        samples[k] = read()
+    recording = Recording(time=t.copy())
+    for j, name in enumerate(outputs):
+        recording.signals[f"observer.{name}"] = samples[:, j]
+    return recording
+
+
+def output_names(fmu: FmuInstance) -> list[str]:
+    """Every output of ``fmu``, in value-reference order."""
+    return [v.name for v in fmu.description.modelVariables if v.causality == "output"]
+
+
+def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer") -> dict:
+    """Last value of every recorded output, typed as JSON likes it."""
+    result = {}
+    for key, series in recording.signals.items():
+        name = key.split(".", 1)[1]
+        vtype = fmu.variables[name].type
+        x = series[-1]
+        result[name] = bool(x) if vtype == "Boolean" else int(x) if vtype == "Integer" else float(x)
+    return result
+
+
+def parameter_sets(variables: Mapping[str, object], assignments: Sequence[str]) -> dict:
+    """``--set`` texts (observer parameters, no prefix) as typed values, checked against
+    the observer's variables (anything with ``causality`` and ``type``, by name)."""
+    parameters: dict[str, float | int | bool] = {}
+    for text in assignments:
+        name, value = parse_assignment(text)
+        check_name(name, variables, "the observer")
+        var = variables[name]
+        if var.causality != "parameter":
+            raise UserError(f"--set {text!r}: {name} is an {var.causality}, not a parameter")
+        parameters[name] = typed_value(name, value, var.type)
+    return parameters
+
+
+def observer_parameters(fmu: FmuInstance, assignments: Sequence[str], mode: int | None) -> dict:
+    """``--set`` texts (observer parameters, no prefix) and ``--mode`` as typed values."""
+    parameters = parameter_sets(fmu.variables, assignments)
+    if mode is not None:
+        parameters["mode"] = mode
+    return parameters

@@ -1,0 +1,142 @@
+"""The SSP 1.0 system source → plant → observer: ``dist/ActionReaction.ssp``.
+
+:func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
+connectors, connections, a DefaultExperiment, and parameter sets bound inline per
+component, as ecos reads them). :func:`run_ssp` runs such a file with a fixed-step
+Jacobi master on fmpy, honouring its connections, a named parameter set and its
+DefaultExperiment — which ``fmpy.ssp.simulate_ssp`` does not (it ignores parameter
+bindings, LinearTransformation and DefaultExperiment, and needs every input
+connected). ``arcosim ssp FILE`` is the command line.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import zipfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+
+from arcosim.errors import UserError
+from arcosim.host.instance import FmuInstance
+from arcosim.host.master import Recording
+
+
+@dataclass
+class SspSystem:
+    """What :func:`read_ssp` found: FMU paths, connections, parameter sets, experiment."""
+
+    components: dict[str, Path]
+    connections: list[tuple[str, str, str, str]]
+    parameter_sets: dict[str, dict[str, dict[str, float | int | bool | str]]]
+    start: float = 0.0
+    stop: float = 10.0
+    folder: tempfile.TemporaryDirectory | None = field(default=None, repr=False)
+
+
+def read_ssp(path: Path) -> SspSystem:
+    """Unpack an SSP and read its structure (raises :class:`UserError` on bad files)."""
+    if not Path(path).is_file():
+        raise UserError(f"{path}: no such file")
+    folder = tempfile.TemporaryDirectory(prefix="arcosim_ssp_")
+    try:
+        with zipfile.ZipFile(path) as z:
+            z.extractall(folder.name)
+        root = ElementTree.parse(Path(folder.name) / "SystemStructure.ssd").getroot()
+    except (zipfile.BadZipFile, FileNotFoundError, ElementTree.ParseError) as error:
+        folder.cleanup()
+        raise UserError(f"{path}: not a readable SSP ({error})") from None
+    components, sets = {}, {}
+    for c in root.iterfind("{*}System/{*}Elements/{*}Component"):
+        components[c.get("name")] = Path(folder.name) / c.get("source")
+        for pset in c.iterfind(
+            "{*}ParameterBindings/{*}ParameterBinding/{*}ParameterValues/{*}ParameterSet"
+        ):
+            values = sets.setdefault(pset.get("name"), {}).setdefault(c.get("name"), {})
+            for p in pset.iterfind("{*}Parameters/{*}Parameter"):
+                typed = p[0]
+                values[p.get("name")] = _parse(typed.tag.split("}")[1], typed.get("value"))
+    connections = [
+        (x.get("startElement"), x.get("startConnector"), x.get("endElement"), x.get("endConnector"))
+        for x in root.iterfind("{*}System/{*}Connections/{*}Connection")
+    ]
+    experiment = root.find("{*}DefaultExperiment")
+    system = SspSystem(components, connections, sets, folder=folder)
+    if experiment is not None:
+        system.start = float(experiment.get("startTime", 0.0))
+        system.stop = float(experiment.get("stopTime", 10.0))
+    return system
+
+
+def run_ssp(
+    path: Path,
+    parameter_set: str | None = "bench",
+    stop: float | None = None,
+    h: float = 1e-3,
+    extra: Mapping[str, Mapping[str, float | int | bool | str]] | None = None,
+) -> Recording:
+    """Run an SSP with a Jacobi master: every step, each connection's input takes the
+    start's output at t, then every FMU steps from t to t + h.
+
+    Returns a recording of every output of every component (``"component.name"``).
+    """
+    system = read_ssp(path)
+    if parameter_set is not None and parameter_set not in system.parameter_sets:
+        known = ", ".join(system.parameter_sets) or "none"
+        raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
+    chosen = system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
+    stop = system.stop if stop is None else stop
+    steps = round((stop - system.start) / h)
+    instances = {name: FmuInstance(fmu, name) for name, fmu in system.components.items()}
+    try:
+        for name, fmu in instances.items():
+            fmu.initialize({**chosen.get(name, {}), **(extra or {}).get(name, {})}, system.start)
+        links = [
+            (instances[a].reader([ca]), instances[b].real_writer([cb]))
+            for a, ca, b, cb in system.connections
+        ]
+        readers = {
+            name: (
+                fmu.reader(
+                    outs := [
+                        v.name for v in fmu.description.modelVariables if v.causality == "output"
+                    ]
+                ),
+                outs,
+            )
+            for name, fmu in instances.items()
+        }
+        logs = {name: np.empty((steps + 1, len(outs))) for name, (_, outs) in readers.items()}
+        for name, (read, _) in readers.items():
+            logs[name][0] = read()
+        for k in range(steps):
+            t = system.start + k * h
+            for read, write in links:
+                write(read())
+            for name, fmu in instances.items():
+                if fmu.do_step(t, h) > 1:
+                    raise UserError(f"{name} refused the step at t = {t!r} s: {fmu.messages[-1:]}")
+            for name, (read, _) in readers.items():
+                logs[name][k + 1] = read()
+    finally:
+        for fmu in instances.values():
+            fmu.close()
+        system.folder.cleanup()
+    recording = Recording(time=system.start + np.arange(steps + 1) * h)
+    for name, (_, outs) in readers.items():
+        for j, out in enumerate(outs):
+            recording.signals[f"{name}.{out}"] = logs[name][:, j]
+    return recording
+
+
+def _parse(kind: str, text: str) -> float | int | bool | str:
+    if kind == "Boolean":
+        return text in ("true", "1")
+    if kind == "Integer":
+        return int(text)
+    if kind == "String":
+        return text
+    return float(text)

@@ -1,0 +1,149 @@
+"""``arcosim validate [FMU ...]``: check built FMUs the way a strict FMI host would.
+
+For each FMU (default: every ``.fmu`` in ``dist/``) it runs fmpy's validation and
+then checks what fmpy does not: a unit from ``<UnitDefinitions>`` on every Real, a
+description on every variable, the project as ``generationTool``, a
+DefaultExperiment, state save/restore declared; then it runs the FMU: a clean
+start and 20 steps with a silent log, a refused NaN input, step size 0, a wrong
+communication point and a ``doStep`` before initialization (each fmi2Discard
+with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and
+its ``libtbb12`` are installed, a run in that C++ engine with a bare environment.
+Prints the problems and exits 1 if there are any.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree
+
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
+
+from arcosim.host.ecos import ecos_binary, run_ecos
+from arcosim.host.instance import FmuInstance
+
+
+def check_model_description(fmu: Path) -> list[str]:
+    """Problems with the model description beyond fmpy's own validation."""
+    with zipfile.ZipFile(fmu) as z:
+        root = ElementTree.fromstring(z.read("modelDescription.xml"))
+    problems = []
+    if not (root.get("generationTool") or "").startswith("arcosim"):
+        problems.append(f"generationTool is {root.get('generationTool')!r}, not arcosim")
+    if root.find("DefaultExperiment") is None:
+        problems.append("no DefaultExperiment")
+    cs = root.find("CoSimulation")
+    for flag in ("canGetAndSetFMUstate", "canSerializeFMUstate"):
+        if cs is None or cs.get(flag) != "true":
+            problems.append(f"CoSimulation does not declare {flag}=true")
+    units = {u.get("name") for u in root.iter("Unit")}
+    for sv in root.iter("ScalarVariable"):
+        name = sv.get("name")
+        if not sv.get("description"):
+            problems.append(f"{name}: no description")
+        real = sv.find("Real")
+        if real is not None and real.get("unit") not in units:
+            problems.append(f"{name}: unit {real.get('unit')!r} is missing or undefined")
+    return problems
+
+
+def check_runtime(fmu: Path) -> list[str]:
+    """Run the FMU in fmpy: happy path, refused misuse, state round trip."""
+    problems: list[str] = []
+    with FmuInstance(fmu, "validate") as instance:
+        real_inputs = [
+            v.name
+            for v in instance.description.modelVariables
+            if v.causality == "input" and v.type == "Real"
+        ]
+        outputs = [v.name for v in instance.description.modelVariables if v.causality == "output"]
+        read = instance.reader(outputs)
+        if _status(lambda: instance.slave.doStep(0.0, 1e-3)) != 2:
+            problems.append("doStep before initialization was not refused with fmi2Discard")
+        clean_start = len(instance.messages)
+        instance.initialize()
+        for k in range(20):
+            if instance.do_step(k * 1e-3, 1e-3) != 0:
+                problems.append(f"step {k} of a clean run failed: {instance.messages[-1:]}")
+                break
+        values = read()
+        if not all(math.isfinite(x) for x in values):
+            problems.append("an output is not finite after a clean run")
+        if instance.messages[clean_start:]:
+            said = instance.messages[clean_start:][:3]
+            problems.append(f"the log is not silent on a clean run: {said}")
+        t = 20e-3
+        misuse = (
+            [
+                (
+                    "a NaN input",
+                    lambda: instance.set({real_inputs[0]: math.nan}),
+                    t,
+                    1e-3,
+                    f"input {real_inputs[0]} = nan",
+                ),
+                (
+                    "step size 0",
+                    lambda: instance.set({real_inputs[0]: 0.0}),
+                    t,
+                    0.0,
+                    "step size 0.0",
+                ),
+                ("a wrong communication point", lambda: None, t + 5.0, 1e-3, "communication point"),
+            ]
+            if real_inputs
+            else []
+        )
+        for what, prepare, when, h, phrase in misuse:
+            prepare()
+            before = len(instance.messages)
+            status = instance.do_step(when, h)
+            said = " ".join(instance.messages[before:])
+            if status != 2 or phrase not in said:
+                problems.append(f"{what} gave status {status} and log {said!r}")
+        state = instance.slave.getFMUstate()
+        first = [_step_read(instance, t + k * 1e-3, read) for k in range(10)]
+        instance.slave.setFMUstate(state)
+        again = [_step_read(instance, t + k * 1e-3, read) for k in range(10)]
+        instance.slave.freeFMUstate(state)
+        if first != again:
+            problems.append("get state / step / set state / step did not repeat the outputs")
+    return problems
+
+
+def check_ecos(fmu: Path) -> tuple[list[str], str | None]:
+    """Run the FMU alone in ecos with a bare environment: (problems, why skipped)."""
+    binary, why_not = ecos_binary()
+    if binary is None:
+        return [], why_not
+    with tempfile.TemporaryDirectory(prefix="arcosim_ecos_") as tmp:
+        result = run_ecos(binary, fmu, Path(tmp), stop=0.02, timeout=120)
+        if result.returncode != 0 or not list(Path(tmp).glob("*.csv")):
+            return [f"ecos (C++ host) failed with exit {result.returncode}"], None
+    return [], None
+
+
+def validate(fmu: Path) -> tuple[list[str], list[str]]:
+    """All problems of one FMU, and notes on checks that could not run."""
+    problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
+    problems += check_model_description(fmu)
+    problems += check_runtime(fmu)
+    ecos_problems, skipped = check_ecos(fmu)
+    problems += ecos_problems
+    return problems, [f"ecos run skipped: {skipped}"] if skipped else []
+
+
+def _status(call) -> int:
+    try:
+        call()
+    except FMICallException as error:
+        return error.status
+    return 0
+
+
+def _step_read(instance: FmuInstance, t: float, read) -> list[float]:
+    instance.do_step(t, 1e-3)
+    return read()

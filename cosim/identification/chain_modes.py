@@ -1,0 +1,77 @@
+"""A load chain and its driving-point modes, both ways (pure algebra, offline).
+
+With the motor held still, the load chain (inertias J_1 … J_n, kg·m²; springs k_1 …
+k_n, N·m/rad, k_1 from the motor to J_1) rings at its clamped frequencies p_i (rad/s).
+Undamped, the reaction torque it puts on a motor that moves by θ_m is
+
+    τ(s) / θ_m(s) = k_1 − Σ_i r_i / (s² + p_i²),   r_i = k_1² φ_{1i}² > 0,
+
+with φ_i the mass-normalized mode shapes. The 2n numbers (p_i, r_i) fix the chain
+(k_1 = Σ r_i / p_i², J_1 = k_1² / Σ r_i, and the Lanczos recursion rebuilds the
+mass-normalized stiffness matrix from its eigenvalues p_i² and first components;
+Gladwell, *Inverse Problems in Vibration*, ch. 4). Any p_i > 0 distinct and r_i > 0
+give a physical chain: every J_i and k_i positive.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from arcosim.fmu.flexchain.chain import spring_matrix
+
+
+def driving_point_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Clamped frequencies p (rad/s) and residues r (N·m/rad·s⁻²) of the chain, shape (n,)."""
+    root = np.sqrt(np.asarray(J, dtype=float))
+    K = np.array(spring_matrix([float(x) for x in k]))[1:, 1:]  # motor held still
+    eigenvalues, shapes = np.linalg.eigh(K / root[:, None] / root[None, :])
+    first = shapes[0] / root[0]  # φ_{1i}
+    return np.sqrt(eigenvalues), float(k[0]) ** 2 * first**2
+
+
+def chain_from_modes(p: Sequence[float], r: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The chain ``(J, k)`` (kg·m², N·m/rad; shape (n,) each) with clamped frequencies
+    ``p`` (rad/s, distinct, > 0) and residues ``r`` (> 0).
+
+    Raises:
+        ValueError: for non-positive or repeated frequencies, or non-positive residues.
+    """
+    p = np.asarray(p, dtype=float)
+    r = np.asarray(r, dtype=float)
+    if p.shape != r.shape or p.ndim != 1 or len(p) == 0:
+        raise ValueError(f"need as many frequencies as residues, got {p.shape} and {r.shape}")
+    if np.any(~np.isfinite(p)) or np.any(p <= 0) or np.any(~np.isfinite(r)) or np.any(r <= 0):
+        raise ValueError(f"frequencies and residues must be finite and > 0, got {p}, {r}")
+    if len(np.unique(p)) < len(p):
+        raise ValueError(f"the clamped frequencies must be distinct, got {p}")
+    k1 = float(np.sum(r / p**2))
+    J1 = k1**2 / float(np.sum(r))
+    diagonal, coupling = _lanczos(p**2, np.sqrt(r / np.sum(r)))
+    T = np.diag(diagonal) - np.diag(coupling, 1) - np.diag(coupling, -1)
+    first = np.zeros(len(p))
+    first[0] = 1.0
+    root_J = (k1 / np.sqrt(J1)) * np.linalg.solve(T, first)  # √J_i: the static deflection
+    k = [k1] + [coupling[i] * root_J[i] * root_J[i + 1] for i in range(len(p) - 1)]
+    return root_J**2, np.array(k)
+
+
+def _lanczos(eigenvalues: np.ndarray, first: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobi matrix (diagonal, shape (n,); off-diagonal magnitudes, shape (n−1,)) with
+    the given eigenvalues and unit first-component vector (full reorthogonalization)."""
+    n = len(eigenvalues)
+    basis = np.zeros((n, n))
+    diagonal, coupling = np.zeros(n), np.zeros(n - 1)
+    q, previous, beta = first / np.linalg.norm(first), np.zeros(n), 0.0
+    for j in range(n):
+        basis[:, j] = q
+        z = eigenvalues * q
+        diagonal[j] = q @ z
+        z = z - diagonal[j] * q - beta * previous
+        z -= basis[:, : j + 1] @ (basis[:, : j + 1].T @ z)
+        if j < n - 1:
+            beta = float(np.linalg.norm(z))
+            coupling[j] = beta
+            previous, q = q, z / beta
+    return diagonal, coupling

@@ -1,0 +1,205 @@
+"""``arcosim sweep SPEC.toml``: Monte Carlo and grid sweeps of co-simulations on Dask.
+
+    arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
+
+The spec (format in :mod:`cosim.sweep_spec`) names the scenario, the parameters to
+vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of
+runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of
+``--workers`` processes runs here; with it the same tasks go to that cluster. Each run
+is a task that builds nothing: the FMUs are built once and shipped as bytes. Rows are
+appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
+finished run and ``--resume`` runs only the others; a failed run records its error and
+the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
+parameter and the PNGs the error histograms and the errors against each parameter
+(:mod:`cosim.sweep_summary`).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import hashlib
+import tempfile
+import time
+import traceback
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from arcosim.build.builder import ensure_built, fmu_variables
+from arcosim.build.recipes import OBSERVER, PLANT
+from arcosim.errors import UserError
+from arcosim.experiments.metrics import flexible_score, percent_error
+from arcosim.host.overrides import typed_value
+from arcosim.sweeps.spec import SweepSpec, check_names, draw_runs, load_spec, metric_columns
+from arcosim.sweeps.summary import complete, read_results, write_summary
+
+__all__ = ["draw_runs", "load_spec", "read_results", "run_one", "sweep"]
+
+
+def run_one(
+    run: int, values: Mapping[str, object], spec: SweepSpec, blobs: Mapping[str, bytes]
+) -> dict:
+    """One co-simulation (a Dask task): returns its row, with ``error`` set on failure."""
+    row: dict[str, object] = {"run": run, **values}
+    start = time.perf_counter()
+    try:
+        folder = _materialize(blobs)
+        row.update(_metrics(spec, folder, values))
+        row["error"] = ""
+    except Exception as error:  # a failed run is recorded, the sweep goes on
+        text = " | ".join(line.strip() for line in str(error).splitlines() if line.strip())
+        row["error"] = f"{type(error).__name__}: {text}"[:400]
+        if not isinstance(error, UserError):
+            row["error"] += " | " + traceback.format_exc(limit=1).strip().splitlines()[-1][:200]
+    if "runtime" in spec.metrics:
+        row["runtime"] = time.perf_counter() - start
+    return row
+
+
+def _materialize(blobs: Mapping[str, bytes]) -> Path:
+    """Write the shipped FMUs once per worker machine, into a folder named by their hash."""
+    digest = hashlib.sha256(b"".join(blobs[k] for k in sorted(blobs))).hexdigest()[:16]
+    folder = Path(tempfile.gettempdir()) / f"arcosim_sweep_{digest}"
+    if not all((folder / name).is_file() for name in blobs):
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, data in blobs.items():
+            part = folder / f"{name}.{time.time_ns()}.part"
+            part.write_bytes(data)
+            part.replace(folder / name)
+    return folder
+
+
+def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dict[str, float]:
+    from arcosim.experiments.scenarios import SCENARIOS, run_scenario
+    from arcosim.fmu.flexchain import bench
+
+    settings = {**spec.fixed, **values}
+    variables = fmu_variables(folder)
+    typed: dict[str, dict[str, object]] = {"plant": {}, "observer": {}}
+    for qualified, value in settings.items():
+        fmu, name = qualified.split(".", 1)
+        typed[fmu][name] = typed_value(qualified, str(value), variables[fmu][name].type)
+    scenario = SCENARIOS[spec.scenario]
+    if spec.duration is not None:
+        scenario = dataclasses.replace(scenario, duration=spec.duration)
+    n = spec.masses
+    record_plant = ["theta_m_true", *(f"theta[{i}]" for i in range(1, n + 1))]
+    record_observer = [
+        "k_hat",
+        "B_hat",
+        "D_m_hat",
+        "f_c_hat",
+        *(f"theta_hat[{i}]" for i in range(1, n + 1)),
+    ]
+    every_step = "theta_error" in spec.metrics  # scores need the whole record
+    r = run_scenario(
+        scenario,
+        n,
+        typed["plant"],
+        typed["observer"],
+        h=spec.step,
+        ideal=spec.ideal,
+        record_plant=record_plant,
+        record_observer=record_observer,
+        fmu_dir=folder,
+        record_every=1 if every_step else 10**9,
+    )
+    plant = typed["plant"]
+
+    out: dict[str, float] = {}
+    for metric in spec.metrics:
+        if metric == "k_error":
+            out[metric] = percent_error(r["observer.k_hat"][-1], plant.get("k[1]", bench.K))
+        elif metric == "B_error":
+            out[metric] = percent_error(r["observer.B_hat"][-1], plant.get("B[1]", bench.B))
+        elif metric == "D_m_error":
+            out[metric] = percent_error(r["observer.D_m_hat"][-1], plant.get("D_m", bench.D_M))
+        elif metric == "f_c_error":
+            out[metric] = percent_error(r["observer.f_c_hat"][-1], plant.get("f_c", bench.F_C))
+        elif metric == "theta_error":
+            motor = r["plant.theta_m_true"]
+            for i in range(1, n + 1):
+                truth = r[f"plant.theta[{i}]"]
+                est = r[f"observer.theta_hat[{i}]"]
+                out[f"theta_error[{i}]"] = flexible_score(est, truth, motor)
+    return out
+
+
+def sweep(
+    spec: SweepSpec,
+    out: Path,
+    scheduler: str | None = None,
+    workers: int = 2,
+    resume: bool = False,
+    show_progress: bool = True,
+    fmu_dir: Path | None = None,
+) -> Path:
+    """Run the sweep; return the results CSV (see module doc)."""
+    folder = ensure_built(spec.masses, fmu_dir)
+    fmus = {f"{r.name}.fmu": folder / f"{r.name}.fmu" for r in (PLANT, OBSERVER)}
+    variables = fmu_variables(folder)
+    check_names(spec, variables)
+    runs = draw_runs(spec)
+    columns = ["run", *spec.vary, *metric_columns(spec), "error"]
+    out.mkdir(parents=True, exist_ok=True)
+    results = out / "results.csv"
+    done = _finished_runs(results, columns) if resume else set()
+    if results.exists() and not resume:
+        raise UserError(
+            f"{results} exists: add --resume to finish that sweep, or choose another --out"
+        )
+    pending = [(i, v) for i, v in enumerate(runs) if i not in done]
+    blobs = {name: path.read_bytes() for name, path in fmus.items()}
+    if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
+        with open(results, "a", encoding="utf-8") as f:
+            f.write("\n")  # an interrupted write: keep its partial line apart
+    with open(results, "a", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        if not done:
+            writer.writeheader()
+            f.flush()
+        if pending:
+            _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress)
+    write_summary(spec, results, out)
+    return results
+
+
+def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress) -> None:
+    from dask.distributed import Client, LocalCluster, as_completed
+    from tqdm import tqdm
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
+        )
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(scheduler, timeout=20)
+        except OSError as error:
+            raise UserError(f"--scheduler {scheduler}: cannot connect ({error})") from None
+    try:
+        shipped = client.scatter(blobs, broadcast=True)
+        futures = [client.submit(run_one, i, v, spec, shipped, pure=False) for i, v in pending]
+        with tqdm(total=len(futures), unit="run", disable=not show_progress, desc=spec.name) as bar:
+            for future in as_completed(futures):
+                writer.writerow(future.result())
+                f.flush()
+                bar.update(1)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _finished_runs(results: Path, columns: Sequence[str]) -> set[int]:
+    if not results.exists():
+        return set()
+    with open(results, newline="", encoding="utf-8") as f:
+        reader = csv.DictReader(f)
+        if reader.fieldnames != list(columns):
+            raise UserError(
+                f"{results} was written by another spec (columns differ); choose another --out"
+            )
+        return {int(row["run"]) for row in reader if complete(row)}

@@ -1,0 +1,109 @@
+"""The summary of a sweep: metric quantiles per varied parameter, and plots."""
+
+from __future__ import annotations
+
+import csv
+import itertools
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from arcosim.sweeps.spec import SweepSpec, metric_columns
+
+
+def complete(row: Mapping[str, str | None]) -> bool:
+    """A row written in full (an interrupted write leaves a short last line)."""
+    return row.get("error") is not None and (row.get("run") or "").strip().isdigit()
+
+
+def read_results(results: Path) -> list[dict[str, str]]:
+    """The rows of a results CSV, one per finished run (a cut-off last line is left out)."""
+    with open(results, newline="", encoding="utf-8") as f:
+        return [row for row in csv.DictReader(f) if complete(row)]
+
+
+def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
+    """``summary.md`` (metric quantiles per varied parameter) and PNG plots."""
+    from arcosim.experiments.report import markdown_table
+
+    rows = read_results(results)
+    ok = [r for r in rows if not r["error"]]
+    metrics = metric_columns(spec)
+    lines = [
+        f"# Sweep {spec.name}: {len(rows)} runs, {len(rows) - len(ok)} failed",
+        "",
+        f"Scenario `{spec.scenario}`, n = {spec.masses}, seed {spec.seed}. "
+        "Quantiles 5 % / 50 % / 95 % of each metric.",
+        "",
+    ]
+    table = []
+    for metric in metrics:
+        x = np.array([float(r[metric]) for r in ok if r.get(metric)])
+        if x.size:
+            table.append(
+                ["all runs", metric, x.size, *(f"{q:.4g}" for q in np.percentile(x, [5, 50, 95]))]
+            )
+        for name in spec.vary:
+            for label, members in _groups(ok, name):
+                y = np.array([float(r[metric]) for r in members if r.get(metric)])
+                if y.size:
+                    table.append(
+                        [
+                            f"{name} {label}",
+                            metric,
+                            y.size,
+                            *(f"{q:.4g}" for q in np.percentile(y, [5, 50, 95])),
+                        ]
+                    )
+    lines.append(markdown_table(["runs", "metric", "count", "p5", "p50", "p95"], table))
+    failures = [r for r in rows if r["error"]]
+    if failures:
+        lines += ["", "Failed runs:", ""] + [
+            f"- run {r['run']}: {r['error']}" for r in failures[:20]
+        ]
+    lines += [
+        "",
+        *(f"![{m}]({_plot(spec, ok, m, out).name})" for m in metrics if any(r.get(m) for r in ok)),
+    ]
+    summary = out / "summary.md"
+    summary.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return summary
+
+
+def _groups(rows: list[dict[str, str]], name: str) -> list[tuple[str, list[dict[str, str]]]]:
+    values = sorted({float(r[name]) for r in rows})
+    if len(values) <= 8:
+        return [(f"= {v:g}", [r for r in rows if float(r[name]) == v]) for v in values]
+    edges = np.percentile([float(r[name]) for r in rows], [0, 25, 50, 75, 100])
+    groups = []
+    for lo, hi in itertools.pairwise(edges):
+        members = [r for r in rows if lo <= float(r[name]) <= hi]
+        groups.append((f"in [{lo:.3g}, {hi:.3g}]", members))
+    return groups
+
+
+def _plot(spec: SweepSpec, rows: list[dict[str, str]], metric: str, out: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(spec.vary)
+    fig, axes = plt.subplots(1, 1 + len(names), figsize=(4 * (1 + len(names)), 3.4), squeeze=False)
+    y = np.array([float(r[metric]) for r in rows if r.get(metric)])
+    axes[0, 0].hist(y, bins=min(30, max(5, len(y) // 5)))
+    axes[0, 0].set_xlabel(metric)
+    axes[0, 0].set_ylabel("runs")
+    for ax, name in zip(axes[0, 1:], names):
+        x = np.array([float(r[name]) for r in rows if r.get(metric)])
+        ax.plot(x, y, ".", alpha=0.6)
+        ax.set_xlabel(name)
+        ax.set_ylabel(metric)
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(f"{spec.name}: {metric} ({len(y)} runs)")
+    fig.tight_layout()
+    path = out / f"{metric.replace('[', '_').replace(']', '')}.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
