@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test build lint format clean
+.PHONY: demo test build docs lint format clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,7 +23,11 @@ test: build
 	$(BIN)/arcosim validate dist/*.fmu
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	$(BIN)/python -m mkdocs build --strict --quiet
 	$(BIN)/python -m pytest
+
+docs: $(STAMP)
+	$(BIN)/python -m mkdocs build --strict
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
@@ -34,4 +38,4 @@ format: $(STAMP)
 	$(BIN)/ruff check --fix .
 
 clean:
-	rm -rf dist reports build *.egg-info .pytest_cache .ruff_cache
+	rm -rf dist reports build .site .docs-src *.egg-info .pytest_cache .ruff_cache

@@ -1,8 +1,122 @@
-"""Co-simulation orchestration for the action-reaction toolkit (``arcosim``)."""
+"""arcosim — sensorless identification and state estimation of flexible drives.
 
-from importlib.metadata import PackageNotFoundError, version
+A motor drives a chain of inertias joined by springs (a robot joint, a belt drive,
+a multi-inertia test bench). From the motor's current and encoder alone, arcosim
+estimates the load disturbance, the reaction torque, every inertia, stiffness and
+damping of the chain, and the angle of every load mass (the action-reaction method
+of Khalil and Sabanovic; ``docs/method.md``). It ships the method as FMI 2.0
+co-simulation FMUs and this library on fmpy. Units are SI throughout: A, rad,
+rad/s, N·m, kg·m², N·m/rad, N·m·s/rad, s.
 
-try:
-    __version__ = version("arcosim")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0.0.0+unknown"
+Drive logs
+----------
+read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
+DriveLog            -- time (s) and the measured columns of a log, SI units
+write_csv           -- columns of equal length as a CSV file
+
+Identifying the chain from a log (numpy/scipy, no FMU needed)
+-------------------------------------------------------------
+Actuator            -- the motor's terms: J_mo, k_to, Δk_t, ΔJ, D_m, f_c
+motor_record        -- a log as the reaction-torque record the fits use
+encoder_record      -- a log as the current → encoder record of the refinement
+identify_whole_chain -- every J_i, k_i, B_i (and n) from the motor side
+uniform_chain       -- the paper's uniform chain: k and B by output error
+
+Scenarios and co-simulation
+---------------------------
+SCENARIOS           -- the named scenarios (selfid, rigid, flexible, identification, …)
+Scenario            -- a current command, a duration and FMU settings
+run_scenario        -- co-simulate plant + observer FMUs through one scenario
+cosimulate          -- the fixed-step master for two FMU instances
+FmuInstance         -- one FMU instance on fmpy, values by name
+Recording           -- time and recorded signals of a run
+replay_log          -- feed a drive log to the observer FMU
+run_ssp             -- run an SSP system (e.g. ActionReaction.ssp)
+
+Excitation signals (A, sampled at the step times)
+-------------------------------------------------
+multisine           -- a sum of sines with Schroeder phases
+rigid_maneuver      -- a slow sine under raised-cosine ramps (mode 1)
+chirp               -- a linear frequency sweep
+filtered_random     -- low-passed Gaussian noise
+
+Building and checking FMUs
+--------------------------
+build_all           -- build the three FMUs and their SSP into a folder
+ensure_built        -- the folder of current FMUs, built if needed (per-user cache)
+validate            -- FMI compliance and behaviour checks of an FMU file
+
+The paper
+---------
+reproduce           -- the paper's experiments and the report
+
+Errors
+------
+ArcosimError        -- base of every error arcosim raises for a user to fix
+UserError           -- a bad argument, file or datum
+BuildError          -- an FMU could not be built
+
+Every name above is importable from ``arcosim`` directly (loaded on first use, so
+``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
+``arcosim.host``, ``arcosim.build``, ``arcosim.experiments``, ``arcosim.sweeps``,
+``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
+
+Examples
+--------
+>>> import arcosim
+>>> arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406).k_to
+0.0406
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from arcosim.version import __version__
+
+#: Public name → the module that defines it.
+_API = {
+    "read_log": "arcosim.logs",
+    "DriveLog": "arcosim.logs",
+    "write_csv": "arcosim.logs",
+    "Actuator": "arcosim.fmu.flexchain.dob",
+    "motor_record": "arcosim.identification.output_error",
+    "encoder_record": "arcosim.identification.encoder_fit",
+    "identify_whole_chain": "arcosim.identification.whole_chain",
+    "uniform_chain": "arcosim.identification.output_error",
+    "SCENARIOS": "arcosim.experiments.scenarios",
+    "Scenario": "arcosim.experiments.scenarios",
+    "run_scenario": "arcosim.experiments.scenarios",
+    "cosimulate": "arcosim.host.master",
+    "FmuInstance": "arcosim.host.instance",
+    "Recording": "arcosim.host.master",
+    "replay_log": "arcosim.host.replay",
+    "run_ssp": "arcosim.host.ssp",
+    "multisine": "arcosim.experiments.excitation",
+    "rigid_maneuver": "arcosim.experiments.excitation",
+    "chirp": "arcosim.experiments.excitation",
+    "filtered_random": "arcosim.experiments.excitation",
+    "build_all": "arcosim.build.builder",
+    "ensure_built": "arcosim.build.builder",
+    "validate": "arcosim.host.validate",
+    "reproduce": "arcosim.experiments.reproduce",
+    "ArcosimError": "arcosim.errors",
+    "UserError": "arcosim.errors",
+    "BuildError": "arcosim.errors",
+}
+#: Where the public name differs from the defining module's name.
+_ALIASES = {"identify_whole_chain": "identify"}
+
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name: str) -> object:
+    if name not in _API:
+        raise AttributeError(f"module 'arcosim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_API[name]), _ALIASES.get(name, name))
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -19,7 +19,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from arcosim import __version__
+from arcosim.version import __version__
 from arcosim.build.cache import (
     DIGEST_FILE,
     default_folder,

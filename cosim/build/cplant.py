@@ -19,7 +19,7 @@ import zipfile
 from pathlib import Path
 from xml.etree.ElementTree import SubElement, tostring
 
-from arcosim import __version__
+from arcosim.version import __version__
 from arcosim.build.cache import plant_package_dir
 from arcosim.errors import BuildError
 

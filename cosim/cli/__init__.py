@@ -7,7 +7,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from arcosim import __version__
+from arcosim.version import __version__
 from arcosim.cli import bench, build, identify, reproduce, simulate, ssp, sweep, validate
 from arcosim.errors import UserError
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-from arcosim import __version__
+from arcosim.version import __version__
 from arcosim.build.builder import ensure_built, fmu_variables
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
