@@ -7,9 +7,9 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from arcosim.version import __version__
 from arcosim.cli import bench, build, identify, reproduce, simulate, ssp, sweep, validate
 from arcosim.errors import UserError
+from arcosim.version import __version__
 
 
 def make_parser() -> argparse.ArgumentParser:

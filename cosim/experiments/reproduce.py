@@ -26,7 +26,6 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-from arcosim.version import __version__
 from arcosim.build.builder import ensure_built, fmu_variables
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
@@ -46,6 +45,7 @@ from arcosim.identification.output_error import motor_record
 from arcosim.identification.whole_chain import Choice
 from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import write_csv
+from arcosim.version import __version__
 
 N_MASSES = 3
 SEEDS = (1, 2, 3, 4, 5)
