@@ -35,10 +35,10 @@ run_ssp             -- run an SSP system (e.g. ActionReaction.ssp)
 
 Excitation signals (A, sampled at the step times)
 -------------------------------------------------
-multisine           -- a sum of sines with Schroeder phases
+multisine           -- a sum of sines with random phases, scaled to a peak
 rigid_maneuver      -- a slow sine under raised-cosine ramps (mode 1)
 chirp               -- a linear frequency sweep
-filtered_random     -- low-passed Gaussian noise
+filtered_random     -- low-passed Gaussian noise of a given rms
 
 Building and checking FMUs
 --------------------------
@@ -46,15 +46,14 @@ build_all           -- build the three FMUs and their SSP into a folder
 ensure_built        -- the folder of current FMUs, built if needed (per-user cache)
 validate            -- FMI compliance and behaviour checks of an FMU file
 
-The paper
----------
-reproduce           -- the paper's experiments and the report
-
 Errors
 ------
 ArcosimError        -- base of every error arcosim raises for a user to fix
 UserError           -- a bad argument, file or datum
 BuildError          -- an FMU could not be built
+
+The paper's experiments and the report are the command ``arcosim reproduce``
+(:func:`arcosim.experiments.reproduce.reproduce`).
 
 Every name above is importable from ``arcosim`` directly (loaded on first use, so
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
@@ -99,7 +98,6 @@ _API = {
     "build_all": "arcosim.build.builder",
     "ensure_built": "arcosim.build.builder",
     "validate": "arcosim.host.validate",
-    "reproduce": "arcosim.experiments.reproduce",
     "ArcosimError": "arcosim.errors",
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",

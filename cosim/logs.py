@@ -23,13 +23,35 @@ LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
 
 @dataclass(frozen=True)
 class DriveLog:
-    """A checked log: ``time`` strictly increasing, every value finite, SI units."""
+    """A checked drive log: ``time`` strictly increasing, every value finite, SI units.
+
+    One row per sample, as the timing contract defines it (``docs/method.md``): the
+    angle and velocity at ``time`` and the current that acted over the step ending
+    at ``time``.
+
+    Parameters
+    ----------
+    path : Path
+        The file it was read from.
+    columns : dict of str to ndarray
+        ``time`` (s), ``i_a`` (A), ``omega_m`` (rad/s), ``theta_m`` (rad), each of
+        shape ``(N,)``.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> t = np.arange(3) * 1e-3
+    >>> log = arcosim.DriveLog(Path("x.csv"), {"time": t, "i_a": t, "omega_m": t, "theta_m": t})
+    >>> len(log), float(log.time[-1])
+    (3, 0.002)
+    """
 
     path: Path
     columns: dict[str, np.ndarray]
 
     @property
     def time(self) -> np.ndarray:
+        """Sample times (s), shape ``(N,)``."""
         return self.columns["time"]
 
     def __len__(self) -> int:
@@ -55,12 +77,38 @@ def parse_scales(texts: Iterable[str]) -> dict[str, float]:
 
 
 def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> DriveLog:
-    """Read and check a log; raise :class:`UserError` naming the row or column at fault.
+    """Read and check a drive log.
 
-    Args:
-        path: CSV file with a header row.
-        scales: factors that convert a column to SI (``{"i_a": 1e-3}`` for mA,
-            ``{"theta_m": 2 * pi / 4096}`` for counts).
+    Parameters
+    ----------
+    path : str or Path
+        CSV file with a header row naming at least ``time``, ``i_a``, ``omega_m``,
+        ``theta_m`` (other columns are ignored), one row per sample.
+    scales : mapping of str to float, optional
+        Factors that convert a column to SI units (dimensionless multipliers):
+        ``{"i_a": 1e-3}`` for mA, ``{"theta_m": 2 * pi / 4096}`` for counts.
+
+    Returns
+    -------
+    DriveLog
+        The log's columns in SI units (s, A, rad/s, rad).
+
+    Raises
+    ------
+    UserError
+        Naming the row or column at fault: no such file, an empty file, a missing
+        column, a cell that is not a finite number, time that does not increase,
+        fewer than two rows.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "log.csv"
+    >>> _ = path.write_text("time,i_a,omega_m,theta_m\\n0,0,0,0\\n0.001,0.5,0.1,0.0001\\n")
+    >>> log = arcosim.read_log(path, {"i_a": 1e-3})
+    >>> len(log), float(log.columns["i_a"][1])
+    (2, 0.0005)
     """
     path = Path(path)
     if not path.is_file():
@@ -116,7 +164,29 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
 
 
 def write_csv(path: str | Path, columns: Mapping[str, np.ndarray]) -> Path:
-    """Write equal-length columns as CSV with a header (full precision); return the path."""
+    """Write columns of equal length as a CSV file with a header, at full precision.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (its folder is created if needed).
+    columns : mapping of str to ndarray
+        Column name → values (any unit; the name should say it), each of shape ``(N,)``.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "out.csv"
+    >>> _ = arcosim.write_csv(path, {"time": np.array([0.0, 0.001]), "i_a": np.array([0.0, 0.5])})
+    >>> path.read_text().splitlines()[0]
+    'time,i_a'
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     names = list(columns)

@@ -66,8 +66,9 @@ def build_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
 
     Examples
     --------
+    >>> import tempfile
     >>> from arcosim.build.recipes import PLANT
-    >>> build_fmu(PLANT, 3, Path(tmp)).name  # doctest: +SKIP
+    >>> build_fmu(PLANT, 3, Path(tempfile.mkdtemp())).name
     'MotorChainPlant.fmu'
     """
     check_masses(n)
@@ -151,9 +152,12 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
 
     Examples
     --------
-    >>> paths = build_all(3, Path(tmp))  # doctest: +SKIP
-    >>> [p.name for p in paths]  # doctest: +SKIP
-    ['MotorChainPlant.fmu', 'ReactionTorqueObserver.fmu', 'ExcitationSource.fmu', 'ActionReaction.ssp']
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> paths = arcosim.build_all(2, Path(tempfile.mkdtemp()) / "fmus")
+    >>> [p.name for p in paths]  # doctest: +NORMALIZE_WHITESPACE
+    ['MotorChainPlant.fmu', 'ReactionTorqueObserver.fmu', 'ExcitationSource.fmu',
+     'ActionReaction.ssp']
     """
     check_masses(n)
     target = Path(out) if out is not None else default_folder(n)
@@ -193,8 +197,8 @@ def ensure_built(n: int = 3, folder: Path | None = None) -> Path:
 
     Examples
     --------
-    >>> folder = ensure_built(3)  # doctest: +SKIP
-    >>> (folder / "ReactionTorqueObserver.fmu").is_file()  # doctest: +SKIP
+    >>> folder = arcosim.ensure_built(3)
+    >>> (folder / "ReactionTorqueObserver.fmu").is_file()
     True
     """
     target = Path(folder) if folder is not None else default_folder(n)

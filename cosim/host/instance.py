@@ -100,16 +100,38 @@ class RealPort:
 
 
 class FmuInstance:
-    """An instantiated co-simulation FMU.
+    """An instantiated FMI 2.0 co-simulation FMU, driven through fmpy's FMI calls.
 
-    Args:
-        path: the ``.fmu`` file.
-        instance_name: name given to ``fmi2Instantiate`` (appears in log lines).
-        echo_log: also print every log line to stdout.
+    Variables are set and read by name (typed from the model description); the
+    FMU's log lines are collected; a refused step is a status, not an exception.
+    Use it as a context manager (``with FmuInstance(...) as fmu:``), or call
+    :meth:`close`.
 
-    Attributes:
-        messages: log lines received, as ``"status: message"``.
-        variables: model variables by name (fmpy ``ScalarVariable``).
+    Parameters
+    ----------
+    path : str or Path
+        The ``.fmu`` file.
+    instance_name : str
+        Name given to ``fmi2Instantiate`` (appears in log lines).
+    echo_log : bool
+        Also print every log line to standard output.
+
+    Attributes
+    ----------
+    messages : list of str
+        Log lines received, as ``"status: message"``.
+    variables : dict
+        Model variables by name (fmpy ``ScalarVariable``).
+
+    Examples
+    --------
+    >>> folder = arcosim.ensure_built(3)
+    >>> with arcosim.FmuInstance(folder / "MotorChainPlant.fmu", "plant") as plant:
+    ...     plant.initialize({"k[1]": 0.2})
+    ...     status = plant.do_step(0.0, 1e-3)  # 0 is fmi2OK
+    ...     values = plant.get(["k[1]", "theta_m"])
+    >>> status, values[0]
+    (0, 0.2)
     """
 
     def __init__(self, path: str | Path, instance_name: str = "instance", echo_log: bool = False):

@@ -54,14 +54,45 @@ def replay_log(
     parameters: Mapping[str, float | int | bool] | None = None,
     outputs: Sequence[str] | None = None,
 ) -> Recording:
-    """Feed every sample of ``log`` to a fresh observer instance; record ``outputs``.
+    """Feed every sample of a drive log to a fresh observer FMU instance.
 
     The first row is the initial sample (set before initialization); row k ends the
     step from row k−1, so ``doStep(t_{k−1}, t_k − t_{k−1})`` receives it, as with a
-    Gauss–Seidel master.
+    Gauss–Seidel master. The step may vary; the observer gets the step taken.
 
-    Returns:
-        The recording, one sample per log row, signals named ``"observer.<name>"``.
+    Parameters
+    ----------
+    observer : FmuInstance
+        A ReactionTorqueObserver instance, not yet initialized.
+    log : DriveLog
+        The samples (``time`` s, ``i_a`` A, ``omega_m`` rad/s, ``theta_m`` rad).
+    parameters : mapping of str to value, optional
+        Observer parameters by name (in each parameter's unit), e.g.
+        ``{"mode": 2, "k[1]": 0.16}``.
+    outputs : sequence of str, optional
+        Outputs to record (default: every output).
+
+    Returns
+    -------
+    Recording
+        One sample per log row, signals named ``"observer.<name>"``.
+
+    Raises
+    ------
+    UserError
+        When the observer refuses a sample (its log line is in the message).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> t = np.arange(200) * 1e-3
+    >>> log = arcosim.DriveLog(Path("synthetic.csv"), {
+    ...     "time": t, "i_a": np.full(200, 0.2), "omega_m": 10.0 * t, "theta_m": 5.0 * t**2})
+    >>> folder = arcosim.ensure_built(3)
+    >>> with arcosim.FmuInstance(folder / "ReactionTorqueObserver.fmu") as observer:
+    ...     run = arcosim.replay_log(observer, log, {"mode": 2}, ["d_hat"])
+    >>> run.signals["observer.d_hat"].shape
+    (200,)
     """
     if outputs is None:
         outputs = output_names(observer)

@@ -78,10 +78,42 @@ def run_ssp(
     h: float = 1e-3,
     extra: Mapping[str, Mapping[str, float | int | bool | str]] | None = None,
 ) -> Recording:
-    """Run an SSP with a Jacobi master: every step, each connection's input takes the
-    start's output at t, then every FMU steps from t to t + h.
+    """Run an SSP system with a fixed-step Jacobi master.
 
-    Returns a recording of every output of every component (``"component.name"``).
+    Every step, each connection's input takes its start's output at t, then every
+    FMU steps from t to t + h. Unlike ``fmpy.ssp.simulate_ssp``, the file's parameter
+    sets and DefaultExperiment are honoured.
+
+    Parameters
+    ----------
+    path : Path
+        The ``.ssp`` file (e.g. ``ActionReaction.ssp`` beside the built FMUs).
+    parameter_set : str or None
+        Name of the parameter set to apply (``None``: none).
+    stop : float, optional
+        Stop time (s); default: the file's DefaultExperiment.
+    h : float
+        Communication step (s).
+    extra : mapping, optional
+        More start values, ``{component: {variable: value}}`` (in each variable's
+        unit), applied after the parameter set.
+
+    Returns
+    -------
+    Recording
+        Every output of every component, named ``"component.variable"``.
+
+    Raises
+    ------
+    UserError
+        A missing or unreadable file, an unknown parameter set, a refused step.
+
+    Examples
+    --------
+    >>> folder = arcosim.ensure_built(3)
+    >>> run = arcosim.run_ssp(folder / "ActionReaction.ssp", "bench", stop=0.05)
+    >>> run.time.shape, "observer.tau_reac_hat" in run.signals
+    ((51,), True)
     """
     system = read_ssp(path)
     if parameter_set is not None and parameter_set not in system.parameter_sets:

@@ -127,7 +127,34 @@ def check_ecos(fmu: Path) -> tuple[list[str], str | None]:
 
 
 def validate(fmu: Path) -> tuple[list[str], list[str]]:
-    """All problems of one FMU, and notes on checks that could not run."""
+    """Check one FMU the way a strict FMI host would.
+
+    fmpy's validation, then what it does not check (units from
+    ``<UnitDefinitions>``, descriptions, generationTool, DefaultExperiment, state
+    support), then a run: a clean start and 20 steps with a silent log, refused bad
+    steps (NaN input, step size 0, a wrong communication point, a step before
+    initialization), a state round trip, and a run in the ecos C++ engine where
+    ``ecospy`` and its system library are installed.
+
+    Parameters
+    ----------
+    fmu : Path
+        The ``.fmu`` file.
+
+    Returns
+    -------
+    problems : list of str
+        Every problem found, one sentence each (empty: none).
+    notes : list of str
+        Checks that could not run here, and why.
+
+    Examples
+    --------
+    >>> folder = arcosim.ensure_built(3)
+    >>> problems, notes = arcosim.validate(folder / "MotorChainPlant.fmu")
+    >>> problems
+    []
+    """
     problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
     problems += check_model_description(fmu)
     problems += check_runtime(fmu)

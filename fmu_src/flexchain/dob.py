@@ -29,15 +29,31 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Actuator:
-    """Nominal and identified actuator terms.
+    """The motor's terms: nominal values and the identified corrections.
 
-    Attributes:
-        J_mo: nominal motor inertia (kg·m²).
-        k_to: nominal torque constant (N·m/A).
-        dkt: k_t − k_to (N·m/A).
-        dJm: J_m − J_mo (kg·m²).
-        D_m: motor viscous friction (N·m·s/rad).
-        f_c: motor Coulomb friction (N·m).
+    The disturbance observer uses the nominal model ``J_mo θ̈_m = k_to i_a − d``; the
+    reaction torque observer removes the identified terms (eq. 16).
+
+    Parameters
+    ----------
+    J_mo : float
+        Nominal motor inertia (kg·m²), e.g. from the datasheet.
+    k_to : float
+        Nominal torque constant (N·m/A).
+    dkt : float
+        k_t − k_to (N·m/A).
+    dJm : float
+        J_m − J_mo (kg·m²).
+    D_m : float
+        Motor viscous friction (N·m·s/rad).
+    f_c : float
+        Motor Coulomb friction (N·m).
+
+    Examples
+    --------
+    >>> motor = arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406, D_m=2e-5, f_c=2e-3)
+    >>> motor.J_mo + motor.dJm, motor.k_to + motor.dkt
+    (2.09e-05, 0.0406)
     """
 
     J_mo: float
