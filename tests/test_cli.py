@@ -68,6 +68,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         "fig4_reaction_torque.png",
         "fig5_flexible_response.png",
         "fig6_state_estimates.png",
+        "fig7_whole_chain.png",
     ):
         assert (out / name).stat().st_size > 20_000, name
     runs = ("selfid.csv", "flexible.csv", "identification.csv", "whole_chain.csv")

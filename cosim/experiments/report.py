@@ -79,36 +79,134 @@ def figure_flexible_response(recording: Recording, n: int, path: Path) -> Path:
 
 
 def figure_state_estimates(
-    recording: Recording, n: int, scores: Sequence[float], path: Path
+    recording: Recording,
+    n: int,
+    scores: Sequence[float],
+    path: Path,
+    model_based: Recording | None = None,
+    model_scores: Sequence[float] = (),
+    window: tuple[float, float] = (4.0, 6.0),
 ) -> Path:
-    """Fig. 6: estimated against true angle of every mass, relative to the motor."""
+    """Fig. 6: estimated against true angle of every mass, relative to the motor.
+
+    Left, the paper's recursion (``recording``) on its own scale (it diverges from
+    the second mass on); right, the model-based observer (``model_based``, the same
+    maneuver) on the truth's scale. Both over ``window`` (s) of the run; the scores
+    (rms error / rms flexible motion) are over the whole run.
+    """
     plt = _pyplot()
-    t = recording.time
-    motor = recording["plant.theta_m_true"]
-    fig, axes = plt.subplots(n, 1, figsize=(9, 2.2 * n + 1), sharex=True, squeeze=False)
-    for i, ax in enumerate(axes[:, 0], start=1):
-        truth = recording[f"plant.theta[{i}]"] - motor
-        estimate = recording[f"observer.theta_hat[{i}]"] - motor
-        ax.plot(
-            t,
-            estimate * 1e3,
-            color="C1",
-            lw=0.6,
-            alpha=0.7,
-            label=f"θ̂_{i} − θ_m estimated (score {scores[i - 1]:.3g})",
-        )
-        ax.plot(t, truth * 1e3, color="C0", lw=1.2, zorder=3, label=f"θ_{i} − θ_m true")
-        span = np.max(np.abs(truth)) * 1e3
-        ax.set_ylim(-3 * span, 3 * span)
-        ax.set_ylabel("mrad")
+    columns = 1 if model_based is None else 2
+    fig, axes = plt.subplots(
+        n, columns, figsize=(5.2 * columns, 2.2 * n + 1.2), sharex=True, squeeze=False
+    )
+
+    def panel(ax, run: Recording, i: int, label: str, color: str) -> None:
+        shown = (run.time >= window[0]) & (run.time <= window[1])
+        t = run.time[shown]
+        motor = run["plant.theta_m_true"][shown]
+        truth = (run[f"plant.theta[{i}]"][shown] - motor) * 1e3
+        estimate = (run[f"observer.theta_hat[{i}]"][shown] - motor) * 1e3
+        ax.plot(t, truth, color="C0", lw=1.4, label="true")
+        ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label)
+        ax.set_ylabel(f"θ_{i} − θ_m (mrad)")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
-    axes[-1, 0].set_xlabel("time (s)")
-    fig.suptitle("Fig. 6 — estimated and true angle of each mass, relative to the motor")
+        ax.legend(loc="upper right", fontsize=7)
+
+    for i in range(1, n + 1):
+        panel(axes[i - 1, 0], recording, i, f"recursion (score {scores[i - 1]:.3g})", "C1")
+        if model_based is not None:
+            score = f" (score {model_scores[i - 1]:.3g})" if model_scores else ""
+            panel(axes[i - 1, 1], model_based, i, f"model-based{score}", "C3")
+    axes[0, 0].set_title("the paper's recursion (eq. 22–26), own scale", fontsize=9)
+    if model_based is not None:
+        axes[0, 1].set_title("model-based observer, chain identified from the motor", fontsize=9)
+    for ax in axes[-1]:
+        ax.set_xlabel("time (s)")
+    fig.suptitle("Fig. 6 — angle of each mass relative to the motor, estimated and true")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def figure_whole_chain(
+    identified: dict[str, float],
+    std: dict[str, float],
+    true: dict[str, float],
+    response: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    path: Path,
+) -> Path:
+    """Fig. 7: the whole-chain result: every parameter against the truth, and the model.
+
+    Parameters
+    ----------
+    identified, std, true : dict of str to float
+        ``J[i]``, ``k[i]``, ``B[i]`` identified, their standard errors and the truth
+        (kg·m², N·m/rad, N·m·s/rad).
+    response : tuple of ndarray
+        ``(lines, measured, w, model, truth)``: the excitation lines (rad/s, shape
+        ``(L,)``) and the response τ̂_reac / θ_m measured there (N·m/rad, complex,
+        shape ``(L,)``); a frequency grid (rad/s, shape ``(F,)``) and the identified
+        and true chains' responses on it (N·m/rad, complex, shape ``(F,)``).
+    path : Path
+        The PNG to write.
+    """
+    plt = _pyplot()
+    fig = plt.figure(figsize=(10, 7.5))
+    grid = fig.add_gridspec(2, 2, height_ratios=(1, 1.3))
+    for column, group, unit_note in ((0, ("J", "k"), "J_i, k_i"), (1, ("B",), "B_i")):
+        ax = fig.add_subplot(grid[0, column])
+        names = [name for name in identified if name.split("[")[0] in group and name in true]
+        errors = [100 * (identified[x] - true[x]) / true[x] for x in names]
+        bars = [200 * std[x] / true[x] for x in names]
+        ax.errorbar(range(len(names)), errors, yerr=bars, fmt="o", capsize=4, color="C3")
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xticks(range(len(names)), names)
+        ax.set_ylabel("error against the truth (%)")
+        ax.set_title(f"{unit_note}: identified − true, bars ±2σ", fontsize=9)
+        ax.grid(True, alpha=0.3)
+    lines, measured, w, model, truth = response
+    magnitude = fig.add_subplot(grid[1, :])
+    magnitude.loglog(
+        lines, np.abs(measured), "o", ms=4, color="0.4", label="measured τ̂_reac / θ_m (lines)"
+    )
+    magnitude.loglog(w, np.abs(truth), color="C0", lw=1.5, label="true chain")
+    magnitude.loglog(w, np.abs(model), "--", color="C3", lw=1.2, label="identified chain")
+    magnitude.set_xlabel("frequency (rad/s)")
+    magnitude.set_ylabel("|τ / θ_m| through G(s) (N·m/rad)")
+    magnitude.grid(True, which="both", alpha=0.3)
+    magnitude.legend(fontsize=8)
+    fig.suptitle("Fig. 7 — the whole chain from the motor's current and encoder alone")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def measured_response(
+    time: np.ndarray, theta_m: np.ndarray, tau_hat: np.ndarray, lines: np.ndarray
+) -> np.ndarray:
+    """The response τ̂_reac / θ_m of a multi-sine record, at its excitation lines.
+
+    The ratio of the two signals' Hann-windowed Fourier transforms at each line.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``, a constant step.
+    theta_m, tau_hat : ndarray
+        Motor angle (rad) and reaction torque estimate (N·m), shape ``(N,)``.
+    lines : ndarray
+        The excitation's frequencies (rad/s), shape ``(F,)``.
+
+    Returns
+    -------
+    ndarray
+        Complex response (N·m/rad) at each line, shape ``(F,)``.
+    """
+    window = np.hanning(len(time))
+    phasors = np.exp(-1j * np.outer(lines, time - time[0])) * window
+    return (phasors @ (tau_hat - tau_hat.mean())) / (phasors @ (theta_m - theta_m.mean()))
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:

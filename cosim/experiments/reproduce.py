@@ -33,13 +33,21 @@ from arcosim.experiments.report import (
     figure_flexible_response,
     figure_reaction_torque,
     figure_state_estimates,
+    figure_whole_chain,
     markdown_table,
+    measured_response,
 )
-from arcosim.experiments.scenarios import SCENARIOS, recording_columns, run_scenario
+from arcosim.experiments.scenarios import (
+    IDENTIFICATION_LINES,
+    SCENARIOS,
+    recording_columns,
+    run_scenario,
+)
 from arcosim.fmu.flexchain import bench
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED
 from arcosim.host.master import Recording
+from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.output_error import motor_record
 from arcosim.identification.whole_chain import Choice
@@ -142,6 +150,7 @@ def reproduce(
         results.masses = choice.n
         results.whole_chain = choice.fit.as_dict()
         results.whole_chain_std = choice.fit.std_dict()
+        estimated = None
         if choice.n == N_MASSES:  # the plant has three masses: n must match to co-simulate
             identified = {**actuator, **results.whole_chain, "estimator": MODEL_BASED}
             estimated = run("flexible", observer=identified)
@@ -151,14 +160,16 @@ def reproduce(
         flexible_score(flexible[f"observer.theta_hat[{i}]"], flexible[f"plant.theta[{i}]"], motor)
         for i in range(1, N_MASSES + 1)
     ]
-    if results.masses == N_MASSES:
+    if estimated is not None:
         results.whole_scores = [
             flexible_score(
                 estimated[f"observer.theta_hat[{i}]"], estimated[f"plant.theta[{i}]"], motor
             )
             for i in range(1, N_MASSES + 1)
         ]
-    results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean)
+    results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean, estimated)
+    if estimated is not None:
+        results.files.append(_whole_chain_figure(out, identification, results))
     report = out / "report.md"
     report.write_text(_report(results, ideal, k_mean, b_mean), encoding="utf-8")
     results.files.append(report)
@@ -204,7 +215,13 @@ def whole_chain_rows(results: Results) -> list[list[str]]:
 
 
 def _figures(
-    out: Path, rigid: Recording, flexible: Recording, results: Results, k_hat: float, b_hat: float
+    out: Path,
+    rigid: Recording,
+    flexible: Recording,
+    results: Results,
+    k_hat: float,
+    b_hat: float,
+    model_based: Recording | None,
 ) -> list[Path]:
     a = math.exp(-G_DIST * 1e-3)
     raw = k_hat * (rigid["plant.theta_m_true"] - rigid["plant.theta[1]"]) + b_hat * (
@@ -215,9 +232,43 @@ def _figures(
         figure_reaction_torque(rigid, rebuilt, out / "fig4_reaction_torque.png", k_hat, b_hat),
         figure_flexible_response(flexible, N_MASSES, out / "fig5_flexible_response.png"),
         figure_state_estimates(
-            flexible, N_MASSES, results.scores, out / "fig6_state_estimates.png"
+            flexible,
+            N_MASSES,
+            results.scores,
+            out / "fig6_state_estimates.png",
+            model_based,
+            results.whole_scores,
         ),
     ]
+
+
+def _whole_chain_figure(out: Path, identification: Recording, results: Results) -> Path:
+    """Fig. 7: experiment 4's parameters against the truth, and its model's response."""
+    true = {}
+    for i in range(1, N_MASSES + 1):
+        true.update({f"J[{i}]": bench.J[i - 1], f"k[{i}]": bench.K, f"B[{i}]": bench.B})
+    lines = IDENTIFICATION_LINES
+    measured = measured_response(
+        identification.time,
+        identification["plant.theta_m"],
+        identification["observer.tau_reac_hat"],
+        lines,
+    )
+    w = np.geomspace(lines[0], lines[-1], 1500)
+    g = G_DIST / (1j * w + G_DIST)  # what τ̂_reac carries: τ_reac through G(s)
+
+    def model(values: dict[str, float]) -> np.ndarray:
+        J, k, B = ([values[f"{p}[{i}]"] for i in range(1, N_MASSES + 1)] for p in "JkB")
+        return g * driving_point_response(J, k, B, w)
+
+    fitted = results.whole_chain
+    return figure_whole_chain(
+        fitted,
+        results.whole_chain_std,
+        true,
+        (lines, measured, w, model(fitted), model(true)),
+        out / "fig7_whole_chain.png",
+    )
 
 
 def actuator_rows(results: Results) -> list[list[str]]:
@@ -382,4 +433,8 @@ near 25 %). With these parameters alone, the model-based
 observer on experiment 3's flexible maneuver (`whole_chain.csv`) scores per mass:
 
 {markdown_table(["mass", "model-based score, identified chain"], whole_state_rows(results))}
+
+![Fig. 7](fig7_whole_chain.png)
+
+Fig. 6 above shows the model-based observer with these parameters beside the recursion.
 """

@@ -75,3 +75,48 @@ def _lanczos(eigenvalues: np.ndarray, first: np.ndarray) -> tuple[np.ndarray, np
             coupling[j] = beta
             previous, q = q, z / beta
     return diagonal, coupling
+
+
+def driving_point_response(
+    J: Sequence[float], k: Sequence[float], B: Sequence[float], w: np.ndarray
+) -> np.ndarray:
+    """The chain's reaction torque per motor angle, τ_1(jω) / θ_m(jω), with damping.
+
+    With the motor angle prescribed, the load masses obey
+    ``(−ω² M + jω C + K)_LL θ_L = −(jω C + K)_L0 θ_m``, and the reaction torque is
+    the first spring's, ``τ_1 = (K + jω C)_00 θ_m + (K + jω C)_0L θ_L``.
+
+    Parameters
+    ----------
+    J : sequence of float
+        Load inertias J_1 … J_n (kg·m²).
+    k : sequence of float
+        Spring stiffnesses k_1 … k_n (N·m/rad), k_1 from the motor to J_1.
+    B : sequence of float
+        Spring dampings B_1 … B_n (N·m·s/rad).
+    w : ndarray
+        Angular frequencies (rad/s), shape ``(F,)``.
+
+    Returns
+    -------
+    ndarray
+        Complex response (N·m/rad), shape ``(F,)``: 0 at ω = 0 (the chain follows
+        the motor), about −ω² ΣJ_i well below the first mode, and a resonance at each
+        clamped frequency p_i.
+
+    Examples
+    --------
+    >>> z = driving_point_response([1e-3], [0.5], [0.0], np.array([0.0, 10.0]))
+    >>> np.round(z.real, 6).tolist()  # one mass: k J ω² / (J ω² − k)
+    [0.0, -0.125]
+    """
+    K = np.array(spring_matrix([float(x) for x in k]))
+    C = np.array(spring_matrix([float(x) for x in B]))
+    M = np.diag([0.0, *(float(x) for x in J)])
+    out = np.empty(len(w), dtype=complex)
+    for j, omega in enumerate(np.asarray(w, dtype=float)):
+        Z = K + 1j * omega * C
+        D = Z - omega**2 * M
+        theta_L = np.linalg.solve(D[1:, 1:], -Z[1:, 0])
+        out[j] = Z[0, 0] + Z[0, 1:] @ theta_L
+    return out
