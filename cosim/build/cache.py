@@ -1,0 +1,130 @@
+"""Where built FMUs live, and whether a folder of them can be trusted.
+
+A folder of FMUs is *current* when it holds every FMU and the SSP, each a zip that
+opens with a modelDescription.xml that parses, and a ``.source-digest`` equal to the
+digest of the sources they are built from (:func:`source_digest`). The digest is
+written last, after every file is complete, so a build that died halfway leaves a
+folder that is rebuilt, never trusted. Builds and the checks before them take the
+folder's lock (:func:`lock_folder`), so two builds into one folder never interleave.
+
+Without a folder named by the user, FMUs go to a per-user cache:
+``$ARCOSIM_CACHE`` if set, else ``$XDG_CACHE_HOME/arcosim`` (``~/.cache/arcosim``),
+one subfolder per number of masses and source digest.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import functools
+import hashlib
+import os
+import zipfile
+from collections.abc import Iterator
+from pathlib import Path
+from xml.etree import ElementTree
+
+from arcosim.version import __version__
+from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+
+#: Written beside the FMUs, last: the digest of the sources they were built from.
+DIGEST_FILE = ".source-digest"
+#: The lock file of a folder of FMUs.
+LOCK_FILE = ".arcosim-build.lock"
+
+
+def fmu_package_dir() -> Path:
+    """Folder of :mod:`arcosim.fmu`, the code the Python FMUs bundle."""
+    import arcosim.fmu
+
+    return Path(arcosim.fmu.__file__).parent
+
+
+def plant_package_dir() -> Path:
+    """Folder of :mod:`arcosim.plant`: the reference plant and ``motorchain_c/``."""
+    import arcosim.plant
+
+    return Path(arcosim.plant.__file__).parent
+
+
+def cache_root() -> Path:
+    """The per-user cache folder of arcosim (see the module docstring)."""
+    if os.environ.get("ARCOSIM_CACHE"):
+        return Path(os.environ["ARCOSIM_CACHE"]).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base).expanduser() / "arcosim"
+
+
+def default_folder(n: int = 3) -> Path:
+    """The cache folder of the FMUs for ``n`` masses built from the current sources.
+
+    Examples
+    --------
+    >>> default_folder(3).parent.name
+    'fmus'
+    """
+    return cache_root() / "fmus" / f"n{check_masses(n)}-{source_digest(n)[:16]}"
+
+
+@functools.cache
+def source_digest(n: int) -> str:
+    """SHA-256 (hex) of everything the FMUs for ``n`` masses are built from.
+
+    The bundled code, the plant's Python and C sources, and the build code itself,
+    with the project version and ``n``. Computed once per process (a process runs one
+    version of the sources).
+    """
+    digest = hashlib.sha256(f"{__version__} n={n}".encode())
+    roots = (fmu_package_dir(), plant_package_dir(), Path(__file__).parent)
+    files = sorted(
+        (f for root in roots for f in root.rglob("*") if f.suffix in {".py", ".c", ".h"}),
+        key=lambda f: (f.name, str(f)),
+    )
+    for f in files:
+        digest.update(f.name.encode())
+        digest.update(f.read_bytes())
+    return digest.hexdigest()
+
+
+@contextlib.contextmanager
+def lock_folder(folder: Path) -> Iterator[None]:
+    """Hold the exclusive build lock of ``folder`` (waits while another process holds it)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    with open(folder / LOCK_FILE, "a+b") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def fmu_problem(path: Path) -> str | None:
+    """Why ``path`` is not a complete FMU (or SSP), or None if it is one.
+
+    Checks that the zip opens, every member's CRC-32 matches, and the model
+    description (``SystemStructure.ssd`` for an SSP) parses as XML.
+    """
+    inner = "SystemStructure.ssd" if path.suffix == ".ssp" else "modelDescription.xml"
+    try:
+        with zipfile.ZipFile(path) as z:
+            bad = z.testzip()
+            if bad is not None:
+                return f"{path.name}: member {bad} is corrupt"
+            ElementTree.fromstring(z.read(inner))
+    except FileNotFoundError:
+        return f"{path.name} is missing"
+    except (zipfile.BadZipFile, KeyError, ElementTree.ParseError, OSError, EOFError) as error:
+        return f"{path.name} is not a complete FMU ({error})"
+    return None
+
+
+def is_current(folder: Path, n: int) -> bool:
+    """True if ``folder`` holds complete FMUs for ``n`` masses built from these sources."""
+    stamp = folder / DIGEST_FILE
+    try:
+        if stamp.read_text(encoding="utf-8").strip() != source_digest(n):
+            return False
+    except OSError:
+        return False
+    wanted = [folder / r.file_name for r in RECIPES] + [folder / SSP_NAME]
+    return all(fmu_problem(path) is None for path in wanted)

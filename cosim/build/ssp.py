@@ -1,0 +1,133 @@
+"""Write the SSP 1.0 system source → plant → observer (``ActionReaction.ssp``).
+
+:func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
+connectors, connections, a DefaultExperiment, and parameter sets bound inline per
+component, as ecos reads them). :mod:`arcosim.host.ssp` runs such a file.
+"""
+
+from __future__ import annotations
+
+import os
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+from xml.etree import ElementTree
+from xml.etree.ElementTree import Element, SubElement
+
+from arcosim.fmu.fmukit.variables import type_of
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+NS = {"ssd": SSD, "ssc": SSC, "ssv": SSV}
+
+#: (component, FMU file stem)
+COMPONENTS = (
+    ("source", "ExcitationSource"),
+    ("plant", "MotorChainPlant"),
+    ("observer", "ReactionTorqueObserver"),
+)
+#: (start component, connector, end component, connector)
+CONNECTIONS = (
+    ("source", "i_ref", "plant", "i_ref"),
+    ("plant", "i_a", "observer", "i_a"),
+    ("plant", "omega_m", "observer", "omega_m"),
+    ("plant", "theta_m", "observer", "theta_m"),
+)
+#: The bench parameter set: the flexible maneuver (multi-sine, 0.3 A peak) and the
+#: observer estimating the load angles with the bench's actuator terms.
+BENCH = {
+    "source": {
+        "signal": 1,
+        "amplitude": 0.48,
+        "frequency": 3.0,
+        "frequency_end": 120.0,
+        "lines": 10,
+        "seed": 1,
+    },
+    "plant": {"encoder_cpr": 2000, "i_noise_std": 0.005, "seed": 1},
+    "observer": {"mode": 2, "D_m": 2e-5, "f_c": 2e-3},
+}
+
+
+def write_ssp(
+    path: Path,
+    fmu_dir: Path,
+    parameter_sets: Mapping[str, Mapping[str, Mapping[str, float | int | bool | str]]]
+    | None = None,
+    stop: float = 10.0,
+) -> Path:
+    """Pack the three FMUs of ``fmu_dir`` into an SSP at ``path``; return it."""
+    sets = {"bench": BENCH} if parameter_sets is None else parameter_sets
+    ElementTree.register_namespace("ssd", SSD)
+    ElementTree.register_namespace("ssc", SSC)
+    ElementTree.register_namespace("ssv", SSV)
+    root = Element(
+        f"{{{SSD}}}SystemStructureDescription", {"version": "1.0", "name": "ActionReaction"}
+    )
+    system = SubElement(
+        root,
+        f"{{{SSD}}}System",
+        {
+            "name": "ActionReaction",
+            "description": "current source -> motor-chain plant -> action-reaction observer",
+        },
+    )
+    elements = SubElement(system, f"{{{SSD}}}Elements")
+    for name, stem in COMPONENTS:
+        component = SubElement(
+            elements,
+            f"{{{SSD}}}Component",
+            {
+                "name": name,
+                "source": f"resources/{stem}.fmu",
+                "type": "application/x-fmu-sharedlibrary",
+            },
+        )
+        connectors = SubElement(component, f"{{{SSD}}}Connectors")
+        for a, ca, b, cb in CONNECTIONS:
+            for element, connector, kind in ((a, ca, "output"), (b, cb, "input")):
+                if element == name:
+                    c = SubElement(
+                        connectors, f"{{{SSD}}}Connector", {"name": connector, "kind": kind}
+                    )
+                    SubElement(c, f"{{{SSC}}}Real")
+        bindings = SubElement(component, f"{{{SSD}}}ParameterBindings")
+        for set_name, per_component in sets.items():
+            values = per_component.get(name, {})
+            binding = SubElement(bindings, f"{{{SSD}}}ParameterBinding")
+            holder = SubElement(binding, f"{{{SSD}}}ParameterValues")
+            pset = SubElement(
+                holder, f"{{{SSV}}}ParameterSet", {"version": "1.0", "name": set_name}
+            )
+            parameters = SubElement(pset, f"{{{SSV}}}Parameters")
+            for pname, value in values.items():
+                p = SubElement(parameters, f"{{{SSV}}}Parameter", {"name": pname})
+                SubElement(p, f"{{{SSV}}}{type_of(value)}", {"value": _text(value)})
+    connections = SubElement(system, f"{{{SSD}}}Connections")
+    for a, ca, b, cb in CONNECTIONS:
+        SubElement(
+            connections,
+            f"{{{SSD}}}Connection",
+            {"startElement": a, "startConnector": ca, "endElement": b, "endConnector": cb},
+        )
+    SubElement(
+        root, f"{{{SSD}}}DefaultExperiment", {"startTime": "0.0", "stopTime": repr(float(stop))}
+    )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.{os.getpid()}.part")
+    with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr(
+            "SystemStructure.ssd",
+            ElementTree.tostring(root, xml_declaration=True, encoding="UTF-8"),
+        )
+        for _, stem in COMPONENTS:
+            z.write(fmu_dir / f"{stem}.fmu", f"resources/{stem}.fmu")
+    partial.replace(path)
+    return path
+
+
+def _text(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value) if isinstance(value, float) else str(value)
