@@ -19,7 +19,6 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from arcosim.version import __version__
 from arcosim.build.cache import (
     DIGEST_FILE,
     default_folder,
@@ -30,6 +29,7 @@ from arcosim.build.cache import (
 )
 from arcosim.build.native_loader import loader_problem, patch_linux_binaries
 from arcosim.build.recipes import RECIPES, SSP_NAME, FmuRecipe, check_masses
+from arcosim.version import __version__
 
 # pythonfmu 0.7's loader (findClass) re-runs this script with the module's namespace
 # as globals and then releases one reference to that namespace it never took, once

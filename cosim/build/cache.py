@@ -24,8 +24,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
-from arcosim.version import __version__
 from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+from arcosim.version import __version__
 
 #: Written beside the FMUs, last: the digest of the sources they were built from.
 DIGEST_FILE = ".source-digest"
