@@ -8,7 +8,7 @@ import sys
 from collections.abc import Sequence
 
 from arcosim.cli import bench, build, identify, reproduce, simulate, ssp, sweep, validate
-from arcosim.errors import UserError
+from arcosim.errors import ArcosimError
 from arcosim.version import __version__
 
 
@@ -35,7 +35,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args.execute(args) or 0)
-    except UserError as error:
+    except ArcosimError as error:
         print(f"arcosim: error: {error}", file=sys.stderr)
         return 2
 

@@ -160,11 +160,23 @@ class FmuInstance:
     def initialize(
         self, parameters: Mapping[str, float | int | bool] | None = None, start_time: float = 0.0
     ) -> None:
-        """Set parameters by name, then run initialization mode at ``start_time`` (s)."""
+        """Set parameters by name, then run initialization mode at ``start_time`` (s).
+
+        Raises:
+            UserError: the FMU refused its parameters (its log lines are the message).
+        """
         self.slave.setupExperiment(startTime=start_time)
         self.set(parameters or {})
         self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
+        before = len(self.messages)
+        try:
+            self.slave.exitInitializationMode()
+        except FMICallException as error:
+            said = [m.split(": ", 1)[-1] for m in self.messages[before:]]
+            raise UserError(
+                f"{self.path.name} refused its parameters: "
+                + ("; ".join(said) if said else f"status {error.status}")
+            ) from None
         self.time = start_time
 
     def do_step(self, t: float, h: float) -> int:
