@@ -42,7 +42,7 @@ from cosim import excitation
 from cosim.errors import UserError
 from cosim.metrics import flexible_score, percent_error
 from cosim.output_error import Fit, MotorRecord, motor_record, uniform_chain
-from cosim.scenarios import Scenario, run_scenario
+from cosim.scenarios import BROADBAND_LINES, Scenario, run_scenario
 from flexchain import bench
 from flexchain.chain import spring_matrix
 from flexchain.dob import Actuator
@@ -59,7 +59,7 @@ ACTUATOR = Actuator(bench.J_M, bench.K_T, 0.0, 0.0, bench.D_M, bench.F_C)
 G_DIST = 100.0
 ENCODER_CPR = 2000
 #: Broadband lines (rad/s): the flexible scenario's plus 150 for the five-mass chain.
-LINES = np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120, 150.0])
+LINES = BROADBAND_LINES
 BROADBAND_DURATION = 10.0
 #: Peak current of the broadband multi-sine (A). At this level the bench's motor
 #: stands still (|ω| < 0.5 rad/s) 2 % of the time; at the flexible scenario's 0.48 A,

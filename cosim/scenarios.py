@@ -20,6 +20,7 @@ from cosim import excitation
 from cosim.build import OBSERVER, PLANT, ensure_built
 from cosim.instance import FmuInstance
 from cosim.master import Recording, cosimulate
+from flexchain import bench
 
 #: Plant outputs recorded by default (truth included, for scoring).
 PLANT_SIGNALS = (
@@ -47,6 +48,8 @@ class Scenario:
         duration: length (s).
         plant: plant start values.
         observer: observer start values.
+        inputs: the plant's other inputs over the step times (s), by name
+            (``tau_ext[i]``, N·m), each held over its step like the current; None: none.
     """
 
     name: str
@@ -55,6 +58,7 @@ class Scenario:
     duration: float
     plant: Mapping[str, float | int | bool] = field(default_factory=dict)
     observer: Mapping[str, float | int | bool] = field(default_factory=dict)
+    inputs: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None
 
 
 def _self_identification_current(t: np.ndarray) -> np.ndarray:
@@ -84,6 +88,78 @@ def identification_current(t: np.ndarray) -> np.ndarray:
 
 #: The maneuver's length: 8 periods at 2.1 rad/s.
 RIGID_DURATION = 8 * 2 * np.pi / 2.1
+
+#: Lines of the broadband multi-sine (rad/s): the flexible scenario's plus 150 (the
+#: accuracy benchmark's, and the load torque scenario's).
+BROADBAND_LINES = np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120, 150.0])
+
+
+@dataclass(frozen=True)
+class LoadProfile:
+    """The load torque scenario's external torque on one mass, over a flexible maneuver.
+
+    Nothing acts until ``step_time``; then a step of ``fraction`` of the drive's peak
+    torque (k_t of the bench times the maneuver's peak current); from ``sine_time`` the
+    torque goes on as that size times cos(``frequency`` (t − sine_time)), continuous at
+    the switch. The maneuver is the broadband multi-sine of ``amplitude`` A: at 1 A
+    the bench's motor stands still 2 % of the time; at the flexible scenario's 0.48 A,
+    26 %, and the encoder then reads zero velocity in a third of the samples, where the
+    DOB only knows the reaction torque to within ±f_c (README).
+
+    Attributes:
+        mass: the load mass the torque acts on (1 … n).
+        amplitude: peak current argument of the multi-sine (A).
+        fraction: step size over the drive's peak torque.
+        step_time, sine_time: s.
+        frequency: of the sine (rad/s).
+        duration: s.
+    """
+
+    mass: int = 3
+    amplitude: float = 1.0
+    fraction: float = 0.1
+    step_time: float = 1.0
+    sine_time: float = 7.0
+    frequency: float = 2.0
+    duration: float = 15.0
+
+    def current(self, t: np.ndarray) -> np.ndarray:
+        """The maneuver's current command (A)."""
+        return excitation.multisine(t, self.amplitude, BROADBAND_LINES, 1)
+
+    def size(self) -> float:
+        """The step (N·m): ``fraction`` of the bench drive's peak torque over the run."""
+        t = np.arange(round(self.duration / 1e-3)) * 1e-3
+        return self.fraction * bench.K_T * float(np.max(np.abs(self.current(t))))
+
+    def torque(self, t: np.ndarray) -> np.ndarray:
+        """The external torque (N·m) held over the step starting at each of ``t`` (s)."""
+        size = self.size()
+        tau = np.where(t >= self.step_time, size, 0.0)
+        sine = size * np.cos(self.frequency * (t - self.sine_time))
+        return np.where(t >= self.sine_time, sine, tau)
+
+    def inputs(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """The plant inputs: ``tau_ext[mass]``."""
+        return {f"tau_ext[{self.mass}]": self.torque(t)}
+
+    def scenario(self, name: str = "load-torque") -> Scenario:
+        """The co-simulation: observer in mode 2, estimator 1, estimating ``mass``."""
+        return Scenario(
+            name,
+            f"load torque on mass {self.mass}: a step of a tenth of the drive's peak torque "
+            f"at {self.step_time:g} s, a {self.frequency:g} rad/s sine from {self.sine_time:g} s, "
+            f"during a {self.amplitude:g} A multi-sine 3–150 rad/s (mode 2, estimator 1)",
+            self.current,
+            self.duration,
+            {},
+            {"mode": 2, "estimator": 1, "load_mass": self.mass},
+            self.inputs,
+        )
+
+
+#: Experiment 5's load: on the bench's last mass.
+LOAD_PROFILE = LoadProfile()
 
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
@@ -120,6 +196,7 @@ SCENARIOS: dict[str, Scenario] = {
             {},
             {"mode": 2},
         ),
+        LOAD_PROFILE.scenario(),
         Scenario(
             "chirp",
             "chirp 1 → 150 rad/s over 10 s, 0.2 A (mode 2)",
@@ -203,6 +280,7 @@ def run_scenario(
             ordering=ordering,
             progress=progress,
             record_every=record_every,
+            plant_inputs=scenario.inputs(t) if scenario.inputs is not None else None,
         )
 
 
