@@ -175,6 +175,21 @@ def score(
     )
 
 
+def score_profile(time: np.ndarray, estimate: np.ndarray, profile) -> LoadScore:
+    """:func:`score` for a run of ``profile`` (a :class:`cosim.scenarios.LoadProfile`)."""
+    truth = step_truth(time, profile.torque(time))
+    return score(
+        time,
+        estimate,
+        truth,
+        profile.step_time,
+        profile.sine_time,
+        profile.frequency,
+        profile.settled_from,
+        profile.sine_from,
+    )
+
+
 def step_truth(time: np.ndarray, torque_at_start: Sequence[float]) -> np.ndarray:
     """The torque over the step ending at each sample, from the torque held over the
     step starting at each sample (the plant input's timing): shifted by one, 0 first."""

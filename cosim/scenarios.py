@@ -139,6 +139,16 @@ class LoadProfile:
         sine = size * np.cos(self.frequency * (t - self.sine_time))
         return np.where(t >= self.sine_time, sine, tau)
 
+    @property
+    def settled_from(self) -> float:
+        """Start of the step's scoring window (s): half-way from the step to the sine."""
+        return 0.5 * (self.step_time + self.sine_time)
+
+    @property
+    def sine_from(self) -> float:
+        """Start of the sine's scoring window (s): its last two whole periods."""
+        return self.duration - 2.0 * (2.0 * np.pi / self.frequency)
+
     def inputs(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """The plant inputs: ``tau_ext[mass]``."""
         return {f"tau_ext[{self.mass}]": self.torque(t)}
