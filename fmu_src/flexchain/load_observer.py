@@ -21,9 +21,10 @@ increments, white with standard deviation ``ω_L σ_τ h`` per step (ω_L the
 would then be estimated with a first-order bandwidth of ω_L, since the steady-state
 Kalman gain of a random walk is √(q_c / r_c) = ω_L with q_c = (ω_L σ_τ)² h and
 r_c = σ_τ² h. A torque on a load mass reaches τ_reac with a static gain of −1 (the
-springs from the motor to mass L carry it), so below the chain's first clamped mode
-this is the bandwidth of the estimate (measured: README). The gain is designed jointly
-with the chain's states (one Riccati equation).
+springs from the motor to mass L carry it), so ω_L sets the estimate's bandwidth; the
+chain adds its own lag, about a quarter period of its first clamped mode, since above
+that mode a torque on mass L reaches the motor attenuated as ω^(−2L) (measured: README).
+The gain is designed jointly with the chain's states (one Riccati equation).
 
 The output ``tau_load`` is the Kalman estimate of d through a second-order Butterworth
 low-pass at ``SMOOTHING_RATIO · ω_L`` (exact for the step taken). A Kalman filter
@@ -32,8 +33,8 @@ sum of its corrections), and the reaction torque observer's largest error is far
 ω_L: with the encoder's backward-difference velocity the DOB pairs the current with the
 acceleration half a step late (shared/METHOD.md), an error of J_m Δα/2 per step that
 rings at the drive's resonances (on the bench, 0.015 N·m at its 90 rad/s mode under a
-2 A multi-sine: 16 % of a load step of 5 mN·m leaked through the first-order roll-off,
-0.5 % after the low-pass). The chain model uses the unsmoothed d.
+2 A multi-sine: an rms error of 9 % of a 5 mN·m load step through the first-order
+roll-off, 0.2 % after the low-pass). The chain model uses the unsmoothed d.
 
 A random walk and not a first-order Gauss–Markov model: the filter then has integral
 action, so a constant torque is estimated without bias (a Gauss–Markov torque decays
