@@ -72,4 +72,4 @@ def test_ssp_in_ecos_matches_the_fmpy_jacobi_run(build_fmus, tmp_path) -> None:
             scale = max(np.max(np.abs(mine)), 1e-300)
             assert np.max(np.abs(mine - theirs[:, j + 1])) <= 1e-9 * scale, f"{component}.{name}"
             compared += 1
-    assert compared == 34  # 1 source + 16 plant + 17 observer outputs
+    assert compared == 35  # 1 source + 16 plant + 18 observer outputs

@@ -194,6 +194,14 @@ def test_state_estimation_by_recursion(fmus, tmp_path_factory) -> None:
         ({"estimator": 3}, "estimator = 3 is not allowed"),
         ({"encoder_cpr": -5}, "encoder_cpr = -5 must be >= 0"),
         ({"J_mo": float("nan")}, "J_mo = nan is not a finite number"),
+        ({"estimator": 1, "load_mass": 4}, "load_mass = 4 is not allowed"),
+        ({"estimator": 1, "load_mass": -1}, "load_mass = -1 is not allowed"),
+        ({"load_mass": 2}, "load_mass = 2 needs mode = 2 and estimator = 1"),
+        ({"mode": 1, "estimator": 1, "load_mass": 2}, "load_mass = 2 needs mode = 2"),
+        (
+            {"estimator": 1, "load_mass": 3, "load_torque_bandwidth": 0.0},
+            "load_torque_bandwidth = 0.0 must be > 0",
+        ),
     ],
 )
 def test_bad_parameter_is_refused_with_a_message(fmus, parameters, phrase) -> None:
