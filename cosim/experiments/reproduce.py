@@ -230,7 +230,7 @@ def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, fig
     )
     log = {c: rec[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")}
     log["time"] = rec.time
-    theta = estimate_states(settings, log, N_MASSES)
+    theta = estimate_states(settings, log)
     motor = rec["plant.theta_m_true"]
     results.load_angles["true chain, no torque state"] = [
         flexible_score(theta[:, i], rec[f"plant.theta[{i + 1}]"], motor) for i in range(N_MASSES)
