@@ -113,7 +113,12 @@ class Log:
                 writer.writerow([repr(float(x)) for x in row])
 
     def columns(self) -> dict[str, np.ndarray]:
-        return {"time": self.time, "i_a": self.i_a, "omega_m": self.omega_m, "theta_m": self.theta_m}
+        return {
+            "time": self.time,
+            "i_a": self.i_a,
+            "omega_m": self.omega_m,
+            "theta_m": self.theta_m,
+        }
 
 
 class _Model:

@@ -21,14 +21,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy import optimize, signal
 
 from cosim.encoder_fit import EncoderRecord, refine
 from cosim.errors import UserError
-from cosim.modal_start import masses_seen, record_modes, singular_values
-from cosim.output_error import Fit, MotorRecord, check_excited, continued_fit
+from cosim.modal_start import (
+    Detected,
+    Modes,
+    chain_of,
+    detect_modes,
+    excitation_lines,
+    record_modes,
+)
+from cosim.output_error import Fit, MotorRecord, check_excited, continued_fit, predict
+from flexchain.chain import spring_matrix
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
@@ -41,7 +50,7 @@ def names(n: int) -> list[str]:
 
 def split(p: np.ndarray, n: int) -> tuple[list[float], list[float], list[float]]:
     """``(J, k, B)`` from the stacked parameter vector (kg·m², N·m/rad, N·m·s/rad)."""
-    return list(p[:n]), list(p[n : 2 * n]), list(p[2 * n :])
+    return list(p[:n]), list(p[n : 2 * n]), list(p[2 * n : 3 * n])
 
 
 def _lower(n: int) -> Callable[[np.ndarray], np.ndarray]:
@@ -49,7 +58,7 @@ def _lower(n: int) -> Callable[[np.ndarray], np.ndarray]:
     return lambda p: np.concatenate([1e-3 * p[: 2 * n], np.zeros(n)])
 
 
-def fit_chain(record: MotorRecord, n: int) -> Fit:
+def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Fit:
     """Fit every J_i, k_i, B_i of an n-mass chain to ``record`` (steps in the module doc).
 
     Returns:
@@ -63,7 +72,8 @@ def fit_chain(record: MotorRecord, n: int) -> Fit:
     if n < 1:
         raise UserError(f"the chain needs at least one load mass, got {n}")
     check_excited(record)
-    modes = record_modes(record, n)
+    if modes is None:
+        modes = record_modes(record, n)
     J0, k0 = modes.chain()
     zeta = float(np.mean(np.clip(modes.damping, 1e-4, 0.05)))
     B0 = 2.0 * zeta * k0 / modes.frequency[0]
@@ -120,43 +130,170 @@ def identify(
 ) -> Choice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
-    With ``"auto"``: the record's subspace singular values show n modes
-    (:func:`~cosim.modal_start.masses_seen`); chains of n − 1, n and n + 1 masses are
-    fitted and the smallest criterion wins (one lag for all, the largest: the residual
-    of a good fit is the most correlated). An n the record cannot support (fewer modes
-    seen, or a mode that carries no reaction torque) is refused and reported.
+    The record's modes come from a stabilization diagram of the subspace step
+    (:func:`~cosim.modal_start.detect_modes`): a mode counts when it comes back at
+    several model orders and its residue stands above its standard error; ``auto``
+    takes n = the number that count. An n the record cannot support is refused, naming
+    the modes it shows, the ones too weakly excited, and what would fix the record.
 
-    With ``encoder`` (the same log's current and encoder counts), the chosen fit is
-    refined by the prediction-error fit (:mod:`cosim.encoder_fit`), which takes the
-    counts for what they are; without it the output-error fit is the result.
+    With ``encoder`` (the same log's current and encoder counts) the chain is fitted by
+    the prediction-error fit from the current to the encoder (:mod:`cosim.encoder_fit`:
+    with the motor's friction and a load torque when the record asks for them) straight
+    from the modal start; without it, by the output-error fit to τ̂_reac.
 
     Raises:
         UserError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
-            record cannot support even one mass.
+            record cannot support the chain asked for.
     """
-    if masses != "auto":
-        n = _masses(masses)
-        result = fit_chain(record, n)
-        ic = information_criterion(result, record)
-        return Choice(n, _refined(result, record, encoder, n), {n: ic}, {n: result.rms_residual})
+    auto = masses == "auto"
+    n_asked = None if auto else _masses(masses)
     check_excited(record)
-    singular = singular_values(record)
-    seen = masses_seen(singular, MAX_AUTO_MASSES)
-    fits: dict[int, Fit] = {}
-    refused: dict[int, str] = {}
-    for n in range(max(seen - 1, 1), min(seen + 1, MAX_AUTO_MASSES) + 1):
-        try:
-            fits[n] = fit_chain(record, n)
-        except UserError as error:
-            refused[n] = str(error)
-    if not fits:
-        raise UserError(" ".join(refused.values()))
-    lag = max(f.lag for f in fits.values())
-    criterion = {n: information_criterion(f, record, lag) for n, f in fits.items()}
-    best = min(criterion, key=criterion.__getitem__)
-    residual = {n: f.rms_residual for n, f in fits.items()}
-    chosen = _refined(fits[best], record, encoder, best)
-    return Choice(best, chosen, criterion, residual, refused, seen, singular)
+    lines = None if encoder is None else excitation_lines(encoder.drive, encoder.h)
+    detected = detect_modes(record, max(MAX_AUTO_MASSES, n_asked or 0), lines)
+    n = detected.n if auto else n_asked
+    if n < 1 or detected.n < n:
+        raise UserError(missing_modes(detected, n if n >= 1 else None, record))
+    modes = _strongest(detected, n)
+    if encoder is None:
+        result = fit_chain(record, n, modes)
+    else:
+        J0, k0 = modes.chain()
+        B0 = modal_damping(J0, k0, modes)
+        if not encoder.friction_given:
+            D_m, f_c = friction_start(record, encoder, J0, k0, B0)
+            encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+        start = np.concatenate([J0, k0, B0])
+        note = (
+            "chain with the record's clamped modes "
+            + ", ".join(f"{w:.4g}" for w in modes.frequency)
+            + " rad/s (subspace stabilization diagram) and their residues"
+        )
+        first = Fit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
+        first.extra.update(_mode_evidence(modes))
+        result = refine(encoder, record, first, n)
+        result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
+    result.extra.update(
+        detected_modes_rad_s=[float(w) for w in detected.frequency],
+        residue_t_values=[float(t) for t in detected.t_value],
+        weak_modes=[{"rad_s": w, "t": t} for w, t in detected.weak],
+        excitation_lines_taken=[float(w) for w in detected.lines],
+        assumptions=assumptions(encoder),
+    )
+    refused = {}
+    if detected.weak:
+        refused[n + 1] = missing_modes(detected, n + 1, record)
+    ic = information_criterion(result, record) if encoder is None else float("nan")
+    return Choice(
+        n,
+        result,
+        {n: ic},
+        {n: result.rms_residual},
+        refused,
+        detected.n,
+        detected.singular_values,
+    )
+
+
+def _strongest(detected: Detected, n: int) -> Modes:
+    """The n modes with the largest residue t values, by frequency."""
+    if detected.n == n:
+        return detected.modes()
+    keep = np.sort(np.argsort(-detected.t_value)[:n])
+    return Modes(
+        detected.frequency[keep],
+        detected.damping[keep],
+        detected.residue[keep],
+        detected.singular_values,
+        detected.band,
+    )
+
+
+def _mode_evidence(modes: Modes) -> dict:
+    return {
+        "modes_rad_s": [float(w) for w in modes.frequency],
+        "damping_ratios": [float(z) for z in modes.damping],
+        "singular_values": [float(x) for x in modes.singular_values[:20]],
+    }
+
+
+def modal_damping(J: np.ndarray, k: np.ndarray, modes: Modes) -> np.ndarray:
+    """Spring dampers B_i ≥ 0 whose clamped modal damping matches the modes' (first
+    order in the damping: 2 ζ_i p_i = Σ_j B_j (φ_ji − φ_(j−1)i)², φ the mass-normalized
+    clamped mode shapes, φ_0 = 0), shape (n,); a floor of 1e-3 of their mean."""
+    n = len(J)
+    root = np.sqrt(np.asarray(J, dtype=float))
+    K = np.array(spring_matrix([float(x) for x in k]))[1:, 1:]
+    eigenvalues, shapes = np.linalg.eigh(K / root[:, None] / root[None, :])
+    phi = shapes / root[:, None]  # mass-normalized, rows: masses
+    stretch = np.diff(np.vstack([np.zeros(n), phi]), axis=0) ** 2  # (spring j, mode i)
+    target = 2.0 * np.clip(modes.damping, 1e-4, 0.2) * np.sqrt(eigenvalues)
+    B, _ = optimize.nnls(stretch.T, target)
+    floor = 1e-3 * max(float(np.mean(B)), 1e-12)
+    return np.maximum(B, floor)
+
+
+def friction_start(
+    record: MotorRecord, encoder: EncoderRecord, J: np.ndarray, k: np.ndarray, B: np.ndarray
+) -> tuple[float, float]:
+    """Start values ``(D_m, f_c)`` (N·m·s/rad, N·m) for a record whose τ̂_reac was
+    computed without friction: what the start chain leaves of τ̂ is
+    ``G[D_m ω + f_c sgn ω]``, linear in both (least squares; each at least a small
+    positive value)."""
+    a = np.exp(-record.g_dist * record.h)
+    G = lambda x: signal.lfilter([1.0 - a], [1.0, -a], x)  # noqa: E731
+    left = record.tau_hat - predict(record, J, k, B)
+    omega = encoder.velocity
+    X = np.column_stack([G(omega), G(np.sign(omega))])
+    coef = np.linalg.lstsq(X[1:], left[1:], rcond=None)[0]
+    torque = float(np.sqrt(np.mean(encoder.drive**2)))
+    return max(float(-coef[0]), 1e-9), max(float(-coef[1]), 1e-3 * torque)
+
+
+def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
+    """What the result is conditional on, one line each (for the report)."""
+    scale = (
+        "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
+        "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
+        "homogeneous in torque); J_m alone off moves J[1] most"
+    )
+    out = {"actuator": scale}
+    if encoder is None:
+        out["fit"] = "output-error fit to τ̂_reac (no encoder counts given: encoder_cpr = 0)"
+        return out
+    out["encoder"] = f"{2 * np.pi / encoder.count:.0f} counts per revolution, error q²/12"
+    if encoder.friction_given:
+        out["friction"] = f"given: D_m = {encoder.D_m:.4g} N·m·s/rad, f_c = {encoder.f_c:.4g} N·m"
+    else:
+        out["friction"] = "fitted (D_m, f_c with standard errors)"
+    out["load"] = {
+        "none": "no load torque modelled",
+        "constant": "a constant load torque on the last mass, fitted",
+        "slow": "a constant plus slowly varying load torque on the last mass, fitted",
+    }[encoder.load]
+    return out
+
+
+def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str:
+    """Why the record cannot support n masses (n None: not even one), and what to do."""
+    found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
+    text = (
+        f"the record shows {detected.n} excited mode(s) below {detected.band:.0f} rad/s "
+        f"({found} rad/s)"
+    )
+    if n is not None:
+        text += f", {chain_of(n)} has {n}"
+    if detected.weak:
+        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
+        text += f"; seen but too weakly excited: {weak}"
+    if detected.lines:
+        lines = ", ".join(f"{w:.1f}" for w in detected.lines)
+        text += f"; poles at excitation lines ({lines} rad/s) were taken for the lines"
+    return text + (
+        ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
+        "lines on both sides of each mode, up to the band; a longer record; a finer "
+        f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
+        "see `excite`, or fit fewer masses"
+    )
 
 
 def _refined(result: Fit, record: MotorRecord, encoder: EncoderRecord | None, n: int) -> Fit:
