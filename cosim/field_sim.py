@@ -47,7 +47,8 @@ class Drive:
         current_offset: current sensor offset (A).
         current_noise: current sensor noise, standard deviation (A).
         counts: encoder counts per revolution (0: exact angle).
-        load_torque: constant load torque (N·m).
+        load_torque: constant load torque (N·m), braking positive motion (a positive
+            value acts on the load mass in the negative direction).
         load_sine: (amplitude N·m, frequency rad/s) of a sine load torque.
         load_mass: index (1…n) of the mass the load torque acts on.
     """
@@ -157,7 +158,7 @@ class _Model:
             Bu[2 * m + 1, 0] = 1.0
         Bu[m, 1] = 1.0 / J[0]
         load = (drive.load_mass or n) if n else 0
-        Bu[m + load, 2] = 1.0 / J[load]
+        Bu[m + load, 2] = -1.0 / J[load]  # the load torque brakes positive motion
         stuck = A.copy()
         stuck[m, :] = 0.0  # motor held: no acceleration
         stuck[0, :] = 0.0  # and no motion
@@ -341,14 +342,18 @@ def _new_mode(model, x, stuck, i_ref, f_c) -> bool:
 
 
 def multisine(
-    lines: np.ndarray, amplitude: float, seed: int = 1
+    lines: np.ndarray, amplitude: float, seed: int = 1, slope: float = 0.0
 ) -> Callable[[np.ndarray], np.ndarray]:
-    """Sum of sines at ``lines`` (rad/s), each ``amplitude / len(lines)``, random phases."""
+    """Sum of sines at ``lines`` (rad/s) with random phases; line j's amplitude is
+    ∝ lines_j^slope, scaled so that they add up to ``amplitude`` (slope 0: each
+    ``amplitude / len(lines)``)."""
     phases = np.random.default_rng(seed).uniform(0, 2 * np.pi, len(lines))
     lines = np.asarray(lines, dtype=float)
+    weights = lines**slope
+    weights = amplitude * weights / weights.sum()
 
     def signal(t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
-        return amplitude / len(lines) * np.sin(np.outer(t, lines) + phases).sum(axis=1)
+        return np.sin(np.outer(t, lines) + phases) @ weights
 
     return signal

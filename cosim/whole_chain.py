@@ -149,7 +149,17 @@ def identify(
     n_asked = None if auto else _masses(masses)
     check_excited(record)
     lines = None if encoder is None else excitation_lines(encoder.drive, encoder.h)
-    detected = detect_modes(record, max(MAX_AUTO_MASSES, n_asked or 0), lines)
+    largest = max(MAX_AUTO_MASSES, n_asked or 0)
+    detected = detect_modes(record, largest, lines)
+    if encoder is not None and not encoder.friction_given and detected.n:
+        # τ̂ was computed without friction: estimate it from the first modes, take it
+        # out of τ̂, and read the modes again
+        modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
+        J0, k0 = modes.chain()
+        D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
+        record = without_friction(record, encoder, D_m, f_c)
+        encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+        detected = detect_modes(record, largest, lines)
     n = detected.n if auto else n_asked
     if n < 1 or detected.n < n:
         raise UserError(missing_modes(detected, n if n >= 1 else None, record))
@@ -159,9 +169,6 @@ def identify(
     else:
         J0, k0 = modes.chain()
         B0 = modal_damping(J0, k0, modes)
-        if not encoder.friction_given:
-            D_m, f_c = friction_start(record, encoder, J0, k0, B0)
-            encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
         start = np.concatenate([J0, k0, B0])
         note = (
             "chain with the record's clamped modes "
@@ -246,7 +253,19 @@ def friction_start(
     X = np.column_stack([G(omega), G(np.sign(omega))])
     coef = np.linalg.lstsq(X[1:], left[1:], rcond=None)[0]
     torque = float(np.sqrt(np.mean(encoder.drive**2)))
-    return max(float(-coef[0]), 1e-9), max(float(-coef[1]), 1e-3 * torque)
+    return max(float(coef[0]), 1e-9), max(float(coef[1]), 1e-3 * torque)
+
+
+def without_friction(
+    record: MotorRecord, encoder: EncoderRecord, D_m: float, f_c: float
+) -> MotorRecord:
+    """``record`` with ``G[D_m ω + f_c s]`` taken out of τ̂_reac (ω, s: the encoder
+    record's velocity and friction sign)."""
+    a = np.exp(-record.g_dist * record.h)
+    friction = D_m * encoder.velocity + f_c * encoder.sign
+    friction[0] = 0.0
+    tau = record.tau_hat - signal.lfilter([1.0 - a], [1.0, -a], friction)
+    return replace(record, tau_hat=tau)
 
 
 def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
