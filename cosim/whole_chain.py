@@ -33,7 +33,6 @@ from cosim.modal_start import (
     Modes,
     chain_of,
     detect_modes,
-    excitation_lines,
     record_modes,
 )
 from cosim.output_error import Fit, MotorRecord, check_excited, continued_fit, predict
@@ -148,7 +147,7 @@ def identify(
     auto = masses == "auto"
     n_asked = None if auto else _masses(masses)
     check_excited(record)
-    lines = None if encoder is None else excitation_lines(encoder.drive, encoder.h)
+    lines = None  # excitation lines are not rejected: a lightly damped mode may sit on one
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     detected = detect_modes(record, largest, lines)
     if encoder is not None and not encoder.friction_given and detected.n:
