@@ -27,6 +27,7 @@ import numpy as np
 from scipy import optimize, signal
 
 from cosim.encoder_fit import EncoderRecord, refine
+from cosim.encoder_fit import opening as encoder_opening
 from cosim.errors import UserError
 from cosim.modal_start import (
     Detected,
@@ -40,6 +41,11 @@ from flexchain.chain import spring_matrix
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
+#: With ``auto``, a weakest mode whose residue is below this many standard errors is
+#: confirmed by the data: the n − 1 fit is run too and the lower BIC of the two wins.
+T_CONFIRM = 30.0
+#: Length (s) of the opening those two fits run on.
+CONFIRM_SECONDS = 5.0
 
 
 def names(n: int) -> list[str]:
@@ -162,22 +168,20 @@ def identify(
     n = detected.n if auto else n_asked
     if n < 1 or detected.n < n:
         raise UserError(missing_modes(detected, n if n >= 1 else None, record))
-    modes = _strongest(detected, n)
+    criterion: dict[int, float] = {}
     if encoder is None:
-        result = fit_chain(record, n, modes)
+        result = fit_chain(record, n, _strongest(detected, n))
+        criterion[n] = information_criterion(result, record)
     else:
-        J0, k0 = modes.chain()
-        B0 = modal_damping(J0, k0, modes)
-        start = np.concatenate([J0, k0, B0])
-        note = (
-            "chain with the record's clamped modes "
-            + ", ".join(f"{w:.4g}" for w in modes.frequency)
-            + " rad/s (subspace stabilization diagram) and their residues"
-        )
-        first = Fit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
-        first.extra.update(_mode_evidence(modes))
-        result = refine(encoder, record, first, n)
-        result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
+        if auto and n >= 2 and float(np.min(detected.t_value)) < T_CONFIRM:
+            # the weakest mode is not beyond doubt: let the data decide (BIC of the n and
+            # n − 1 fits on the record's first CONFIRM_SECONDS)
+            short = encoder_opening(encoder, CONFIRM_SECONDS)
+            for m in (n, n - 1):
+                trial = _prediction_error(None, short, _strongest(detected, m))
+                criterion[m] = trial.extra["information_criterion"]
+            n = min(criterion, key=criterion.__getitem__)
+        result = _prediction_error(record, encoder, _strongest(detected, n))
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
@@ -188,16 +192,35 @@ def identify(
     refused = {}
     if detected.weak:
         refused[n + 1] = missing_modes(detected, n + 1, record)
-    ic = information_criterion(result, record) if encoder is None else float("nan")
     return Choice(
         n,
         result,
-        {n: ic},
+        criterion,
         {n: result.rms_residual},
         refused,
         detected.n,
         detected.singular_values,
     )
+
+
+def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes: Modes) -> Fit:
+    """The prediction-error fit of the chain with ``modes`` (:func:`refine`) from the
+    modal start (:meth:`Modes.chain`, dampers from the modal damping)."""
+    n = len(modes.frequency)
+    J0, k0 = modes.chain()
+    B0 = modal_damping(J0, k0, modes)
+    start = np.concatenate([J0, k0, B0])
+    note = (
+        "chain with the record's clamped modes "
+        + ", ".join(f"{w:.4g}" for w in modes.frequency)
+        + " rad/s (subspace stabilization diagram) and their residues"
+    )
+    first = Fit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
+    first.extra.update(_mode_evidence(modes))
+    result = refine(encoder, record, first, n)
+    if record is not None:
+        result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
+    return result
 
 
 def _strongest(detected: Detected, n: int) -> Modes:
