@@ -139,8 +139,9 @@ ROWS: dict[str, Row] = {
         ),
         Row(
             "belt-like two-mass, 4 kHz, friction",
-            _drive(*_BELT, J_m=1.2e-4, k_t=0.1, D_m=1e-4, f_c=0.01, current_noise=0.01,
-                   counts=2**14),
+            _drive(
+                *_BELT, J_m=1.2e-4, k_t=0.1, D_m=1e-4, f_c=0.01, current_noise=0.01, counts=2**14
+            ),
             h=2.5e-4,
             g_dist=400.0,
             lines=np.geomspace(10.0, 600.0, 40),
