@@ -204,12 +204,10 @@ def mean_sign(velocity: np.ndarray) -> np.ndarray:
     takes its own sign. Shape (N,)."""
     w0, w1 = velocity[:-1], velocity[1:]
     s0, s1 = np.sign(w0), np.sign(w1)
-    out = 0.5 * (s0 + s1)  # same sign, or one end at 0
+    out = np.sign(s0 + s1)  # no reversal: the sign of the end that moves (0 if neither)
     cross = s0 * s1 < 0
     r = w0[cross] / (w0[cross] - w1[cross])  # fraction of the step before the reversal
     out[cross] = s0[cross] * (2.0 * r - 1.0)
-    both_moving_same = (s0 == s1) & (s0 != 0)
-    out[both_moving_same] = s0[both_moving_same]
     return np.concatenate([[np.sign(velocity[0])], out])
 
 

@@ -28,9 +28,10 @@ Contract (scripts rely on it)::
   current to the encoder). ``--load constant|slow``: a load torque on the last mass is
   part of the model (fitted, reported as ``tau_load``). ``--masses auto`` reads the
   number of masses from the record. The report's ``assumptions`` say what the result
-  is conditional on (and any drive parameter left at the bench's default). ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
-  own parameter names: pass them back with ``--set`` in mode 2), their standard errors
-  under ``std``, and the evidence (modes seen, singular values, criterion per n).
+  is conditional on (and any drive parameter left at the bench's default). ``--json``
+  prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's own parameter names: pass them
+  back with ``--set`` in mode 2), their standard errors under ``std``, and the evidence
+  (modes seen and their residue t values, weak modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
 

@@ -105,10 +105,11 @@ DAMPING_TOLERANCE = 0.01
 STABLE_ORDERS = 4
 #: A mode's residue must exceed this many of its standard errors to count as excited.
 RESIDUE_T = 4.0
-#: A pole this lightly damped within :data:`LINE_TOLERANCE` (relative, or a quarter of
-#: the record's frequency bin 2π/T) of an excitation line is the line, not a mode: a multi-sine input is
-#: itself the output of undamped oscillators, and the subspace step fits them where
-#: the motor angle cannot explain the torque at the line (encoder counts).
+#: With ``lines`` given to :func:`detect_modes`, a pole this lightly damped within
+#: :data:`LINE_TOLERANCE` (relative, or a quarter of the record's bin 2π/T) of an
+#: excitation line is taken for the line (a multi-sine is itself the output of undamped
+#: oscillators). The whole-chain fit does not ask for it: a lightly damped mode may sit
+#: on a line (the bench's first mode does), and the information criterion decides.
 LINE_DAMPING = 0.003
 LINE_TOLERANCE = 0.005
 #: An excitation line stands this many times above the current spectrum's median.
