@@ -233,10 +233,18 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
     t_value = residue / np.maximum(std, 1e-300)
     counts = t_value >= RESIDUE_T
     weak = [(float(w), float(t)) for w, t, c in zip(frequency, t_value, counts) if not c]
-    if np.any(counts) and not np.all(counts):  # refit without the weak ones
+    while np.any(counts) and not np.all(counts):  # refit without the weak ones, until
         residue_c, std_c = residues_with_errors(record, frequency[counts], damping[counts])
         residue[counts], std[counts] = residue_c, std_c
         t_value[counts] = residue_c / np.maximum(std_c, 1e-300)
+        still = t_value >= RESIDUE_T
+        if np.all(still[counts]):  # every mode kept stands on its own
+            break
+        weak += [
+            (float(w), float(t))
+            for w, t in zip(frequency[counts & ~still], t_value[counts & ~still])
+        ]
+        counts &= still
     return Detected(
         frequency[counts],
         damping[counts],
