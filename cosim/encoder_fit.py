@@ -454,13 +454,18 @@ def refine(record: EncoderRecord, motor: MotorRecord | None, start: Fit, n: int)
     floor = 1e-3 * np.mean(chain[2 * n :]) if np.any(chain[2 * n :] > 0) else 1e-9
     chain[2 * n :] = np.maximum(chain[2 * n :], floor)
     first = pack(Drive(chain[:n], chain[n : 2 * n], chain[2 * n :], record.D_m, record.f_c), record)
-    values, _, _, evaluations = _least_squares(record, first, n)
+    values, residual, jac, evaluations = _least_squares(record, first, n)
     drive = unpack(values, n, record)
-    states = _Kalman.of(record, drive).smoothed(record, drive)
-    record = replace(
-        record, friction_sign=stuck_aware_sign(record, drive, states), velocity=states[:, n + 1]
-    )
-    values, residual, jac, more = _least_squares(record, values, n)
+    with np.errstate(all="ignore"):
+        states = _Kalman.of(record, drive).smoothed(record, drive)
+    more = 0
+    if np.all(np.isfinite(states)):  # else the first pass's drive is no chain to smooth with
+        record = replace(
+            record,
+            friction_sign=stuck_aware_sign(record, drive, states),
+            velocity=states[:, n + 1],
+        )
+        values, residual, jac, more = _least_squares(record, values, n)
     drive = unpack(values, n, record)
     lag = decorrelation_lag(residual, 1)
     std = np.sqrt(np.clip(np.diag(newey_west_covariance(jac, residual, lag)), 0.0, None))
@@ -525,7 +530,14 @@ def _least_squares(
     x0 = first / scale
 
     def residual(x: np.ndarray) -> np.ndarray:
-        return innovations(record, (), (), (), unpack(x * scale, n, record))
+        with np.errstate(all="ignore"):
+            e = innovations(record, (), (), (), unpack(x * scale, n, record))
+        if not np.all(np.isfinite(e)):
+            raise UserError(
+                f"the prediction-error fit of {n} mass(es) diverged (the record does not "
+                "determine that chain): excite the modes better or fit fewer masses"
+            )
+        return e
 
     result = optimize.least_squares(
         residual,

@@ -41,8 +41,8 @@ from flexchain.chain import spring_matrix
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
-#: With ``auto``, a weakest mode whose residue is below this many standard errors is
-#: confirmed by the data: the n − 1 fit is run too and the lower BIC of the two wins.
+#: With ``auto``, modes whose residues are below this many standard errors are confirmed
+#: by the data: the fits without them (weakest first) are run too, the lowest BIC wins.
 T_CONFIRM = 30.0
 #: Length (s) of the opening those two fits run on.
 CONFIRM_SECONDS = 5.0
@@ -173,13 +173,17 @@ def identify(
         result = fit_chain(record, n, _strongest(detected, n))
         criterion[n] = information_criterion(result, record)
     else:
-        if auto and n >= 2 and float(np.min(detected.t_value)) < T_CONFIRM:
-            # the weakest mode is not beyond doubt: let the data decide (BIC of the n and
-            # n − 1 fits on the record's first CONFIRM_SECONDS)
+        sure = int(np.sum(detected.t_value >= T_CONFIRM))
+        if auto and n >= 2 and sure < n:
+            # the weakest modes are not beyond doubt: let the data decide (BIC of the fits
+            # without them, weakest first, on the record's first CONFIRM_SECONDS)
             short = encoder_opening(encoder, CONFIRM_SECONDS)
-            for m in (n, n - 1):
-                trial = _prediction_error(None, short, _strongest(detected, m))
-                criterion[m] = trial.extra["information_criterion"]
+            for m in range(n, max(sure, 1) - 1, -1):
+                try:
+                    trial = _prediction_error(None, short, _strongest(detected, m))
+                    criterion[m] = trial.extra["information_criterion"]
+                except (UserError, ValueError, np.linalg.LinAlgError):
+                    criterion[m] = float("inf")  # no chain of m masses fits the opening
             n = min(criterion, key=criterion.__getitem__)
         result = _prediction_error(record, encoder, _strongest(detected, n))
     result.extra.update(
@@ -188,6 +192,12 @@ def identify(
         weak_modes=[{"rad_s": w, "t": t} for w, t in detected.weak],
         excitation_lines_taken=[float(w) for w in detected.lines],
         assumptions=assumptions(encoder),
+        warnings=[
+            f"the mode at {w:.1f} rad/s is weakly determined (residue t = {t:.0f} < "
+            f"{T_CONFIRM:g}); the information criterion kept {n} masses"
+            for w, t in zip(detected.frequency, detected.t_value)
+            if t < T_CONFIRM
+        ],
     )
     refused = {}
     if detected.weak:
