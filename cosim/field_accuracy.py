@@ -9,7 +9,9 @@ noise and the multi-sine's phases): the n chosen, the errors of every J_i, k_i, 
 time of the identification.
 
 Run: ``python -m cosim.field_accuracy [--seeds 20] [--rows NAME ...] [--out FILE.json]``
-(prints the markdown table).
+(prints the markdown table); ``--speed`` times the identification instead (five-mass and
+three-mass at 1 kHz, three-mass at 4 kHz, 20 s; five-mass 10 and 40 s for the growth
+with record length).
 """
 
 from __future__ import annotations
@@ -265,12 +267,59 @@ def markdown(summaries: dict[str, dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: Speed rows: (label, row, record length s).
+SPEED = (
+    ("five-mass, 1 kHz, 20 s", "five-mass, weak top mode", 20.0),
+    ("three-mass, 1 kHz, 20 s", "three-mass, slow load torque", 20.0),
+    ("three-mass, 4 kHz, 20 s", "three-mass, 4 kHz", 20.0),
+    ("five-mass, 1 kHz, 10 s", "five-mass, weak top mode", 10.0),
+    ("five-mass, 1 kHz, 40 s", "five-mass, weak top mode", 40.0),
+)
+
+
+def speed(repeats: int = 3) -> list[dict]:
+    """Wall and CPU seconds of the identification (log → result, simulation excluded),
+    median of ``repeats``; the three-mass 1 kHz row without its load model."""
+    global DURATION
+    out = []
+    for label, name, seconds in SPEED:
+        row = ROWS[name]
+        if row.load != "none":
+            row = replace(row, load="none", drive=replace(row.drive, load_sine=(0.0, 0.0)))
+        saved, DURATION = DURATION, seconds
+        try:
+            runs = [run_row(row, seed) for seed in range(1, repeats + 1)]
+        finally:
+            DURATION = saved
+        out.append(
+            {
+                "what": label,
+                "n_right": sum(r.get("n") == row.drive.n for r in runs),
+                "seconds": float(np.median([r["seconds"] for r in runs])),
+                "cpu_seconds": float(np.median([r["cpu_seconds"] for r in runs])),
+                "load_average": os.getloadavg()[0],
+            }
+        )
+    return out
+
+
 def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = print) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--rows", nargs="*", default=list(ROWS))
     parser.add_argument("--out", type=Path)
+    parser.add_argument("--speed", action="store_true", help="time the speed rows instead")
     args = parser.parse_args(argv)
+    if args.speed:
+        rows = speed()
+        print("| what | n right | s wall (median of 3) | s CPU | load average |")
+        print("|---|---|---|---|---|")
+        for r in rows:
+            print(
+                f"| {r['what']} | {r['n_right']} of 3 | {r['seconds']:.2f} "
+                f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
+            )
+        return 0
     results: dict[str, list[dict]] = {}
     summaries: dict[str, dict] = {}
     for name in args.rows:

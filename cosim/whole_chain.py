@@ -156,36 +156,28 @@ def identify(
     lines = None  # excitation lines are not rejected: a lightly damped mode may sit on one
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     detected = detect_modes(record, largest, lines)
-    if encoder is not None and not encoder.friction_given and detected.n:
+    unknown = encoder is not None and not encoder.friction_given
+    raw = record
+    if unknown and detected.n:
         # τ̂ was computed without friction: estimate it from the first modes, take it
         # out of τ̂, and read the modes again
         modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
         J0, k0 = modes.chain()
         D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
-        record = without_friction(record, encoder, D_m, f_c)
+        record = without_friction(raw, encoder, D_m, f_c)
         encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
         detected = detect_modes(record, largest, lines)
-    n = detected.n if auto else n_asked
-    if n < 1 or detected.n < n:
-        raise UserError(missing_modes(detected, n if n >= 1 else None, record))
-    criterion: dict[int, float] = {}
-    if encoder is None:
-        result = fit_chain(record, n, _strongest(detected, n))
-        criterion[n] = information_criterion(result, record)
-    else:
-        sure = int(np.sum(detected.t_value >= T_CONFIRM))
-        if auto and n >= 2 and sure < n:
-            # the weakest modes are not beyond doubt: let the data decide (BIC of the fits
-            # without them, weakest first, on the record's first CONFIRM_SECONDS)
-            short = encoder_opening(encoder, CONFIRM_SECONDS)
-            for m in range(n, max(sure, 1) - 1, -1):
-                try:
-                    trial = _prediction_error(None, short, _strongest(detected, m))
-                    criterion[m] = trial.extra["information_criterion"]
-                except (UserError, ValueError, np.linalg.LinAlgError):
-                    criterion[m] = float("inf")  # no chain of m masses fits the opening
-            n = min(criterion, key=criterion.__getitem__)
-        result = _prediction_error(record, encoder, _strongest(detected, n))
+    n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    if unknown:
+        # the fit's friction is far better than the start's: read the modes once more
+        # with it, and fit again if they changed
+        D_m, f_c = result.extra["D_m"], result.extra["f_c"]
+        again = detect_modes(without_friction(raw, encoder, D_m, f_c), largest, lines)
+        if not _same_modes(again, detected):
+            record = without_friction(raw, encoder, D_m, f_c)
+            encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+            detected = again
+            n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
@@ -231,6 +223,44 @@ def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes:
     if record is not None:
         result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
     return result
+
+
+def _same_modes(a: Detected, b: Detected, tolerance: float = 5e-3) -> bool:
+    """Two mode readings agree: as many modes, each within ``tolerance`` (relative)."""
+    if a.n != b.n:
+        return False
+    return bool(np.all(np.abs(a.frequency - b.frequency) <= tolerance * b.frequency))
+
+
+def _choose_and_fit(
+    record: MotorRecord,
+    encoder: EncoderRecord | None,
+    detected: Detected,
+    auto: bool,
+    n_asked: int | None,
+) -> tuple[int, Fit, dict[int, float]]:
+    """n (read, or asked and checked), the fit, and the criterion per n tried."""
+    n = detected.n if auto else n_asked
+    if n < 1 or detected.n < n:
+        raise UserError(missing_modes(detected, n if n >= 1 else None, record))
+    criterion: dict[int, float] = {}
+    if encoder is None:
+        result = fit_chain(record, n, _strongest(detected, n))
+        criterion[n] = information_criterion(result, record)
+        return n, result, criterion
+    sure = int(np.sum(detected.t_value >= T_CONFIRM))
+    if auto and n >= 2 and sure < n:
+        # the weakest modes are not beyond doubt: let the data decide (BIC of the fits
+        # without them, weakest first, on the record's first CONFIRM_SECONDS)
+        short = encoder_opening(encoder, CONFIRM_SECONDS)
+        for m in range(n, max(sure, 1) - 1, -1):
+            try:
+                trial = _prediction_error(None, short, _strongest(detected, m))
+                criterion[m] = trial.extra["information_criterion"]
+            except (UserError, ValueError, np.linalg.LinAlgError):
+                criterion[m] = float("inf")  # no chain of m masses fits the opening
+        n = min(criterion, key=criterion.__getitem__)
+    return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
 
 
 def _strongest(detected: Detected, n: int) -> Modes:
