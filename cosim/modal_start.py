@@ -99,7 +99,7 @@ EXTRA_PAIRS = 4
 #: Two poles of neighbouring orders are the same mode when their frequencies differ by
 #: less than this fraction and their damping ratios by less than
 #: :data:`DAMPING_TOLERANCE` (absolute) or half their own.
-FREQUENCY_TOLERANCE = 0.01
+FREQUENCY_TOLERANCE = 0.02
 DAMPING_TOLERANCE = 0.01
 #: A mode must be found at this many model orders (of the diagram's) to count.
 STABLE_ORDERS = 4
@@ -259,16 +259,17 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
 
 
 def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, int]]:
-    """Modes of the stabilization diagram: chains of poles of consecutive orders that
-    match (frequency and damping within tolerance), at least :data:`STABLE_ORDERS`
-    long; each as (median frequency, median damping, length), one per frequency."""
+    """Modes of the stabilization diagram: chains of poles of increasing orders that
+    match the chain so far (its median frequency and damping, within tolerance; one
+    order may be skipped), at least :data:`STABLE_ORDERS` poles long; each as (median
+    frequency, median damping, length), one per frequency."""
     chains: list[list[tuple[float, float]]] = []
-    open_chains: list[list[tuple[float, float]]] = []
+    open_chains: list[tuple[list[tuple[float, float]], int]] = []  # (poles, misses)
     for poles in per_order:
-        extended: list[list[tuple[float, float]]] = []
+        extended: list[tuple[list[tuple[float, float]], int]] = []
         used = np.zeros(len(poles), dtype=bool)
-        for chain in open_chains:
-            w, z = chain[-1]
+        for chain, misses in open_chains:
+            w, z = np.median(np.array(chain), axis=0)
             if len(poles):
                 df = np.abs(poles[:, 0] - w) / w
                 dz = np.abs(poles[:, 1] - z)
@@ -281,13 +282,16 @@ def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, in
                     j = int(np.flatnonzero(ok)[np.argmin(df[ok])])
                     used[j] = True
                     chain.append((float(poles[j, 0]), float(poles[j, 1])))
-                    extended.append(chain)
+                    extended.append((chain, 0))
                     continue
-            chains.append(chain)
+            if misses == 0:
+                extended.append((chain, 1))  # one order without it: keep it open
+            else:
+                chains.append(chain)
         for j in np.flatnonzero(~used):
-            extended.append([(float(poles[j, 0]), float(poles[j, 1]))])
+            extended.append(([(float(poles[j, 0]), float(poles[j, 1]))], 0))
         open_chains = extended
-    chains += open_chains
+    chains += [chain for chain, _ in open_chains]
     found = []
     for chain in chains:
         if len(chain) >= STABLE_ORDERS:
