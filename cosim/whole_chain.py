@@ -41,10 +41,11 @@ from flexchain.chain import spring_matrix
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
-#: With ``auto``, modes whose residues are below this many standard errors are confirmed
-#: by the data: the fits without them (weakest first) are run too, the lowest BIC wins.
+#: A mode whose residue is below this many standard errors is reported as weakly
+#: determined (the result's warnings).
 T_CONFIRM = 30.0
-#: Length (s) of the opening those two fits run on.
+#: Length (s) of the opening the order check's fits run on (``auto``: the n modes seen,
+#: then without the weakest, one at a time while the BIC falls).
 CONFIRM_SECONDS = 5.0
 
 
@@ -186,7 +187,7 @@ def identify(
         assumptions=assumptions(encoder),
         warnings=[
             f"the mode at {w:.1f} rad/s is weakly determined (residue t = {t:.0f} < "
-            f"{T_CONFIRM:g}); the information criterion kept {n} masses"
+            f"{T_CONFIRM:g}); the information criterion chose {n} masses"
             for w, t in zip(detected.frequency, detected.t_value)
             if t < T_CONFIRM
         ],
@@ -248,18 +249,25 @@ def _choose_and_fit(
         result = fit_chain(record, n, _strongest(detected, n))
         criterion[n] = information_criterion(result, record)
         return n, result, criterion
-    sure = int(np.sum(detected.t_value >= T_CONFIRM))
-    if auto and n >= 2 and sure < n:
-        # the weakest modes are not beyond doubt: let the data decide (BIC of the fits
-        # without them, weakest first, on the record's first CONFIRM_SECONDS)
+    if auto and n >= 2:
+        # the data decide: BIC of the fits without the weakest modes, on the record's
+        # first CONFIRM_SECONDS, as long as dropping one more lowers it (a pole of the
+        # noise or of an excitation line adds nothing to the prediction of the encoder)
         short = encoder_opening(encoder, CONFIRM_SECONDS)
-        for m in range(n, max(sure, 1) - 1, -1):
+
+        def bic(m: int) -> float:
             try:
                 trial = _prediction_error(None, short, _strongest(detected, m))
-                criterion[m] = trial.extra["information_criterion"]
+                return trial.extra["information_criterion"]
             except (UserError, ValueError, np.linalg.LinAlgError):
-                criterion[m] = float("inf")  # no chain of m masses fits the opening
-        n = min(criterion, key=criterion.__getitem__)
+                return float("inf")  # no chain of m masses fits the opening
+
+        criterion[n] = bic(n)
+        while n >= 2:
+            criterion[n - 1] = bic(n - 1)
+            if not criterion[n - 1] < criterion[n]:
+                break
+            n -= 1
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
 
 
