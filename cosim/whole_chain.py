@@ -244,6 +244,13 @@ def _choose_and_fit(
     n = detected.n if auto else n_asked
     if n < 1 or detected.n < n:
         raise UserError(missing_modes(detected, n if n >= 1 else None, record))
+    if float(np.max(detected.t_value)) < T_CONFIRM:
+        raise UserError(
+            "every mode the record shows is weakly determined (residue t values "
+            + ", ".join(f"{t:.0f}" for t in detected.t_value)
+            + f", all under {T_CONFIRM:g}): "
+            + missing_modes(detected, None, record)
+        )
     criterion: dict[int, float] = {}
     if encoder is None:
         result = fit_chain(record, n, _strongest(detected, n))
