@@ -320,6 +320,8 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
         weak_modes=result.extra["weak_modes"],
         refused={str(n): why for n, why in choice.refused.items()},
         assumptions=result.extra["assumptions"],
+        warnings=result.extra["warnings"],
+        criterion={str(n): v for n, v in choice.criterion.items()},
         masses_seen=choice.seen,
     )
     defaults = [name for name in ("J_mo", "k_to", "encoder_cpr") if name not in given]
@@ -343,6 +345,8 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
         print(f"  {key}: {report[key]}")
     for key, text in result.extra["assumptions"].items():
         print(f"  assumption, {key}: {text}")
+    for text in result.extra["warnings"]:
+        print(f"  warning: {text}")
     chain = {k: v for k, v in result.as_dict().items() if k[0] in "JkB" and "[" in k}
     settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in chain.items())
     print(f"observer in mode 2 with this chain: --masses {choice.n} {settings}")

@@ -350,7 +350,9 @@ def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
     scale = (
         "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
         "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
-        "homogeneous in torque); J_m alone off moves J[1] most"
+        "homogeneous in torque); one of them alone off distorts the chain unevenly, by "
+        "up to about 1.5 ε (measured on a five-mass chain: k_t +5 % gave J_i, k_i "
+        "−1.5 … +7.3 %, J_m +5 % gave −0.5 … +4.2 %)"
     )
     out = {"actuator": scale}
     if encoder is None:
