@@ -16,15 +16,9 @@ with record length).
 
 from __future__ import annotations
 
-import os
-
-# Small matrices (10×10 exponentials, Riccati steps) on a shared 2-core machine:
-# OpenBLAS's threads made each one ~1000× slower (12 ms instead of 13 µs) under load.
-# Effective only when this runs before numpy is imported (``python -m``).
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
 import argparse
 import json
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain import bench, excitation
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_excitation import ExcitationError, excite
@@ -21,6 +20,7 @@ from arcosim.identification.encoder_fit import (
     mean_sign,
     output_recursion,
 )
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import check
 from arcosim.identification.output_error import linear_recursion, motor_record
 from arcosim.identification.whole_chain import identify, split
@@ -132,7 +132,9 @@ def test_three_masses_at_4_khz_and_a_refusal_that_names_the_modes() -> None:
     d = drive(J=THREE["J"], k=THREE["k"], B=THREE["B"])
     log = field_sim.simulate(d, 2.5e-4, 10.0, current=field_sim.multisine(LINES, 3.0))
     assert_chain(fit(d, log), d, rtol=5e-3)
-    with pytest.raises(UserError, match=r"3 excited mode\(s\).*11\.2, 26\.6, 53\.0.*5 masses"):
+    with pytest.raises(
+        IdentificationError, match=r"3 excited mode\(s\).*11\.2, 26\.6, 53\.0.*5 masses"
+    ):
         fit(d, log, masses=5)
 
 

@@ -11,9 +11,9 @@ import pytest
 from scipy import signal
 
 from arcosim.cli import main
-from arcosim.errors import UserError
 from arcosim.experiments.scenarios import SCENARIOS, run_scenario
 from arcosim.fmu.flexchain import bench
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     MotorRecord,
     constant_step,
@@ -60,12 +60,12 @@ def test_a_record_without_torque_is_refused() -> None:
     """A log whose reaction torque never moved cannot show a resonance."""
     t = np.arange(5001) * H
     record = MotorRecord(H, 0.5 * np.sin(t), np.zeros_like(t), 100.0)
-    with pytest.raises(UserError, match="shows no resonance"):
+    with pytest.raises(IdentificationError, match="shows no resonance"):
         uniform_chain(record, bench.J)
 
 
 def test_a_variable_step_is_refused() -> None:
-    with pytest.raises(UserError, match="constant sample step"):
+    with pytest.raises(IdentificationError, match="constant sample step"):
         constant_step(np.array([0.0, 1e-3, 2e-3, 4e-3]))
 
 

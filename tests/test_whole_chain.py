@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from arcosim.cli import main
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain import bench
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification import encoder_fit
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.encoder_fit import EncoderRecord, encoder_record
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import Fit, MotorRecord, predict
 from arcosim.identification.whole_chain import fit_chain, identify, names, split
 
@@ -84,23 +84,25 @@ def test_a_record_that_cannot_determine_the_chain_is_refused_with_what_to_do() -
     start rings the modes, and with ζ ≈ 1e-3 the ringing determines the chain.)"""
     good = record(10.0)
     noise = np.random.default_rng(1).normal(0.0, 1e-3, len(good.theta_m))
-    with pytest.raises(UserError, match=r"lightly damped mode|carry no reaction torque"):
+    with pytest.raises(IdentificationError, match=r"lightly damped mode|carry no reaction torque"):
         fit_chain(MotorRecord(H, good.theta_m, noise, 100.0), 2)
 
 
 def test_a_record_too_short_for_its_modes_is_refused() -> None:
-    with pytest.raises(UserError, match=r"too short to find 5 modes.*record at least 1\.1 s"):
+    with pytest.raises(
+        IdentificationError, match=r"too short to find 5 modes.*record at least 1\.1 s"
+    ):
         fit_chain(record(1.0), 5)
 
 
 @pytest.mark.parametrize("masses", ["0", "two", "-1", "2.5"])
 def test_a_bad_number_of_masses_is_refused(masses: str) -> None:
-    with pytest.raises(UserError, match="masses"):
+    with pytest.raises(IdentificationError, match="masses"):
         identify(record(3.0), masses)
 
 
 def test_a_chain_without_masses_is_refused() -> None:
-    with pytest.raises(UserError, match="at least one load mass"):
+    with pytest.raises(IdentificationError, match="at least one load mass"):
         fit_chain(record(3.0), 0)
 
 
@@ -173,5 +175,5 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
 
 def test_an_encoder_without_counts_is_refused() -> None:
     actuator = Actuator(bench.J_M, bench.K_T)
-    with pytest.raises(UserError, match="counts per revolution"):
+    with pytest.raises(IdentificationError, match="counts per revolution"):
         encoder_record(np.arange(5) * H, np.zeros(5), np.zeros(5), actuator, 0)

@@ -35,9 +35,9 @@ import numpy as np
 import scipy.linalg
 from scipy import optimize, signal
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.chain import spring_matrix
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     Fit,
     MotorRecord,
@@ -133,13 +133,15 @@ def encoder_record(
     starts from a rigid-body estimate (:func:`rigid_friction`).
 
     Raises:
-        UserError: for an encoder without counts (``cpr`` ≤ 0), a varying step or an
+        IdentificationError: for an encoder without counts (``cpr`` ≤ 0), a varying step or an
             unknown ``load``.
     """
     if cpr <= 0:
-        raise UserError("the prediction-error fit needs the encoder's counts per revolution")
+        raise IdentificationError(
+            "the prediction-error fit needs the encoder's counts per revolution"
+        )
     if load not in LOADS:
-        raise UserError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
+        raise IdentificationError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
     h = constant_step(time)
     count = 2.0 * np.pi / cpr
     theta = np.asarray(theta_m, dtype=float) + count / 2.0
@@ -533,7 +535,7 @@ def _least_squares(
         with np.errstate(all="ignore"):
             e = innovations(record, (), (), (), unpack(x * scale, n, record))
         if not np.all(np.isfinite(e)):
-            raise UserError(
+            raise IdentificationError(
                 f"the prediction-error fit of {n} mass(es) diverged (the record does not "
                 "determine that chain): excite the modes better or fit fewer masses"
             )

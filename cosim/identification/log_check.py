@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import (
     SIGN_VELOCITY_CUTOFF,
     STUCK_VELOCITY_COUNTS,
     encoder_record,
 )
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import Detected, detect_modes, excitation_lines
 from arcosim.identification.output_error import motor_record, smooth_velocity
 from arcosim.identification.whole_chain import friction_start, modal_damping, without_friction
@@ -106,6 +107,7 @@ class CheckReport:
         return "\n".join(out)
 
 
+@single_threaded
 def check(
     time: np.ndarray,
     i_a: np.ndarray,
@@ -172,7 +174,7 @@ def check(
             )
     try:
         detected = _modes(time, np.asarray(i_a, float), omega_m, theta, k_t, J_m, counts, g_dist)
-    except UserError as error:
+    except IdentificationError as error:
         detected = None
         report.problems.append(str(error))
     if detected is not None:

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
-from arcosim.errors import UserError
 from arcosim.identification.chain_modes import chain_from_modes
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     MotorRecord,
     decorrelation_lag,
@@ -69,20 +69,20 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     """The n clamped modes of the chain in ``record`` and their residues.
 
     Raises:
-        UserError: when the record is too short, or shows fewer than n modes.
+        IdentificationError: when the record is too short, or shows fewer than n modes.
     """
     band = _band(record)
     u, y, step = _decimated(record, band)
     rows = max(2 * n + 4, min(ROWS, len(u) // 8))
     if len(u) < 8 * (2 * n + 4):
-        raise UserError(
+        raise IdentificationError(
             f"the record ({record.duration:g} s) is too short to find {n} modes below "
             f"{band:.0f} rad/s; record at least {8 * (2 * n + 4) * step:.1f} s (20 s advised)"
         )
     frequency, damping, singular = _modes(u, y, n, rows, step, band)
     if len(frequency) < n:
         found = ", ".join(f"{w:.1f}" for w in frequency) or "none"
-        raise UserError(
+        raise IdentificationError(
             f"the record shows {len(frequency)} lightly damped mode(s) below {band:.0f} rad/s "
             f"({found} rad/s), {chain_of(n)} has {n}: excite every mode (a multi-sine "
             "with many lines across the band, `arcosim simulate --scenario identification`) "
@@ -91,7 +91,7 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     residue = residues(record, frequency, damping)
     if np.any(residue <= 0.0):
         missing = ", ".join(f"{w:.1f}" for w in frequency[residue <= 0.0])
-        raise UserError(
+        raise IdentificationError(
             f"the mode(s) at {missing} rad/s carry no reaction torque when the record is "
             f"read as {chain_of(n)}: try another number of masses (--masses auto)"
         )
@@ -192,14 +192,14 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
     spacing of the modes or the size of their residues.
 
     Raises:
-        UserError: when the record is too short.
+        IdentificationError: when the record is too short.
     """
     band = _band(record)
     u, y, step = _decimated(record, band)
     top = 2 * (largest + EXTRA_PAIRS)
     rows = max(top + 2, min(ROWS, len(u) // 8))
     if len(u) < 8 * (top // 2 + 4):
-        raise UserError(
+        raise IdentificationError(
             f"the record ({record.duration:g} s) is too short to show its modes below "
             f"{band:.0f} rad/s; record at least {8 * (top // 2 + 4) * step:.1f} s (20 s advised)"
         )
@@ -319,7 +319,9 @@ def singular_values(record: MotorRecord) -> np.ndarray:
     u, y, _ = _decimated(record, band)
     rows = min(ROWS, len(u) // 8)
     if rows < 4:
-        raise UserError(f"the record ({record.duration:g} s) is too short to show its modes")
+        raise IdentificationError(
+            f"the record ({record.duration:g} s) is too short to show its modes"
+        )
     singular = moesp(u, y, 2, rows)[1]
     return singular / singular[0]
 

@@ -26,10 +26,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy import optimize, signal
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import EncoderRecord, refine
 from arcosim.identification.encoder_fit import opening as encoder_opening
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import Detected, Modes, chain_of, detect_modes, record_modes
 from arcosim.identification.output_error import (
     Fit,
@@ -72,11 +73,11 @@ def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Fit:
         ``damping_ratios``) and the subspace singular values (``singular_values``).
 
     Raises:
-        UserError: for n < 1, or a record that shows no motion, no reaction torque or
+        IdentificationError: for n < 1, or a record that shows no motion, no reaction torque or
             fewer than n modes.
     """
     if n < 1:
-        raise UserError(f"the chain needs at least one load mass, got {n}")
+        raise IdentificationError(f"the chain needs at least one load mass, got {n}")
     check_excited(record)
     if modes is None:
         modes = record_modes(record, n)
@@ -131,6 +132,7 @@ class Choice:
     singular_values: np.ndarray | None = None
 
 
+@single_threaded
 def identify(
     record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
 ) -> Choice:
@@ -148,7 +150,7 @@ def identify(
     from the modal start; without it, by the output-error fit to τ̂_reac.
 
     Raises:
-        UserError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
+        IdentificationError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
             record cannot support the chain asked for.
     """
     auto = masses == "auto"
@@ -243,9 +245,9 @@ def _choose_and_fit(
     """n (read, or asked and checked), the fit, and the criterion per n tried."""
     n = detected.n if auto else n_asked
     if n < 1 or detected.n < n:
-        raise UserError(missing_modes(detected, n if n >= 1 else None, record))
+        raise IdentificationError(missing_modes(detected, n if n >= 1 else None, record))
     if float(np.max(detected.t_value)) < T_CONFIRM:
-        raise UserError(
+        raise IdentificationError(
             "every mode the record shows is weakly determined (residue t values "
             + ", ".join(f"{t:.0f}" for t in detected.t_value)
             + f", all under {T_CONFIRM:g}): "
@@ -266,7 +268,7 @@ def _choose_and_fit(
             try:
                 trial = _prediction_error(None, short, _strongest(detected, m))
                 return trial.extra["information_criterion"]
-            except (UserError, ValueError, np.linalg.LinAlgError):
+            except (IdentificationError, ValueError, np.linalg.LinAlgError):
                 return float("inf")  # no chain of m masses fits the opening
 
         criterion[n] = bic(n)
@@ -404,5 +406,5 @@ def _masses(masses: int | str) -> int:
     except ValueError:
         n = 0
     if n < 1 or str(masses).strip() not in (str(n), "auto"):
-        raise UserError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
+        raise IdentificationError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
     return n
