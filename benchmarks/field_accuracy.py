@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.encoder_fit import encoder_record
@@ -84,7 +85,7 @@ class Row:
     name: str
     drive: field_sim.Drive
     h: float = 1e-3
-    g_dist: float = 100.0
+    g_dist: float = G_DIST
     lines: np.ndarray = field(default_factory=lambda: LINES)
     amplitude: float = AMPLITUDE
     speed_loop: tuple[float, float] | None = None

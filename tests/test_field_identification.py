@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from arcosim.fmu.flexchain import bench, excitation
+from arcosim.fmu.flexchain import defaults, excitation
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_excitation import ExcitationError, excite
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
@@ -31,7 +31,7 @@ THREE = dict(J=(3e-4, 5e-4, 4e-4), k=(0.25, 0.4, 0.15), B=(1.2e-5, 1.5e-5, 6e-6)
 
 
 def drive(**kw) -> field_sim.Drive:
-    base = dict(J_m=bench.J_M, k_t=bench.K_T, D_m=bench.D_M, f_c=bench.F_C)
+    base = dict(J_m=defaults.J_M, k_t=defaults.K_T, D_m=defaults.D_M, f_c=defaults.F_C)
     base.update(THREE)
     base.update(current_noise=0.005)
     base.update(kw)
@@ -78,13 +78,13 @@ def test_the_simulator_agrees_with_the_project_plant(build_fmus) -> None:
     )
     plant = {k.split(".", 1)[1]: v for k, v in recording.signals.items()}
     d = field_sim.Drive(
-        bench.J_M,
-        bench.K_T,
-        bench.J,
-        (bench.K,) * 3,
-        (bench.B,) * 3,
-        bench.D_M,
-        bench.F_C,
+        defaults.J_M,
+        defaults.K_T,
+        defaults.J,
+        (defaults.K,) * 3,
+        (defaults.B,) * 3,
+        defaults.D_M,
+        defaults.F_C,
         counts=0,
     )
     log = field_sim.simulate(d, 1e-3, 5.0, current=current)
@@ -96,7 +96,9 @@ def test_the_simulator_agrees_with_the_project_plant(build_fmus) -> None:
 
 def test_a_current_below_the_friction_never_moves_the_motor() -> None:
     d = drive(counts=2**20)
-    log = field_sim.simulate(d, 1e-3, 1.0, current=lambda t: 0.9 * bench.F_C / bench.K_T + 0 * t)
+    log = field_sim.simulate(
+        d, 1e-3, 1.0, current=lambda t: 0.9 * defaults.F_C / defaults.K_T + 0 * t
+    )
     assert log.stuck_fraction == 1.0 and np.all(log.theta_true == 0.0)
 
 
@@ -181,7 +183,7 @@ def test_a_slowly_varying_load_torque_is_modelled_not_taken_for_the_chain() -> N
 
 
 def test_excite_designs_what_the_excitation_source_plays() -> None:
-    e = excite((3.0, 150.0), 3.0, k_t=bench.K_T, f_c=bench.F_C)
+    e = excite((3.0, 150.0), 3.0, k_t=defaults.K_T, f_c=defaults.F_C)
     assert e.source_parameters == {
         "signal": 1,
         "amplitude": 3.0,
@@ -193,7 +195,7 @@ def test_excite_designs_what_the_excitation_source_plays() -> None:
     same = [excitation.multisine(t, 3.0, list(e.frequencies), list(e.phases)) for t in e.time[:50]]
     np.testing.assert_allclose(e.signal[:50], same, atol=1e-12)
     assert np.max(np.abs(e.signal)) <= 3.0 and not e.warnings
-    weak = excite((3.0, 150.0), 1.0, k_t=bench.K_T, f_c=bench.F_C)
+    weak = excite((3.0, 150.0), 1.0, k_t=defaults.K_T, f_c=defaults.F_C)
     assert any("stick" in w for w in weak.warnings)
     speed = excite((3.0, 150.0), 3.0, kind="speed", speed_gain=0.3)
     assert speed.source_parameters is None and speed.amplitudes[-1] > 10 * speed.amplitudes[0]

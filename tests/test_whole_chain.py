@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from arcosim.cli import main
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification import encoder_fit
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
@@ -118,8 +118,8 @@ def test_identify_whole_chain_cli_finds_the_bench_from_the_motor_alone(
     report = json.loads(capsys.readouterr().out)
     assert report["masses"] == report["masses_seen"] == 3
     for i in range(3):
-        assert report[f"J[{i + 1}]"] == pytest.approx(bench.J[i], rel=0.02)
-        assert report[f"k[{i + 1}]"] == pytest.approx(bench.K, rel=0.02)
+        assert report[f"J[{i + 1}]"] == pytest.approx(defaults.J[i], rel=0.02)
+        assert report[f"k[{i + 1}]"] == pytest.approx(defaults.K, rel=0.02)
         assert report["std"][f"B[{i + 1}]"] > 0
     assert min(report["residue_t_values"]) > 30
     assert report["assumptions"]["friction"].startswith("given")
@@ -136,16 +136,16 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     """Motor + two-mass chain driven by a multi-sine torque, read by a 2000-count
     encoder; from a start 1 % off (B 30 % off), every parameter comes back within
     its standard error's reach."""
-    actuator = Actuator(bench.J_M, bench.K_T, 0.0, 0.0, bench.D_M, 0.0)
+    actuator = Actuator(defaults.J_M, defaults.K_T, 0.0, 0.0, defaults.D_M, 0.0)
     t = np.arange(10001) * H
     rng = np.random.default_rng(5)
     current = sum(0.1 * np.sin(w * t + rng.uniform(0, 2 * np.pi)) for w in LINES)
     count = 2 * np.pi / 2000
     zeros = np.zeros_like(t)
     exact = EncoderRecord(
-        H, bench.K_T * current, zeros, zeros, count, bench.J_M, bench.D_M, 0.0, 1e-4
+        H, defaults.K_T * current, zeros, zeros, count, defaults.J_M, defaults.D_M, 0.0, 1e-4
     )
-    truth_drive = encoder_fit.Drive(np.array(J), np.array(K), np.array(B), bench.D_M, 0.0)
+    truth_drive = encoder_fit.Drive(np.array(J), np.array(K), np.array(B), defaults.D_M, 0.0)
     A, Bd = encoder_fit._discrete(exact, truth_drive)
     x = np.zeros(len(A))
     theta, velocity = np.empty_like(t), np.empty_like(t)
@@ -174,6 +174,6 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
 
 
 def test_an_encoder_without_counts_is_refused() -> None:
-    actuator = Actuator(bench.J_M, bench.K_T)
+    actuator = Actuator(defaults.J_M, defaults.K_T)
     with pytest.raises(IdentificationError, match="counts per revolution"):
         encoder_record(np.arange(5) * H, np.zeros(5), np.zeros(5), actuator, 0)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.fmu.flexchain import excitation
+from arcosim.fmu.flexchain.defaults import STEP
 
 #: Lines of the multi-sine (log-spaced over the band).
 LINES = 40
@@ -78,7 +79,7 @@ class Excitation:
 def excite(
     band: tuple[float, float],
     current_limit: float,
-    h: float = 1e-3,
+    h: float = STEP,
     duration: float = DURATION,
     lines: int = LINES,
     kind: str = "current",

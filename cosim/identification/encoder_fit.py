@@ -36,6 +36,7 @@ import scipy.linalg
 from scipy import optimize, signal
 
 from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.defaults import G_DIST, VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
@@ -49,9 +50,6 @@ from arcosim.identification.output_error import (
     smooth_velocity,
 )
 
-#: Cutoff (rad/s) of the lag-free smoothing whose derivative gives the first pass its
-#: friction sign.
-SIGN_VELOCITY_CUTOFF = 400.0
 #: Floor of the process noise's standard deviation (N·m per step).
 TORQUE_STD_FLOOR = 1e-4
 #: Below this smoothed motor speed (encoder counts per second) the motor is taken as
@@ -124,10 +122,12 @@ def encoder_record(
     cpr: int,
     friction_given: bool = True,
     load: str = "none",
+    g_dist: float = G_DIST,
 ) -> EncoderRecord:
     """Build the record from a log (``theta_m`` as the encoder gives it: whole counts);
     the friction's sign from the angle's derivative smoothed without lag at
-    :data:`SIGN_VELOCITY_CUTOFF` (the second pass of :func:`refine` replaces it).
+    ``VELOCITY_SMOOTHING · g_dist``, as the motor record's DOB velocity (the second pass
+    of :func:`refine` replaces it).
 
     With ``friction_given=False`` the actuator's D_m, f_c are ignored and the fit
     starts from a rigid-body estimate (:func:`rigid_friction`).
@@ -146,11 +146,12 @@ def encoder_record(
     count = 2.0 * np.pi / cpr
     theta = np.asarray(theta_m, dtype=float) + count / 2.0
     drive = (actuator.k_to + actuator.dkt) * np.asarray(i_a, dtype=float)
-    velocity = smooth_velocity(theta, h, SIGN_VELOCITY_CUTOFF)
+    cutoff = VELOCITY_SMOOTHING * g_dist
+    velocity = smooth_velocity(theta, h, cutoff)
     J_m = actuator.J_mo + actuator.dJm
     D_m, f_c = actuator.D_m, actuator.f_c
     if not friction_given:
-        D_m, f_c = rigid_friction(drive, theta, h)
+        D_m, f_c = rigid_friction(drive, theta, h, cutoff)
     drift = LOAD_DRIFT * float(np.sqrt(np.mean(drive**2))) * np.sqrt(h)
     return EncoderRecord(
         h=h,
@@ -181,7 +182,9 @@ def opening(record: EncoderRecord, seconds: float) -> EncoderRecord:
     )
 
 
-def rigid_friction(drive: np.ndarray, theta: np.ndarray, h: float) -> tuple[float, float]:
+def rigid_friction(
+    drive: np.ndarray, theta: np.ndarray, h: float, sign_cutoff: float
+) -> tuple[float, float]:
     """Start values ``(D_m, f_c)`` from the record read as one rigid body: below a
     few rad/s the chain moves with the motor, so ``k_t i ≈ J_total α + D_m ω + f_c sgn ω``;
     least squares on the signals low-passed at 2 rad/s (J_total fitted too)."""
@@ -191,7 +194,7 @@ def rigid_friction(drive: np.ndarray, theta: np.ndarray, h: float) -> tuple[floa
     angle = signal.filtfilt(b, a, theta)
     omega = np.gradient(angle, h)
     alpha = np.gradient(omega, h)
-    sign = signal.filtfilt(b, a, np.sign(smooth_velocity(theta, h, SIGN_VELOCITY_CUTOFF)))
+    sign = signal.filtfilt(b, a, np.sign(smooth_velocity(theta, h, sign_cutoff)))
     X = np.column_stack([alpha, omega, sign])
     coef = np.linalg.lstsq(X, torque, rcond=None)[0]
     scale = float(np.sqrt(np.mean(drive**2)))

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from arcosim.fmu.flexchain.defaults import G_DIST, VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import (
-    SIGN_VELOCITY_CUTOFF,
     STUCK_VELOCITY_COUNTS,
     encoder_record,
 )
@@ -116,7 +116,7 @@ def check(
     k_t: float,
     J_m: float,
     counts: int,
-    g_dist: float = 100.0,
+    g_dist: float = G_DIST,
 ) -> CheckReport:
     """Check a log before a whole-chain fit (module doc). Raises nothing for a poor log:
     every finding goes into the report."""
@@ -142,7 +142,7 @@ def check(
             f"the encoder moved over {report.range_counts:.0f} counts only: raise the current"
         )
     if count:
-        speed = smooth_velocity(theta, h, SIGN_VELOCITY_CUTOFF)
+        speed = smooth_velocity(theta, h, VELOCITY_SMOOTHING * g_dist)
         report.stuck_fraction = float(np.mean(np.abs(speed) < STUCK_VELOCITY_COUNTS * count))
         if report.stuck_fraction > STUCK_LIMIT:
             report.problems.append(
@@ -209,7 +209,9 @@ def _modes(time, i_a, omega_m, theta, k_t, J_m, counts, g_dist) -> Detected:
     record = motor_record(time, i_a, omega_m, theta, actuator, g_dist)
     detected = detect_modes(record, LARGEST)
     if detected.n and counts > 0:
-        encoder = encoder_record(time, i_a, theta, actuator, counts, friction_given=False)
+        encoder = encoder_record(
+            time, i_a, theta, actuator, counts, friction_given=False, g_dist=g_dist
+        )
         modes = detected.modes()
         J0, k0 = modes.chain()
         D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))

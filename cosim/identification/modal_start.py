@@ -26,12 +26,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
+from arcosim.fmu.flexchain.filters import lowpass_pole
 from arcosim.identification.chain_modes import chain_from_modes
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     MotorRecord,
     decorrelation_lag,
     newey_west_covariance,
+    through_g,
 )
 
 #: Block rows of the subspace method's Hankel matrices (decimated samples).
@@ -346,8 +348,7 @@ def chain_of(n: int) -> str:
 def _decimated(record: MotorRecord, band: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Motor angle through G(s) and τ̂_reac, both low-passed (zero phase) and decimated
     so that the Nyquist frequency is about ``band``; and the new step (s)."""
-    a = np.exp(-record.g_dist * record.h)
-    u = signal.lfilter([1.0 - a], [1.0, -a], record.theta_m - record.theta_m[0])
+    u = through_g(record.theta_m - record.theta_m[0], record.g_dist, record.h)
     y = record.tau_hat
     factor = max(1, int(np.pi / (band * record.h)))
     if factor > 1:
@@ -427,7 +428,7 @@ def _modal_regressors(
     """The motor angle through ``1/p² − 1/(s² + 2ζps + p²)`` and G(s), per mode (N, n)."""
     h = record.h
     u = record.theta_m - record.theta_m[0]
-    a = np.exp(-record.g_dist * h)
+    a = lowpass_pole(record.g_dist, h)
     columns = []
     for p, zeta in zip(frequency, np.clip(damping, 1e-4, None)):
         numerator = [1.0, 2.0 * zeta * p, 0.0]

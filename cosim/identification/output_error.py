@@ -29,8 +29,10 @@ import scipy.linalg
 from scipy import optimize, signal
 
 from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.defaults import VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver
 from arcosim.fmu.flexchain.driven_chain import discretize
+from arcosim.fmu.flexchain.filters import lowpass_pole
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.errors import IdentificationError
 
@@ -57,6 +59,14 @@ class MotorRecord:
     def duration(self) -> float:
         """Record length (s)."""
         return self.h * (len(self.theta_m) - 1)
+
+
+def through_g(x: np.ndarray, g: float, h: float) -> np.ndarray:
+    """``x`` (shape ``(N,)``, any unit) through the DOB's ``G(s) = g / (s + g)`` (g in
+    rad/s) at a constant step ``h`` (s), held input: the FMU's own discretization
+    (:func:`~arcosim.fmu.flexchain.filters.lowpass_pole`)."""
+    a = lowpass_pole(g, h)
+    return signal.lfilter([1.0 - a], [1.0, -a], x)
 
 
 def constant_step(time: np.ndarray, what: str = "the log") -> float:
@@ -102,9 +112,9 @@ def motor_record(
     velocity = np.asarray(omega_m, dtype=float)
     source = "measured"
     if is_backward_difference(theta_m, velocity, h):
-        velocity = smooth_velocity(theta_m, h, 4.0 * g_dist)
+        velocity = smooth_velocity(theta_m, h, VELOCITY_SMOOTHING * g_dist)
         source = (
-            f"derivative of theta_m smoothed at {4.0 * g_dist:g} rad/s without lag "
+            f"derivative of theta_m smoothed at {VELOCITY_SMOOTHING * g_dist:g} rad/s without lag "
             "(the log's omega_m is its backward difference)"
         )
     dob = ReactionObserver(actuator, g_dist, float(theta_m[0]), float(velocity[0]))
@@ -153,9 +163,7 @@ def predict(
     w = np.vstack([u[:-1], np.diff(u) / record.h])  # inputs of steps 1 … N−1
     x = linear_recursion(Ad, Bd, w, np.zeros(len(c)))  # x_0 … x_{N−1}
     torque = c @ x[:, :-1] + d @ w
-    a = np.exp(-record.g_dist * record.h)
-    filtered = signal.lfilter([1.0 - a], [1.0, -a], torque)
-    return np.concatenate([[0.0], filtered])
+    return np.concatenate([[0.0], through_g(torque, record.g_dist, record.h)])
 
 
 def linear_recursion(F: np.ndarray, G: np.ndarray, u: np.ndarray, first: np.ndarray) -> np.ndarray:

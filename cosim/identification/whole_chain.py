@@ -24,7 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import optimize, signal
+from scipy import optimize
 
 from arcosim.fmu.flexchain.chain import spring_matrix
 from arcosim.identification.blas import single_threaded
@@ -38,6 +38,7 @@ from arcosim.identification.output_error import (
     check_excited,
     continued_fit,
     predict,
+    through_g,
 )
 
 #: Largest chain ``masses="auto"`` tries.
@@ -325,8 +326,10 @@ def friction_start(
     computed without friction: what the start chain leaves of τ̂ is
     ``G[D_m ω + f_c sgn ω]``, linear in both (least squares; each at least a small
     positive value)."""
-    a = np.exp(-record.g_dist * record.h)
-    G = lambda x: signal.lfilter([1.0 - a], [1.0, -a], x)  # noqa: E731
+
+    def G(x: np.ndarray) -> np.ndarray:
+        return through_g(x, record.g_dist, record.h)
+
     left = record.tau_hat - predict(record, J, k, B)
     omega = encoder.velocity
     X = np.column_stack([G(omega), G(np.sign(omega))])
@@ -340,10 +343,9 @@ def without_friction(
 ) -> MotorRecord:
     """``record`` with ``G[D_m ω + f_c s]`` taken out of τ̂_reac (ω, s: the encoder
     record's velocity and friction sign)."""
-    a = np.exp(-record.g_dist * record.h)
     friction = D_m * encoder.velocity + f_c * encoder.sign
     friction[0] = 0.0
-    tau = record.tau_hat - signal.lfilter([1.0 - a], [1.0, -a], friction)
+    tau = record.tau_hat - through_g(friction, record.g_dist, record.h)
     return replace(record, tau_hat=tau)
 
 
