@@ -24,8 +24,9 @@ from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
-from arcosim.version import __version__
 from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+from arcosim.errors import BuildError
+from arcosim.version import __version__
 
 #: Written beside the FMUs, last: the digest of the sources they were built from.
 DIGEST_FILE = ".source-digest"
@@ -88,9 +89,23 @@ def source_digest(n: int) -> str:
 
 @contextlib.contextmanager
 def lock_folder(folder: Path) -> Iterator[None]:
-    """Hold the exclusive build lock of ``folder`` (waits while another process holds it)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    with open(folder / LOCK_FILE, "a+b") as handle:
+    """Hold the exclusive build lock of ``folder`` (waits while another process holds it).
+
+    The lock is an ``flock`` on :data:`LOCK_FILE` in the folder: the kernel drops it
+    when its holder exits, however it exits (``kill -9`` too), so it is never stale.
+
+    Raises
+    ------
+    BuildError
+        When the folder cannot be created or the lock file cannot be opened.
+    """
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / LOCK_FILE, "a+b")  # noqa: SIM115 (held across the yield)
+    except OSError as error:
+        what = "is a file, not a folder" if folder.is_file() else (error.strerror or str(error))
+        raise BuildError(f"cannot build into {folder}: {what}") from None
+    with handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
         try:
             yield

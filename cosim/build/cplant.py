@@ -19,9 +19,9 @@ import zipfile
 from pathlib import Path
 from xml.etree.ElementTree import SubElement, tostring
 
-from arcosim.version import __version__
 from arcosim.build.cache import plant_package_dir
 from arcosim.errors import BuildError
+from arcosim.version import __version__
 
 SOURCES = ("physics.c", "fmu.c")
 HEADERS = ("physics.h",)

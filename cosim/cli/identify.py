@@ -13,7 +13,10 @@ Contract (scripts rely on it)::
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
-* ``--out FILE``: every output over time as CSV (``time`` first).
+* ``--out FILE``: every output over time as CSV (``time`` first); with
+  ``--method output-error`` or ``whole-chain``, the report ``--json`` prints, as a
+  JSON file (its name must end in ``.json``; the observer's CSV may not). An
+  existing file is replaced only with ``--force``; the log itself never.
 * ``--method output-error``: instead of replaying the observer FMU, fit the uniform
   chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
   from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
@@ -31,28 +34,41 @@ Contract (scripts rely on it)::
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
 
-A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
-error naming the row or column, and exit status 2.
+A bad log (missing column, non-increasing time, NaN, empty file, not UTF-8) gives a
+one-line error naming the row or column, and exit status 2. So does a ``--start-k``
+outside the band the log can show (the first clamped mode between one period in the
+record and the Nyquist frequency π/h), and a fit that ends on non-finite numbers.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import OBSERVER, check_masses
-from arcosim.cli.options import add_fmus_option, fmu_folder
+from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.host.instance import FmuInstance
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
 from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
+from arcosim.identification.output_error import (
+    Fit,
+    MotorRecord,
+    clamped_frequencies,
+    motor_record,
+    uniform_chain,
+)
 from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import DriveLog, parse_scales, read_log, write_csv
+from arcosim.outputs import check_output, write_text
+
+#: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
+OFFLINE = ("output-error", "whole-chain")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -87,7 +103,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="multiply a log column to get SI units, repeatable",
     )
     p.add_argument("--json", action="store_true", help="print the final outputs as one JSON object")
-    p.add_argument("--out", type=Path, help="write every output over time to this CSV file")
+    p.add_argument(
+        "--out",
+        type=Path,
+        help="observer: every output over time as CSV; output-error, whole-chain: the "
+        "report as a .json file",
+    )
+    force_option(p)
     p.add_argument(
         "--method",
         choices=("observer", "output-error", "whole-chain"),
@@ -102,20 +124,33 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--start-k",
-        type=float,
-        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan",
+        type=number(0.0, low_open=True, unit="N.m/rad"),
+        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
+        "it must put the chain's first mode in the band the log shows",
     )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
+    for given, option in (
+        (args.start_k is not None, "--start-k"),
+        (args.fit_inertia_scale, "--fit-inertia-scale"),
+    ):
+        if given and args.method != "output-error":
+            raise UserError(f"{option} is for --method output-error (not {args.method})")
+    if args.mode is not None and args.method != "observer":
+        raise UserError(f"--mode is for --method observer (not {args.method})")
+    _check_out(args, [])
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else _masses(args.masses)
-        return _whole_chain(args, log, fmu_folder(args, 3), masses)
+        folder = fmu_folder(args, 3)
+        _check_out(args, fmu_inputs(folder))
+        return _whole_chain(args, log, folder, masses)
     n = _masses(args.masses)
     folder = fmu_folder(args, n)
+    _check_out(args, fmu_inputs(folder))
     if args.method == "output-error":
         return _output_error(args, log, folder, n)
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
@@ -125,12 +160,60 @@ def _execute(args: argparse.Namespace) -> int:
     if args.out:
         columns = {"time": recording.time}
         columns.update({k.split(".", 1)[1]: v for k, v in recording.signals.items()})
-        write_csv(args.out, columns)
+        write_csv(args.out, columns, force=args.force)
     if args.json:
         print(json.dumps(final, indent=2))
     else:
         _print_summary(final, len(log), args.out)
     return 0
+
+
+def _check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
+    """Refuse ``--out`` before any work: a name that does not fit the method's format,
+    an existing file without ``--force``, the log or an FMU."""
+    if args.out is None:
+        return
+    is_json = args.out.suffix.lower() == ".json"
+    if args.method in OFFLINE and not is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
+        )
+    if args.method == "observer" and is_json:
+        raise UserError(
+            f"--out {args.out}: --method observer writes every output over time as CSV; "
+            "name a .csv file (--json prints the final values)"
+        )
+    check_output(args.out, inputs=[args.log, *fmus], force=args.force)
+
+
+def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None:
+    """Refuse a report with a non-finite estimate; write it to ``--out`` if given."""
+    bad = [
+        key
+        for key, value in [*report.items(), *dict(report.get("std") or {}).items()]
+        if isinstance(value, float) and not math.isfinite(value)
+    ]
+    if bad:
+        raise UserError(
+            f"{args.log}: the fit ended on non-finite numbers ({', '.join(bad[:6])}): the log "
+            "does not determine them; check --set and the excitation"
+        )
+    if args.out:
+        write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
+
+
+def check_start_k(k: float, J: Sequence[float], record: MotorRecord) -> None:
+    """Refuse a ``--start-k`` whose uniform chain's first clamped mode lies outside the
+    band the record can show: from one period in its length to the Nyquist frequency."""
+    unit = float(clamped_frequencies([float(x) for x in J], [1.0] * len(J))[0])
+    low_w, high_w = 2.0 * math.pi / record.duration, math.pi / record.h
+    low, high = (low_w / unit) ** 2, (high_w / unit) ** 2
+    if not low <= k <= high:
+        raise UserError(
+            f"--start-k {k:g}: give a stiffness from {low:.3g} to {high:.3g} N.m/rad for this "
+            f"log and J (the chain's first mode between one period in {record.duration:g} s, "
+            f"{low_w:.3g} rad/s, and the Nyquist frequency, {high_w:.3g} rad/s)"
+        )
 
 
 def _print_summary(final: dict, samples: int, out: Path | None) -> None:
@@ -157,7 +240,7 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     """The actuator terms among the observer's parameters."""
     for name in ("J_mo", "k_to", "g_dist"):
         if not values[name] > 0:
-            raise UserError(f"{name} = {values[name]!r} must be > 0")
+            raise UserError(f"{name} = {float(values[name]):g} must be > 0")
     return Actuator(
         values["J_mo"], values["k_to"], values["dkt"], values["dJm"], values["D_m"], values["f_c"]
     )
@@ -172,11 +255,14 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
+    if args.start_k is not None:
+        check_start_k(args.start_k, J, record)
     result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
     names = {"k": "k_hat", "B": "B_hat", "J_scale": "J_scale"}
     report = {names[k]: v for k, v in result.as_dict().items()}
     report["std"] = {names[k]: v for k, v in result.std_dict().items()}
     report.update(evidence(result, record))
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -223,6 +309,7 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     if choice.singular_values is not None:
         report["masses_seen"] = choice.seen
         report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0

@@ -10,6 +10,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import shutil
+import zipfile
 from collections.abc import Iterable, Mapping, Sequence
 from ctypes import CFUNCTYPE, c_int, c_size_t, c_void_p, cast
 from pathlib import Path
@@ -27,6 +28,7 @@ from fmpy.fmi2 import (
     fmi2ValueReference,
 )
 
+from arcosim.build.cache import fmu_problem
 from arcosim.errors import UserError
 
 STATUS_NAMES = ("ok", "warning", "discard", "error", "fatal", "pending")
@@ -47,7 +49,13 @@ def extracted(path: Path) -> str:
     key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     folder = _EXTRACTED.get(key)
     if folder is None or not Path(folder).is_dir():
-        folder = extract(str(path))
+        problem = fmu_problem(path)
+        if problem is not None:
+            raise UserError(f"{path}: {problem}; rebuild it (`arcosim build`) or check the file")
+        try:
+            folder = extract(str(path))
+        except (OSError, zipfile.BadZipFile, EOFError) as error:
+            raise UserError(f"{path}: cannot unzip the FMU ({error})") from None
         _EXTRACTED[key] = folder
         atexit.register(shutil.rmtree, folder, True)
     return folder
@@ -139,11 +147,23 @@ class FmuInstance:
         if not path.is_file():
             raise UserError(f"FMU not found: {path} (run `arcosim build` first)")
         self.path = path
-        self.description = read_model_description(str(path))
+        self.slave = None
+        # The description is read from the unzipped copy whose binary is loaded, so the
+        # two always match, even if the file is replaced (a rebuild) in between.
+        self._unzipped = extracted(path)
+        try:
+            self.description = read_model_description(self._unzipped)
+        except Exception as error:  # fmpy raises whatever its XML reader meets
+            raise UserError(f"{path}: not a valid FMU ({error})") from None
+        if self.description.fmiVersion != "2.0":
+            raise UserError(
+                f"{path}: an FMI {self.description.fmiVersion} FMU; arcosim runs FMI 2.0"
+            )
+        if self.description.coSimulation is None:
+            raise UserError(f"{path}: not a co-simulation FMU (it has no <CoSimulation>)")
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.messages: list[str] = []
         self._echo = echo_log
-        self._unzipped = extracted(path)
         self._callbacks = self._make_callbacks()
         self.slave = FMU2Slave(
             guid=self.description.guid,
@@ -178,7 +198,7 @@ class FmuInstance:
 
     def close(self) -> None:
         """Terminate and free the instance (the unzipped FMU stays for the next one)."""
-        if self.slave is None:
+        if getattr(self, "slave", None) is None:
             return
         with contextlib.suppress(FMICallException):
             self.slave.terminate()

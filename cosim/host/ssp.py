@@ -150,7 +150,9 @@ def run_ssp(
                 write(read())
             for name, fmu in instances.items():
                 if fmu.do_step(t, h) > 1:
-                    raise UserError(f"{name} refused the step at t = {t!r} s: {fmu.messages[-1:]}")
+                    raise UserError(
+                        f"{name} refused the step at t = {float(t):.10g} s: {fmu.messages[-1:]}"
+                    )
             for name, (read, _) in readers.items():
                 logs[name][k + 1] = read()
     finally:
