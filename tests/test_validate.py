@@ -37,7 +37,12 @@ def test_validate_names_what_is_wrong(build_fmus, tmp_path: Path, capsys) -> Non
     assert "J_m: no description" in out
 
 
-def test_validate_without_fmus_says_what_to_do(tmp_path: Path, capsys, monkeypatch) -> None:
+def test_validate_without_arguments_checks_the_cached_fmus(
+    build_fmus, tmp_path: Path, capsys, monkeypatch
+) -> None:
+    """No argument: the FMUs for 3 masses in the per-user cache (built if needed)."""
+    folder = build_fmus(3)
     monkeypatch.chdir(tmp_path)
-    assert main(["validate"]) == 2
-    assert "run `arcosim build`" in capsys.readouterr().err
+    assert main(["validate"]) == 0
+    out = capsys.readouterr().out
+    assert out.count(": OK") == 3 and str(folder) in out

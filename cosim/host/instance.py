@@ -180,11 +180,23 @@ class FmuInstance:
     def initialize(
         self, parameters: Mapping[str, float | int | bool] | None = None, start_time: float = 0.0
     ) -> None:
-        """Set parameters by name, then run initialization mode at ``start_time`` (s)."""
-        self.slave.setupExperiment(startTime=start_time)
-        self.set(parameters or {})
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
+        """Set parameters by name, then run initialization mode at ``start_time`` (s).
+
+        Raises
+        ------
+        UserError
+            When the FMU refuses a value or its initialization, with its log lines
+            (they name the parameters at fault).
+        """
+        before = len(self.messages)
+        try:
+            self.slave.setupExperiment(startTime=start_time)
+            self.set(parameters or {})
+            self.slave.enterInitializationMode()
+            self.slave.exitInitializationMode()
+        except FMICallException as error:
+            said = " | ".join(m.strip() for m in self.messages[before:][-6:]) or str(error)
+            raise UserError(f"{self.path.name} refused its initialization: {said}") from None
         self.time = start_time
 
     def do_step(self, t: float, h: float) -> int:

@@ -117,7 +117,7 @@ def load_spec(path: Path) -> SweepSpec:
     unknown = set(raw) - KEYS
     if unknown:
         raise UserError(
-            f"{where} unknown key {', '.join(sorted(_shown(k) for k in unknown))} "
+            f"{where} unknown key {', '.join(sorted(_key(k) for k in unknown))} "
             f"(known: {', '.join(sorted(KEYS))})"
         )
     name = _text(where, "name", raw.get("name", path.stem))
@@ -141,7 +141,7 @@ def load_spec(path: Path) -> SweepSpec:
     for qualified in [*vary, *fixed]:
         if qualified.split(".", 1)[0] not in ("plant", "observer") or "." not in qualified:
             raise UserError(
-                f"{where} {_shown(qualified)}: name the FMU first (plant.NAME or observer.NAME)"
+                f"{where} {_key(qualified)!r}: name the FMU first (plant.NAME or observer.NAME)"
             )
     both = sorted(set(vary) & set(fixed))
     if both:
@@ -160,11 +160,8 @@ def load_spec(path: Path) -> SweepSpec:
         runs = math.prod(len(vary[n]["values"]) for n in grids)
         if runs > MAX_RUNS:
             raise UserError(f"{where} the grid has {runs:,} runs, more than {MAX_RUNS:,}")
-        if "runs" in raw and raw["runs"] != runs:
-            raise UserError(
-                f"{where} runs = {_shown(raw['runs'])}: a grid's runs are its product "
-                f"({runs}); drop runs"
-            )
+        if "runs" in raw:  # a grid's size comes from the grid; runs is checked, not used
+            _integer(where, "runs", raw["runs"], 1, MAX_RUNS)
     else:
         runs = _integer(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
     masses = _integer(where, "masses", raw.get("masses", 3), MIN_MASSES, MAX_MASSES)
@@ -210,7 +207,7 @@ def _check_distribution(path: Path, name: str, dist: object) -> None:
     missing = [k for k in DISTRIBUTIONS[kind] if k not in dist]
     if missing:
         raise UserError(f"{where} a {kind} distribution needs {', '.join(missing)}")
-    extra = sorted(_shown(k) for k in set(dist) - {"distribution", *DISTRIBUTIONS[kind]})
+    extra = sorted(_key(k) for k in set(dist) - {"distribution", *DISTRIBUTIONS[kind]})
     if extra:
         raise UserError(f"{where} a {kind} distribution takes no {', '.join(extra)}")
     if kind in ("choice", "grid"):
@@ -288,6 +285,11 @@ def _shown(value: object) -> str:
         text = str(value)
     text = text.encode("unicode_escape").decode("ascii") if not text.isprintable() else text
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _key(key: str) -> str:
+    """A TOML key for a message: control characters escaped, at most 60 characters."""
+    return _shown(key)[1:-1] if _shown(key).startswith(("'", '"')) else _shown(key)
 
 
 def _one_line(text: str) -> str:
