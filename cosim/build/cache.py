@@ -20,6 +20,7 @@ import functools
 import hashlib
 import os
 import zipfile
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
@@ -128,7 +129,15 @@ def fmu_problem(path: Path) -> str | None:
             ElementTree.fromstring(z.read(inner))
     except FileNotFoundError:
         return f"{path.name} is missing"
-    except (zipfile.BadZipFile, KeyError, ElementTree.ParseError, OSError, EOFError) as error:
+    except (
+        zipfile.BadZipFile,
+        KeyError,
+        ElementTree.ParseError,
+        OSError,
+        EOFError,
+        zlib.error,  # a corrupt deflate stream (testzip reads every member)
+        ValueError,
+    ) as error:
         return f"{path.name} is not a complete FMU ({error})"
     return None
 

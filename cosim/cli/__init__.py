@@ -82,8 +82,27 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def one_line(text: str) -> str:
-    """``text`` on one line: its lines joined by `` | `` (FMU logs come as several)."""
-    return " | ".join(line.strip() for line in text.splitlines() if line.strip())
+    r"""``text`` on one line: its lines joined by `` | `` (FMU logs come as several).
+
+    A Python traceback inside (an FMU's log of an internal error) keeps only its
+    last line, the exception.
+
+    Examples
+    --------
+    >>> one_line("step refused:\nTraceback (most recent call last):\n  File x\nValueError: no")
+    'step refused: | ValueError: no'
+    """
+    lines, in_traceback = [], False
+    for line in text.splitlines():
+        if line.strip().startswith("Traceback (most recent call last):"):
+            in_traceback = True
+            continue
+        if in_traceback and line[:1].isspace():
+            continue
+        in_traceback = False
+        if line.strip():
+            lines.append(line.strip())
+    return " | ".join(lines)
 
 
 def write_crash_report(argv: Sequence[str]) -> Path | None:

@@ -11,6 +11,7 @@ import atexit
 import contextlib
 import shutil
 import zipfile
+import zlib
 from collections.abc import Iterable, Mapping, Sequence
 from ctypes import CFUNCTYPE, c_int, c_size_t, c_void_p, cast
 from pathlib import Path
@@ -28,7 +29,6 @@ from fmpy.fmi2 import (
     fmi2ValueReference,
 )
 
-from arcosim.build.cache import fmu_problem
 from arcosim.errors import UserError
 
 STATUS_NAMES = ("ok", "warning", "discard", "error", "fatal", "pending")
@@ -49,13 +49,13 @@ def extracted(path: Path) -> str:
     key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     folder = _EXTRACTED.get(key)
     if folder is None or not Path(folder).is_dir():
-        problem = fmu_problem(path)
-        if problem is not None:
-            raise UserError(f"{path}: {problem}; rebuild it (`arcosim build`) or check the file")
-        try:
+        try:  # extracting checks every member's CRC-32: a truncated or corrupt zip fails
             folder = extract(str(path))
-        except (OSError, zipfile.BadZipFile, EOFError) as error:
-            raise UserError(f"{path}: cannot unzip the FMU ({error})") from None
+        except (OSError, zipfile.BadZipFile, EOFError, zlib.error, ValueError) as error:
+            raise UserError(
+                f"{path}: not a complete FMU ({error}); rebuild it (`arcosim build`) or "
+                "check the file"
+            ) from None
         _EXTRACTED[key] = folder
         atexit.register(shutil.rmtree, folder, True)
     return folder

@@ -22,7 +22,6 @@ from xml.etree import ElementTree
 
 import numpy as np
 
-from arcosim.build.cache import fmu_problem
 from arcosim.errors import UserError
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import MAX_STEPS, Recording
@@ -156,10 +155,13 @@ def run_ssp(
     instances: dict[str, FmuInstance] = {}
     try:
         for name, fmu in system.components.items():
-            problem = fmu_problem(fmu)
-            if problem is not None:
-                raise UserError(f"{path}: component {name}: {problem}")
-            instances[name] = FmuInstance(fmu, name)
+            if not fmu.is_file():
+                raise UserError(f"{path}: component {name}: no file {fmu.name} in the SSP")
+            try:
+                instances[name] = FmuInstance(fmu, name)
+            except UserError as error:
+                said = str(error).split(": ", 1)[-1]
+                raise UserError(f"{path}: component {name} ({fmu.name}): {said}") from None
         for name, fmu in instances.items():
             fmu.initialize({**chosen.get(name, {}), **(extra or {}).get(name, {})}, system.start)
         links = [

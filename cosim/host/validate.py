@@ -16,13 +16,13 @@ from __future__ import annotations
 import math
 import tempfile
 import zipfile
+import zlib
 from pathlib import Path
 from xml.etree import ElementTree
 
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
-from arcosim.build.cache import fmu_problem
 from arcosim.errors import UserError
 from arcosim.host.ecos import ecos_binary, run_ecos
 from arcosim.host.instance import FmuInstance
@@ -140,7 +140,16 @@ def not_an_fmu(path: Path) -> str | None:
     if not zipfile.is_zipfile(path):
         size = path.stat().st_size
         return "an empty file, not an FMU" if size == 0 else "not an FMU (not a zip file)"
-    return fmu_problem(path)
+    try:
+        with zipfile.ZipFile(path) as z:
+            if "modelDescription.xml" not in z.namelist():
+                return "a zip file without modelDescription.xml, not an FMU"
+            bad = z.testzip()
+            if bad is not None:
+                return f"a corrupt FMU (member {bad} fails its CRC-32)"
+    except (OSError, zipfile.BadZipFile, EOFError, zlib.error) as error:
+        return f"a truncated or corrupt FMU ({error})"
+    return None
 
 
 def validate(fmu: Path) -> tuple[list[str], list[str]]:
