@@ -58,7 +58,10 @@ def make_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``arcosim`` with ``argv`` (default: the process arguments); return the exit code."""
     parser = make_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as stop:  # a refused argument (one line printed), --help, --version
+        return stop.code if isinstance(stop.code, int) else EXIT_USAGE
     if not hasattr(args, "execute"):
         parser.print_help()
         return EXIT_USAGE
