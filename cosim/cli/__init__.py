@@ -5,6 +5,8 @@ Whatever goes wrong, a user sees one line on stderr, never a Python traceback:
 
 * a bad argument, file or value (:class:`~arcosim.errors.ArcosimError`, or an
   argument argparse refuses): ``arcosim: error: …`` and exit status 2;
+* Python warnings (numpy's, a build's) are collected and printed after a command
+  that succeeds, each once, as ``arcosim: warning: …``; a refusal prints only its line;
 * Ctrl-C: ``arcosim: interrupted`` and exit status 130;
 * anything else (a bug): ``arcosim: internal error: …`` naming the file the
   traceback was written to (in the temporary folder), and exit status 70
@@ -19,6 +21,7 @@ import os
 import sys
 import tempfile
 import traceback
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
@@ -65,8 +68,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not hasattr(args, "execute"):
         parser.print_help()
         return EXIT_USAGE
+    caught: list[str] = []
     try:
-        return int(args.execute(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = lambda message, *_, **__: caught.append(one_line(str(message)))
+            code = int(args.execute(args) or 0)
+        for text in dict.fromkeys(caught):  # each once, after the command's own output
+            print(f"arcosim: warning: {text}", file=sys.stderr)
+        return code
     except ArcosimError as error:
         print(f"arcosim: error: {one_line(str(error))}", file=sys.stderr)
         return EXIT_USAGE

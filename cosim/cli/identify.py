@@ -48,6 +48,8 @@ import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
+
 from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import OBSERVER, check_masses
 from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
@@ -202,6 +204,23 @@ def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> Non
         write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
 
 
+#: Largest reaction torque (N.m) an offline fit takes: far beyond any drive, and small
+#: enough that the fits' sums of squares over 10⁷ samples stay finite.
+MAX_TORQUE = 1e100
+
+
+def check_record(record: MotorRecord, settings: Sequence[str]) -> None:
+    """Refuse a record whose reaction torque is not finite or absurdly large (the
+    actuator terms given with ``--set`` in the wrong units, say)."""
+    peak = float(np.max(np.abs(record.tau_hat))) if record.tau_hat.size else 0.0
+    if not peak <= MAX_TORQUE:
+        given = f" (--set {' --set '.join(settings)})" if settings else ""
+        raise UserError(
+            f"the log's reaction torque through the actuator terms{given} reaches {peak:.3g} "
+            f"N.m (at most {MAX_TORQUE:g}): check J_mo, k_to, g_dist and the --scale factors"
+        )
+
+
 def check_start_k(k: float, J: Sequence[float], record: MotorRecord) -> None:
     """Refuse a ``--start-k`` whose uniform chain's first clamped mode lies outside the
     band the record can show: from one period in its length to the Nyquist frequency."""
@@ -255,6 +274,7 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
+    check_record(record, args.set)
     if args.start_k is not None:
         check_start_k(args.start_k, J, record)
     result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
@@ -290,6 +310,7 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     c = log.columns
     g_dist = values["g_dist"]
     record = motor_record(log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
+    check_record(record, args.set)
     cpr = int(values["encoder_cpr"])
     encoder = None
     if cpr > 0:
