@@ -131,7 +131,7 @@ def cosimulate(
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
     if not (h > 0.0 and np.isfinite(h)):
-        raise UserError(f"step size {float(h):g} s: it must be a finite number > 0")
+        raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
     if record_every < 1:
         raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
     currents = [float(x) for x in i_ref]
