@@ -9,12 +9,14 @@ runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`
 is a task that builds nothing: the FMUs are built once and shipped as bytes. Rows are
 appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
 finished run and ``--resume`` runs only the others; a failed run records its error and
-the sweep goes on. A sweep holds its folder's lock (:func:`lock_sweep`) from the
-check of ``results.csv`` to the summary, so a second sweep into the same folder
-(fresh or ``--resume``) is refused, naming the one that runs: no run is duplicated
-and two fresh starts cannot both begin. At the end ``summary.md`` holds metric quantiles per varied
+the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
 parameter and the PNGs the error histograms and the errors against each parameter
 (:mod:`arcosim.sweeps.summary`).
+
+A sweep holds its folder's lock (:func:`lock_sweep`) from the check of
+``results.csv`` to the summary, so a second sweep into the same folder (fresh or
+``--resume``) is refused, naming the one that runs: no run is duplicated, and two
+fresh starts cannot both begin.
 """
 
 from __future__ import annotations
