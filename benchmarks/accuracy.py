@@ -21,8 +21,11 @@ then run again on the recorded logs, offline, in every configuration (the same
 
 The bench also gets the honesty check of B's standard error (over ``--b-seeds`` seeds)
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
-within 10 %. Last, the whole-chain identification rows (``cosim/chain_accuracy.py``:
+within 10 %. Then the whole-chain identification rows (``cosim/chain_accuracy.py``:
 three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
+Last, the load torque rows (``cosim/load_accuracy.py``: the two- and five-mass chains,
+the load on the last and on a middle mass, a model with springs 5 % off, the same
+seeds; and the bandwidth's trade-off on the bench).
 """
 
 from __future__ import annotations
@@ -41,22 +44,21 @@ import numpy as np
 from arcosim.errors import UserError
 from arcosim.experiments import excitation
 from arcosim.experiments.metrics import flexible_score, percent_error
-from arcosim.experiments.scenarios import Scenario
+from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import bench
 from arcosim.fmu.flexchain.observer import (
     MODEL_BASED,
     RECURSION,
     RIGID_IDENTIFICATION,
     STATE_ESTIMATION,
-    Observer,
-    ObserverSettings,
 )
+from arcosim.identification.offline_observer import estimate_states, replay
 from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
-from benchmarks import chain_accuracy
-from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
+from benchmarks import chain_accuracy, load_accuracy
+from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
 #: Broadband lines (rad/s): the flexible scenario's plus 150 for the five-mass chain.
-LINES = np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120, 150.0])
+LINES = BROADBAND_LINES
 BROADBAND_DURATION = 10.0
 #: Peak current of the broadband multi-sine (A). At this level the bench's motor
 #: stands still (|ω| < 0.5 rad/s) 2 % of the time; at the flexible scenario's 0.48 A,
@@ -115,53 +117,6 @@ def rigid(case: Case, seed: int) -> dict[str, np.ndarray]:
     return run_case(case, scenario, seed)
 
 
-def replay(
-    settings: ObserverSettings,
-    log: dict[str, np.ndarray],
-    after_sample: Callable[[int, Observer], None] | None = None,
-) -> Observer:
-    """Run the observer's algorithms over a log (as the FMU would); return the observer.
-
-    ``after_sample(k, observer)`` is called for the initial sample (k = 0) and after
-    each step."""
-    h = float(log["time"][1] - log["time"][0])
-    i_a, w, th = (log[c].tolist() for c in ("i_a", "omega_m", "theta_m"))
-    observer = Observer(settings, th[0], w[0])
-    if after_sample is not None:
-        after_sample(0, observer)
-    for k in range(1, len(th)):
-        observer.step(h, i_a[k], w[k], th[k])
-        if after_sample is not None:
-            after_sample(k, observer)
-    return observer
-
-
-def estimate_states(settings: ObserverSettings, log: dict[str, np.ndarray], n: int) -> np.ndarray:
-    """Load-angle estimates over the log, shape (N, n)."""
-    out = np.empty((len(log["time"]), n))
-
-    def keep(k: int, observer: Observer) -> None:
-        out[k] = observer.estimator.theta
-
-    replay(settings, log, keep)
-    return out
-
-
-def settings_for(case: Case, mode: int, **kw: object) -> ObserverSettings:
-    base = {
-        "mode": mode,
-        "actuator": ACTUATOR,
-        "g_dist": G_DIST,
-        "g_lpf": G_DIST,
-        "J": case.J,
-        "k": case.k,
-        "B": case.B,
-        "encoder_cpr": ENCODER_CPR,
-    }
-    base.update(kw)
-    return ObserverSettings(**base)
-
-
 def fit_broadband(case: Case, log: dict[str, np.ndarray]) -> tuple[MotorRecord, object]:
     record = motor_record(log["time"], log["i_a"], log["omega_m"], log["theta_m"], ACTUATOR, G_DIST)
     return record, uniform_chain(record, case.J)
@@ -216,7 +171,7 @@ def score_broadband(
     identified = {"k": (k_hat,) * case.n, "B": (B_hat,) * case.n}
     for name, estimator in (("recursion", RECURSION), ("model-based", MODEL_BASED)):
         s = settings_for(case, STATE_ESTIMATION, estimator=estimator, **identified)
-        est = estimate_states(s, log, case.n)
+        est = estimate_states(s, log)
         scores = [flexible_score(est[:, i], truth[i], motor) for i in range(case.n)]
         result.add(result.state, name + suffix, scores)
     naive = [flexible_score(log["theta_m"], truth[i], motor) for i in range(case.n)]
@@ -311,10 +266,18 @@ def _state_cell(x: float) -> str:
 
 
 def run(
-    out: Path, seeds: int, b_seeds: int, quick: bool, progress: Callable[[str], None] = print
+    out: Path,
+    seeds: int,
+    b_seeds: int,
+    quick: bool,
+    progress: Callable[[str], None] = print,
+    load_torque_only: bool = False,
 ) -> dict[str, object]:
-    """Run the benchmark, write ``accuracy.md`` and ``accuracy.json`` into ``out``."""
+    """Run the benchmark, write ``accuracy.md`` and ``accuracy.json`` into ``out``
+    (``load_torque_only``: only the load torque rows, ``load_torque.md``/``.json``)."""
     started = time.perf_counter()
+    if load_torque_only:
+        return _load_torque_rows(out, max(b_seeds, seeds), quick, progress, started)
     cases = CASES[:1] if quick else CASES
     seed_list = list(range(1, seeds + 1))
     results = {case.name: score_case(case, seed_list, progress) for case in cases}
@@ -362,12 +325,49 @@ def run(
         f"`identification`, {len(chain_seeds)} seeds; only the actuator known):\n\n"
         + chain_accuracy.markdown(whole)
     )
+    load_text, load_summary = _load_torque_table(chain_seeds, quick, progress)
+    text += load_text
+    summary.update(load_summary)
     broadband_fit.cache_clear()
     summary["seconds"] = time.perf_counter() - started
     out.mkdir(parents=True, exist_ok=True)
     (out / "accuracy.md").write_text(text, encoding="utf-8")
     (out / "accuracy.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
     return {"table": text, **summary}
+
+
+def _load_torque_table(
+    seeds: Sequence[int], quick: bool, progress: Callable[[str], None]
+) -> tuple[str, dict[str, object]]:
+    """The load torque rows and the bandwidth trade-off (not in quick mode)."""
+    rows = load_accuracy.ROWS[:1] if quick else load_accuracy.ROWS
+    load = load_accuracy.score_rows(rows, seeds, progress)
+    summary: dict[str, object] = {"load_torque": load}
+    text = (
+        f"\nLoad torque from the motor alone (scenario `load-torque`'s profile on the chain, "
+        f"{len(seeds)} seeds; errors in % of the step; the observer's default "
+        "bandwidth):\n\n" + load_accuracy.markdown(load)
+    )
+    if not quick:
+        trade = load_accuracy.bandwidth_rows(progress)
+        summary["load_torque_bandwidth"] = trade
+        text += (
+            "\nThe load torque bandwidth's trade-off (bench, load on mass 3, seed 1):\n\n"
+            + load_accuracy.bandwidth_markdown(trade)
+        )
+    return text, summary
+
+
+def _load_torque_rows(
+    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
+) -> dict[str, object]:
+    seeds = list(range(1, (1 if quick else count) + 1))
+    text, summary = _load_torque_table(seeds, quick, progress)
+    summary["seconds"] = time.perf_counter() - started
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "load_torque.md").write_text(text, encoding="utf-8")
+    (out / "load_torque.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    return {"table": text, **summary, "files": ("load_torque.md", "load_torque.json")}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -383,6 +383,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--b-seeds", type=int, default=20, help="seeds for B's standard-error check (default 20)"
     )
     p.add_argument("--quick", action="store_true", help="the bench only, no long record")
+    p.add_argument(
+        "--load-torque-only",
+        action="store_true",
+        help="only the load torque rows (as many seeds as the whole-chain rows: the larger "
+        "of --seeds and --b-seeds), into load_torque.md/.json",
+    )
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
     p.set_defaults(execute=_execute)
 
@@ -390,12 +396,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def _execute(args: argparse.Namespace) -> int:
     if args.seeds < 1 or args.b_seeds < 0:
         raise UserError("--seeds must be >= 1 and --b-seeds >= 0")
-    result = run(args.out, args.seeds, args.b_seeds, args.quick, progress=_progress)
-    print(result["table"])
-    print(
-        f"wrote {args.out / 'accuracy.md'} and {args.out / 'accuracy.json'} "
-        f"({result['seconds']:.0f} s)"
+    result = run(
+        args.out,
+        args.seeds,
+        args.b_seeds,
+        args.quick,
+        progress=_progress,
+        load_torque_only=args.load_torque_only,
     )
+    print(result["table"])
+    md, js = result.get("files", ("accuracy.md", "accuracy.json"))
+    print(f"wrote {args.out / md} and {args.out / js} ({result['seconds']:.0f} s)")
     return 0
 
 

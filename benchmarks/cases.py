@@ -10,6 +10,7 @@ from arcosim.experiments.scenarios import Scenario, run_scenario
 from arcosim.fmu.flexchain import bench
 from arcosim.fmu.flexchain.chain import spring_matrix
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.fmu.flexchain.observer import ObserverSettings
 
 ACTUATOR = Actuator(bench.J_M, bench.K_T, 0.0, 0.0, bench.D_M, bench.F_C)
 G_DIST = 100.0
@@ -67,3 +68,18 @@ def run_case(case: Case, scenario: Scenario, seed: int) -> dict[str, np.ndarray]
     signals = {k.split(".", 1)[1]: v for k, v in recording.signals.items() if k.startswith("plant")}
     signals["time"] = recording.time
     return signals
+
+
+def settings_for(case: Case, mode: int, **kw: object) -> ObserverSettings:
+    base = {
+        "mode": mode,
+        "actuator": ACTUATOR,
+        "g_dist": G_DIST,
+        "g_lpf": G_DIST,
+        "J": case.J,
+        "k": case.k,
+        "B": case.B,
+        "encoder_cpr": ENCODER_CPR,
+    }
+    base.update(kw)
+    return ObserverSettings(**base)

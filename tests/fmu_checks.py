@@ -15,13 +15,17 @@ def step_from_resources(fmu: Path, folder: Path, input_name: str, output_name: s
 
     Proves that the FMU bundles everything it needs and uses no numpy.
     """
+    from xml.etree import ElementTree
+
     with zipfile.ZipFile(fmu) as z:
         z.extractall(folder)
         module = z.read("resources/slavemodule.txt").decode().strip()
+        description = ElementTree.fromstring(z.read("modelDescription.xml"))
+    identifier = description.find("CoSimulation").get("modelIdentifier")
     script = (
         "import sys; sys.path.insert(0, sys.argv[1])\n"
-        f"import {module} as m\n"
-        f"s = m.{module}(instance_name='x')\n"
+        f"from {module} import {identifier} as Slave\n"
+        "s = Slave(instance_name='x')\n"
         "s.setup_experiment(0.0); s.enter_initialization_mode(); s.exit_initialization_mode()\n"
         f"s.set_real([s.vr['{input_name}']], [0.3])\n"
         "assert all(s.do_step(k * 1e-3, 1e-3) for k in range(50)), s.log_queue\n"

@@ -59,7 +59,7 @@ def test_build_writes_into_the_folder_named(tmp_path: Path) -> None:
 
 
 def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path) -> None:
-    """The paper's three experiments and the fourth end to end (about 60 s)."""
+    """The paper's three experiments and the three beyond them, end to end (about 90 s)."""
     build_fmus(3)  # into the session cache, where reproduce finds them current
     result = arcosim("reproduce", "--out", "report", "--no-progress", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -69,6 +69,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         "fig5_flexible_response.png",
         "fig6_state_estimates.png",
         "fig7_whole_chain.png",
+        "fig8_load_torque.png",
     ):
         assert (out / name).stat().st_size > 20_000, name
     runs = ("selfid.csv", "flexible.csv", "identification.csv", "whole_chain.csv")
@@ -88,6 +89,20 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         if line.strip().startswith(("J[", "k[")) and line.strip().endswith("%")
     ]
     assert len(errors) == 6 and max(abs(e) for e in errors) < 2.0
+    # experiment 5: the load torque's settled error, true chain within 5 % of the step and
+    # the identified chain within 10 % (issue 20's targets; measured 0.89 % and 0.77 %)
+    assert (out / "fig8_load_torque.png").stat().st_size > 20_000
+    for name in ("load_true_chain.csv", "load_identified_chain.csv"):
+        assert (out / name).stat().st_size > 100_000, name
+    rows = {
+        line.split()[0]: line.split()
+        for line in result.stdout.splitlines()
+        if line.strip().startswith(("true chain ", "identified chain ")) and "%" in line
+    }
+    for label, limit in (("true", 5.0), ("identified", 10.0)):
+        cells = rows[label]  # chain, settling, mean %, max %, ...
+        assert cells[4] == "%" and cells[6] == "%", cells
+        assert float(cells[5]) < limit, cells
 
 
 def test_fmus_built_from_other_sources_are_rebuilt_not_run(build_fmus, tmp_path: Path) -> None:

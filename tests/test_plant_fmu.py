@@ -4,6 +4,7 @@ failure handling, and several FMUs in one process."""
 from __future__ import annotations
 
 import math
+import re
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree
@@ -14,6 +15,7 @@ from fmpy.validation import validate_fmu
 from scipy.linalg import eig
 
 from arcosim import __version__
+from arcosim.errors import UserError
 from arcosim.host.instance import FmuInstance
 from tests.plant_runs import IDEAL, run_plant
 
@@ -194,9 +196,10 @@ def test_plants_for_three_and_five_masses_run_side_by_side(build_fmus) -> None:
 )
 def test_invalid_parameter_is_refused_with_a_message(plant_fmu, name, value, phrase) -> None:
     with FmuInstance(plant_fmu, "bad") as plant:
-        plant.initialize({name: value})
-        assert plant.do_step(0.0, 1e-3) == 2  # fmi2Discard, not fatal
-        assert any(phrase in m for m in plant.messages), plant.messages
+        with pytest.raises(UserError, match=re.escape(phrase)):  # fmi2Error, not fatal
+            plant.initialize({name: value})
+        assert any(phrase in m and m.startswith("error") for m in plant.messages), plant.messages
+        assert plant.do_step(0.0, 1e-3) == 2  # every step refused with the same message
         assert plant.do_step(0.0, 1e-3) == 2
     with FmuInstance(plant_fmu, "good") as plant:  # the host carries on
         plant.initialize()
@@ -266,7 +269,8 @@ def test_trace_file_records_outputs_and_never_overwrites(plant_fmu: Path, tmp_pa
     column = lines[0].split(",").index("theta_m_true")
     assert float(lines[-1].split(",")[column]) == last  # full precision
     with FmuInstance(plant_fmu, "again") as plant:
-        plant.initialize({"trace_file": str(trace)})
+        with pytest.raises(UserError, match="exists; choose a new name"):
+            plant.initialize({"trace_file": str(trace)})
         assert plant.do_step(0.0, 1e-3) == 2
         assert any("exists; choose a new name" in m for m in plant.messages)
     assert len(trace.read_text().splitlines()) == 7  # the user's file is intact

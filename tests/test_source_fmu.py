@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
+from arcosim.errors import UserError
 from arcosim.experiments import excitation
 from arcosim.fmu.flexchain.excitation import log_spaced
 from arcosim.host.instance import FmuInstance
@@ -87,6 +90,7 @@ def test_filtered_random_is_the_offline_one(source) -> None:
 )
 def test_bad_source_parameters_are_refused(source, parameters, phrase) -> None:
     with FmuInstance(source, "source") as fmu:
-        fmu.initialize(parameters)
+        with pytest.raises(UserError, match=re.escape(phrase)):  # fmi2Error, not fatal
+            fmu.initialize(parameters)
         assert fmu.do_step(0.0, 1e-3) == 2
         assert any(phrase in m for m in fmu.messages), fmu.messages

@@ -37,12 +37,8 @@ def test_validate_names_what_is_wrong(build_fmus, tmp_path: Path, capsys) -> Non
     assert "J_m: no description" in out
 
 
-def test_validate_without_arguments_checks_the_cached_fmus(
-    build_fmus, tmp_path: Path, capsys, monkeypatch
-) -> None:
-    """No argument: the FMUs for 3 masses in the per-user cache (built if needed)."""
-    folder = build_fmus(3)
-    monkeypatch.chdir(tmp_path)
+def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> None:
+    build_fmus(3)
     assert main(["validate"]) == 0
     out = capsys.readouterr().out
-    assert out.count(": OK") == 3 and str(folder) in out
+    assert out.count(": OK") == 3 and str(build_fmus(3)) in out

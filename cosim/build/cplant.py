@@ -25,7 +25,18 @@ from arcosim.version import __version__
 
 SOURCES = ("physics.c", "fmu.c")
 HEADERS = ("physics.h",)
-CFLAGS = ("-O2", "-std=gnu11", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall", "-Wextra")
+#: ISO C99, no GNU extensions: the sources also build with MSVC or any C99 compiler,
+#: against the FMI 2.0 (2014) headers as well as 2.0.1-2.0.4 (tests/test_cplant_sources.py).
+CFLAGS = (
+    "-O2",
+    "-std=c99",
+    "-pedantic",
+    "-fPIC",
+    "-shared",
+    "-fvisibility=hidden",
+    "-Wall",
+    "-Wextra",
+)
 
 _TYPES = {"Real": "T_REAL", "Integer": "T_INTEGER", "Boolean": "T_BOOLEAN", "String": "T_STRING"}
 _CAUSALITIES = {"parameter": "C_PARAMETER", "input": "C_INPUT", "output": "C_OUTPUT"}
@@ -93,6 +104,17 @@ def model_description_xml(identifier: str, n: int) -> bytes:
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8")
 
 
+def sources_digest(n: int) -> str:
+    """First 10 hex digits of the SHA-256 of the plant's C sources and n: the build
+    field of its serialized states' identity (a state from other sources is refused)."""
+    import hashlib
+
+    digest = hashlib.sha256(f"n={n}".encode())
+    for name in (*SOURCES, *HEADERS):
+        digest.update((source_dir() / name).read_bytes())
+    return digest.hexdigest()[:10]
+
+
 def variables_header(n: int, guid: str) -> str:
     """C header: the variable table, ``VR_<name>`` macros and the GUID."""
     variables = plant_variables(n)
@@ -101,6 +123,8 @@ def variables_header(n: int, guid: str) -> str:
         "#ifndef PLANT_VARIABLES_H",
         "#define PLANT_VARIABLES_H",
         f'#define MODEL_GUID "{guid}"',
+        f'#define MODEL_IDENTIFIER "MotorChainPlant_n{n}"',
+        f'#define PLANT_BUILD "{sources_digest(n)}"',
         f"#define N_VARS {len(variables)}",
         "enum { T_REAL, T_INTEGER, T_BOOLEAN, T_STRING };",
         "enum { C_PARAMETER, C_INPUT, C_OUTPUT };",

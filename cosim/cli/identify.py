@@ -4,8 +4,8 @@ Contract (scripts rely on it)::
 
     arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
                              [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
-                             [--method observer|output-error|whole-chain]
-                             [--fit-inertia-scale] [--start-k K]
+                             [--method observer|output-error|whole-chain|load-torque]
+                             [--fit-inertia-scale] [--start-k K] [--chain FIT.json]
 
 * the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
@@ -33,6 +33,14 @@ Contract (scripts rely on it)::
   under ``std``, and the evidence (modes seen, singular values, criterion per n).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
+* ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
+  time, from the motor alone (``cosim/load_torque.py``: the observer FMU's estimator 1
+  with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) comes from
+  ``--chain`` (the JSON that ``--method whole-chain --json`` prints; it sets
+  ``--masses`` too) and ``--set``, the actuator terms, ``load_mass`` (required) and
+  ``load_torque_bandwidth`` from ``--set``; ``--out`` writes ``time``,
+  ``tau_load_hat``, ``tau_reac_hat``, ``theta_hat[i]``, ``omega_hat[i]`` and the
+  innovation; ``--json`` prints a summary. The step may vary.
 
 A bad log (missing column, non-increasing time, NaN, empty file, not UTF-8) gives a
 one-line error naming the row or column, and exit status 2. So does a ``--start-k``
@@ -55,8 +63,11 @@ from arcosim.build.recipes import OBSERVER, check_masses
 from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
 from arcosim.host.instance import FmuInstance
+from arcosim.host.overrides import parse_assignment
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
+from arcosim.identification import load_torque
 from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.output_error import (
     Fit,
@@ -108,16 +119,23 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--out",
         type=Path,
-        help="observer: every output over time as CSV; output-error, whole-chain: the "
-        "report as a .json file",
+        help="observer, load-torque: every output over time as CSV; output-error, "
+        "whole-chain: the report as a .json file",
     )
     force_option(p)
     p.add_argument(
         "--method",
-        choices=("observer", "output-error", "whole-chain"),
+        choices=("observer", "output-error", "whole-chain", "load-torque"),
         default="observer",
         help="observer: replay the observer FMU (default); output-error: fit k and B "
-        "offline; whole-chain: fit every J[i], k[i], B[i] offline",
+        "offline; whole-chain: fit every J[i], k[i], B[i] offline; load-torque: estimate "
+        "the torque on load mass load_mass over time, offline",
+    )
+    p.add_argument(
+        "--chain",
+        type=Path,
+        help="load-torque: JSON with J[i], k[i], B[i] (the output of --method whole-chain "
+        "--json); sets --masses",
     )
     p.add_argument(
         "--fit-inertia-scale",
@@ -150,6 +168,14 @@ def _execute(args: argparse.Namespace) -> int:
         folder = fmu_folder(args, 3)
         _check_out(args, fmu_inputs(folder))
         return _whole_chain(args, log, folder, masses)
+    if args.method == "load-torque":
+        chain = read_chain(args.chain) if args.chain else {}
+        n = int(chain.pop("masses")) if "masses" in chain else _masses(args.masses)
+        folder = fmu_folder(args, check_masses(n))
+        _check_out(args, fmu_inputs(folder))
+        return _load_torque(args, log, folder, n, chain)
+    if args.chain:
+        raise UserError("--chain is for --method load-torque")
     n = _masses(args.masses)
     folder = fmu_folder(args, n)
     _check_out(args, fmu_inputs(folder))
@@ -180,12 +206,13 @@ def _check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
         raise UserError(
             f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
         )
-    if args.method == "observer" and is_json:
+    if args.method not in OFFLINE and is_json:
         raise UserError(
-            f"--out {args.out}: --method observer writes every output over time as CSV; "
-            "name a .csv file (--json prints the final values)"
+            f"--out {args.out}: --method {args.method} writes its outputs over time as CSV; "
+            "name a .csv file (--json prints a summary)"
         )
-    check_output(args.out, inputs=[args.log, *fmus], force=args.force)
+    chain = [args.chain] if args.chain else []
+    check_output(args.out, inputs=[args.log, *chain, *fmus], force=args.force)
 
 
 def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None:
@@ -347,6 +374,118 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
             "--set D_m=… --set f_c=… (mode 0 measures it), or the fit may add a mode for it"
         )
     return 0
+
+
+def read_chain(path: Path) -> dict[str, float]:
+    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report.
+
+    Raises
+    ------
+    UserError
+        When the file is not UTF-8 JSON, or a value is missing, not a finite number,
+        or ``masses`` not a supported number of masses.
+    """
+    from arcosim.logs import read_text_file
+
+    try:
+        data = json.loads(read_text_file(path, "chain"))
+    except ValueError as error:
+        raise UserError(f"--chain {path}: cannot read it as JSON ({error})") from None
+    if not isinstance(data, dict):
+        raise UserError(f"--chain {path}: expected a JSON object with J[i], k[i], B[i]")
+    chain = {
+        k: v
+        for k, v in data.items()
+        if (k.split("[")[0] in ("J", "k", "B") and k.endswith("]")) or k == "masses"
+    }
+    for key, value in chain.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise UserError(f"--chain {path}: {key} = {value!r:.40} is not a number")
+        if not math.isfinite(value):
+            raise UserError(f"--chain {path}: {key} = {value} is not a finite number")
+    masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
+    if masses != int(masses):
+        raise UserError(f"--chain {path}: masses = {masses} is not a whole number")
+    n = check_masses(int(masses))
+    missing = [f"{p}[{i}]" for p in "JkB" for i in range(1, n + 1) if f"{p}[{i}]" not in chain]
+    if missing:
+        raise UserError(f"--chain {path}: missing {', '.join(missing)}")
+    return {**{k: float(v) for k, v in chain.items()}, "masses": n}
+
+
+def _load_torque(
+    args: argparse.Namespace, log: DriveLog, folder: Path, n: int, chain: dict[str, float]
+) -> int:
+    values = known_parameters(folder, args.set)
+    values.update({k: v for k, v in chain.items() if k not in _set_names(args.set)})
+    load_mass = int(values["load_mass"])
+    if not 1 <= load_mass <= n:
+        raise UserError(
+            f"--method load-torque needs the load mass: --set load_mass=I with I in 1 … {n} "
+            f"(got {load_mass})"
+        )
+    settings = ObserverSettings(
+        mode=STATE_ESTIMATION,
+        actuator=actuator_of(values),
+        g_dist=values["g_dist"],
+        g_lpf=values["g_lpf"],
+        J=tuple(values[f"J[{i}]"] for i in range(1, n + 1)),
+        k=tuple(values[f"k[{i}]"] for i in range(1, n + 1)),
+        B=tuple(values[f"B[{i}]"] for i in range(1, n + 1)),
+        estimator=MODEL_BASED,
+        encoder_cpr=int(values["encoder_cpr"]),
+        torque_noise_std=values["torque_noise_std"],
+        tau_noise_std=values["tau_noise_std"],
+        load_mass=load_mass,
+        load_torque_bandwidth=values["load_torque_bandwidth"],
+    )
+    for name in ("J", "k"):
+        if any(not x > 0 for x in getattr(settings, name)):
+            raise UserError(f"every {name}[i] must be > 0, got {getattr(settings, name)}")
+    if not settings.load_torque_bandwidth > 0:
+        raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
+    c = log.columns
+    try:
+        result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+    except (ValueError, ZeroDivisionError, OverflowError) as error:  # the Kalman design
+        raise UserError(
+            f"--method load-torque: no estimator for these settings ({error}); check "
+            "torque_noise_std, tau_noise_std, load_torque_bandwidth and the chain"
+        ) from None
+    if args.out:
+        write_csv(args.out, result.columns(), force=args.force)
+    last = log.time >= log.time[-1] - 1.0
+    report = {
+        "method": "load-torque",
+        "masses": n,
+        "load_mass": load_mass,
+        "load_torque_bandwidth": settings.load_torque_bandwidth,
+        "samples": len(log),
+        "final": float(result.tau_load[-1]),
+        "mean_last_second": float(np.mean(result.tau_load[last])),
+        "std_last_second": float(np.std(result.tau_load[last])),
+        "rms_innovation": float(np.sqrt(np.mean(result.innovation**2))),
+    }
+    if args.json:
+        print(json.dumps(report, indent=2))
+        return 0
+    print(
+        f"{len(log)} samples, load torque on mass {load_mass} of {n} "
+        f"(bandwidth {settings.load_torque_bandwidth:g} rad/s):"
+    )
+    print(f"  final              {report['final']:.6g} N.m")
+    print(
+        f"  last second        {report['mean_last_second']:.6g} ± "
+        f"{report['std_last_second']:.2g} N.m (mean ± std)"
+    )
+    print(f"  rms innovation     {report['rms_innovation']:.3g} N.m")
+    if args.out:
+        print(f"wrote {args.out}")
+    return 0
+
+
+def _set_names(assignments: Sequence[str]) -> set[str]:
+    return {parse_assignment(text)[0] for text in assignments}
 
 
 def evidence(result: Fit, record: MotorRecord) -> dict[str, object]:

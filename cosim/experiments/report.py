@@ -179,7 +179,36 @@ def figure_whole_chain(
     magnitude.legend(fontsize=8)
     fig.suptitle("Fig. 7 — the whole chain from the motor's current and encoder alone")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
+    plt.close(fig)
+    return path
+
+
+def figure_load_torque(
+    time: np.ndarray, truth: np.ndarray, estimates: dict[str, np.ndarray], path: Path
+) -> Path:
+    """Fig. 8: the load torque on the last mass, estimated from the motor against the truth."""
+    plt = _pyplot()
+    fig, (ax, err) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    ax.plot(time, truth * 1e3, color="k", lw=1.4, label="applied (plant tau_ext[3])")
+    for j, (label, estimate) in enumerate(estimates.items()):
+        style = {"color": f"C{j}", "ls": "-" if j == 0 else "--"}
+        ax.plot(time, estimate * 1e3, lw=1.0, label=f"estimated, {label}", **style)
+        err.plot(time, (estimate - truth) * 1e3, lw=0.8, label=label, **style)
+    size = float(np.max(np.abs(truth)))
+    for a in (ax, err):
+        a.grid(True, alpha=0.3)
+        a.set_ylabel("torque (mN·m)")
+    for bound in (-0.05 * size, 0.05 * size):
+        err.axhline(bound * 1e3, color="0.5", ls="--", lw=0.8)
+    err.set_ylim(-0.3 * size * 1e3, 0.3 * size * 1e3)
+    err.set_xlabel("time (s)")
+    err.set_title("estimate − applied (grey: ±5 % of the step)", fontsize=9)
+    err.legend(loc="lower left", fontsize=8)
+    ax.legend(loc="lower left", fontsize=8)
+    fig.suptitle("Fig. 8 — load torque on mass 3 from the motor alone (model-based observer)")
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 

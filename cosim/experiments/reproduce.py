@@ -1,16 +1,20 @@
-"""``arcosim reproduce [--out DIR] [--ideal]``: the paper's three experiments on the bench,
-and a fourth beyond the paper.
+"""The paper's three experiments on the bench, and three beyond it (``arcosim reproduce``).
 
 1. actuator self-identification with the load detached (mode 0);
 2. five rigid maneuvers with different noise seeds (mode 1), with the actuator terms
    of experiment 1 → Table II next to the paper's own rows, and Fig. 4;
 3. a flexible maneuver with energy at all three modes (mode 2), with the mean k̂, B̂
    of experiment 2 → Fig. 5 (the flexible response) and Fig. 6 (estimated against
-   true angle of every mass);
+   true angle of every mass, the model-based observer of experiment 4 beside it);
 4. beyond the paper: the whole bench chain (every J_i, k_i, B_i, and n) identified
    from one identification record with only the actuator terms of experiment 1
-   known (``cosim/whole_chain.py``), then every mass's angle estimated in mode 2
-   (model-based observer) on the flexible maneuver with those parameters alone.
+   known (:mod:`arcosim.identification.whole_chain`), then every mass's angle
+   estimated in mode 2 (model-based observer) with those parameters alone → Fig. 7;
+5. beyond the paper: a load torque on mass 3 (a step of a tenth of the drive's peak
+   torque, then a 2 rad/s sine) during the broadband maneuver, estimated from the motor
+   alone (model-based observer with ``load_mass = 3``), with the true chain and with
+   experiment 4's chain: settling time, settled error, lag of the sine (scenario
+   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
 
 Writes ``report.md``, the CSV of every run and the PNG figures into ``--out``
 (default ``reports/``), and prints the tables. Realistic sensors (2000-count
@@ -31,6 +35,7 @@ from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import (
     figure_flexible_response,
+    figure_load_torque,
     figure_reaction_torque,
     figure_state_estimates,
     figure_whole_chain,
@@ -39,16 +44,19 @@ from arcosim.experiments.report import (
 )
 from arcosim.experiments.scenarios import (
     IDENTIFICATION_LINES,
+    LOAD_PROFILE,
     SCENARIOS,
     recording_columns,
     run_scenario,
 )
 from arcosim.fmu.flexchain import bench
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.fmu.flexchain.observer import MODEL_BASED
+from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
 from arcosim.host.master import Recording
 from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.encoder_fit import encoder_record
+from arcosim.identification.load_torque import score_profile, step_truth
+from arcosim.identification.offline_observer import estimate_states
 from arcosim.identification.output_error import motor_record
 from arcosim.identification.whole_chain import Choice
 from arcosim.identification.whole_chain import identify as identify_chain
@@ -64,7 +72,7 @@ G_DIST = 100.0
 
 @dataclass
 class Results:
-    """What the three experiments found (SI units)."""
+    """What the five experiments found (SI units)."""
 
     actuator: dict[str, float] = field(default_factory=dict)
     rigid: list[dict[str, float]] = field(default_factory=list)
@@ -73,6 +81,8 @@ class Results:
     whole_chain_std: dict[str, float] = field(default_factory=dict)
     masses: int = 0
     whole_scores: list[float] = field(default_factory=list)
+    load: dict[str, dict[str, float]] = field(default_factory=dict)
+    load_angles: dict[str, list[float]] = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
 
 
@@ -83,9 +93,13 @@ OUTPUTS = (
     "flexible.csv",
     "identification.csv",
     "whole_chain.csv",
+    "load_true_chain.csv",
+    "load_identified_chain.csv",
     "fig4_reaction_torque.png",
     "fig5_flexible_response.png",
     "fig6_state_estimates.png",
+    "fig7_whole_chain.png",
+    "fig8_load_torque.png",
     "report.md",
 )
 
@@ -97,7 +111,7 @@ def reproduce(
     fmu_dir: Path | None = None,
     force: bool = False,
 ) -> Results:
-    """Run the three experiments, write CSVs, figures and ``report.md`` into ``out``.
+    """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
 
     Refuses to start (:class:`UserError`) when one of :data:`OUTPUTS` exists in
     ``out`` unless ``force``; every file is written atomically.
@@ -113,6 +127,7 @@ def reproduce(
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / 1e-3)
         + 2 * round(SCENARIOS["flexible"].duration / 1e-3)
         + round(SCENARIOS["identification"].duration / 1e-3)
+        + 2 * round(LOAD_PROFILE.duration / 1e-3)
     )
     results = Results()
     with tqdm(
@@ -186,6 +201,15 @@ def reproduce(
             results.files.append(
                 write_csv(out / "whole_chain.csv", recording_columns(estimated), force=True)
             )
+            loaded = {}
+            for label, chain, name in (
+                ("true chain", TRUE_CHAIN, "load_true_chain.csv"),
+                ("identified chain", results.whole_chain, "load_identified_chain.csv"),
+            ):
+                loaded[label] = run(LOAD_PROFILE.scenario().name, observer={**actuator, **chain})
+                results.files.append(
+                    write_csv(out / name, recording_columns(loaded[label]), force=True)
+                )
     motor = flexible["plant.theta_m_true"]
     results.scores = [
         flexible_score(flexible[f"observer.theta_hat[{i}]"], flexible[f"plant.theta[{i}]"], motor)
@@ -198,6 +222,8 @@ def reproduce(
             )
             for i in range(1, N_MASSES + 1)
         ]
+    if estimated is not None:
+        results.files.append(_load_experiment(loaded, results, cpr, out / "fig8_load_torque.png"))
     results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean, estimated)
     if estimated is not None:
         results.files.append(_whole_chain_figure(out, identification, results))
@@ -206,9 +232,52 @@ def reproduce(
     return results
 
 
-def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> Choice:
-    """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
-    terms = Actuator(
+#: The bench's chain as observer parameters (experiment 5's "true chain").
+TRUE_CHAIN = {
+    f"{p}[{i}]": v
+    for i in range(1, N_MASSES + 1)
+    for p, v in (("J", bench.J[i - 1]), ("k", bench.K), ("B", bench.B))
+}
+
+
+def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, figure: Path) -> Path:
+    """Experiment 5's scores (into ``results``) and its figure."""
+    estimates = {}
+    for label, rec in runs.items():
+        estimates[label] = rec["observer.tau_load_hat"]
+        results.load[label] = score_profile(rec.time, estimates[label], LOAD_PROFILE).as_dict()
+        motor = rec["plant.theta_m_true"]
+        results.load_angles[label] = [
+            flexible_score(rec[f"observer.theta_hat[{i}]"], rec[f"plant.theta[{i}]"], motor)
+            for i in range(1, N_MASSES + 1)
+        ]
+    # the same run and chain without the torque state: what the unmodelled load costs
+    rec = runs["true chain"]
+    settings = ObserverSettings(
+        mode=STATE_ESTIMATION,
+        actuator=_terms(results.actuator),
+        g_dist=G_DIST,
+        g_lpf=G_DIST,
+        J=tuple(bench.J),
+        k=(bench.K,) * N_MASSES,
+        B=(bench.B,) * N_MASSES,
+        estimator=MODEL_BASED,
+        encoder_cpr=cpr,
+    )
+    log = {c: rec[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")}
+    log["time"] = rec.time
+    theta = estimate_states(settings, log)
+    motor = rec["plant.theta_m_true"]
+    results.load_angles["true chain, no torque state"] = [
+        flexible_score(theta[:, i], rec[f"plant.theta[{i + 1}]"], motor) for i in range(N_MASSES)
+    ]
+    truth = step_truth(rec.time, LOAD_PROFILE.torque(rec.time))
+    return figure_load_torque(rec.time, truth, estimates, figure)
+
+
+def _terms(actuator: dict[str, float]) -> Actuator:
+    """The actuator terms experiment 1 identified, on the bench's nominal J_m and k_t."""
+    return Actuator(
         bench.J_M,
         bench.K_T,
         actuator["dkt_hat"],
@@ -216,6 +285,11 @@ def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int
         actuator["D_m_hat"],
         actuator["f_c_hat"],
     )
+
+
+def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> Choice:
+    """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
+    terms = _terms(actuator)
     signals = [identification[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
     record = motor_record(identification.time, *signals, terms, G_DIST)
     encoder = None
@@ -299,6 +373,44 @@ def _whole_chain_figure(out: Path, identification: Recording, results: Results) 
         (lines, measured, w, model(fitted), model(true)),
         out / "fig7_whole_chain.png",
     )
+
+
+LOAD_HEADER = [
+    "chain",
+    "settling (s)",
+    "settled error (mean)",
+    "settled max |error|",
+    "rms error, flexible motion",
+    "sine amplitude",
+    "sine lag (ms)",
+    "sine rms error",
+]
+
+
+def load_rows(results: Results) -> list[list[str]]:
+    """Experiment 5: the load torque estimate's scores, % of the step."""
+    if not results.load:
+        return [["—", f"not run: n = {results.masses} ≠ the plant's {N_MASSES}"]]
+    rows = []
+    for label, s in results.load.items():
+        settling = "never" if math.isnan(s["settling_s"]) else f"{s['settling_s']:.2f}"
+        rows.append(
+            [
+                label,
+                settling,
+                f"{s['settled_mean_percent']:+.2f} %",
+                f"{s['settled_max_percent']:.2f} %",
+                f"{s['settled_rms_percent']:.2f} %",
+                f"{s['sine_amplitude_ratio']:.3f}",
+                f"{1e3 * s['sine_lag_s']:.0f}",
+                f"{s['sine_rms_percent']:.1f} %",
+            ]
+        )
+    return rows
+
+
+def load_angle_rows(results: Results) -> list[list[str]]:
+    return [[label, *(f"{x:.3g}" for x in scores)] for label, scores in results.load_angles.items()]
 
 
 def actuator_rows(results: Results) -> list[list[str]]:
@@ -467,4 +579,27 @@ observer on experiment 3's flexible maneuver (`whole_chain.csv`) scores per mass
 ![Fig. 7](fig7_whole_chain.png)
 
 Fig. 6 above shows the model-based observer with these parameters beside the recursion.
+
+## 5. Beyond the paper: the load torque on the last mass from the motor alone
+
+Scenario `load-torque` (`load_true_chain.csv`, `load_identified_chain.csv`, seed 1):
+the broadband multi-sine of 11 lines 3–150 rad/s, {LOAD_PROFILE.amplitude:g} A, for
+{LOAD_PROFILE.duration:g} s, and on mass 3 (plant input `tau_ext[3]`) a step of a tenth of
+the drive's peak torque, {1e3 * LOAD_PROFILE.size():.3f} mN·m, at {LOAD_PROFILE.step_time:g} s,
+then from {LOAD_PROFILE.sine_time:g} s the same size times cos(2 rad/s · t). The observer
+(mode 2, estimator 1, `load_mass = 3`, `load_torque_bandwidth` at its default) knows the
+actuator terms of experiment 1 and either the true chain or experiment 4's. Errors in % of
+the step: settling is the time from the step until the estimate stays within 5 %; the
+settled window runs from {LOAD_PROFILE.settled_from:g} s to the sine; the sine is scored
+over its last two periods (from {LOAD_PROFILE.sine_from:.2f} s). Re-run the estimate on a
+log: `arcosim identify load_true_chain.csv --method load-torque --set load_mass=3 ...`.
+
+{markdown_table(LOAD_HEADER, load_rows(results))}
+
+The angles of the same runs (score per mass; the last row: the true chain without the
+torque state, whose static deflections the unmodelled torque leaves wrong):
+
+{markdown_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results))}
+
+![Fig. 8](fig8_load_torque.png)
 """

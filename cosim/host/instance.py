@@ -185,8 +185,8 @@ class FmuInstance:
         Raises
         ------
         UserError
-            When the FMU refuses a value or its initialization, with its log lines
-            (they name the parameters at fault).
+            When the FMU refuses a value or its initialization; its log lines (they
+            name the parameters at fault) are the message.
         """
         before = len(self.messages)
         try:
@@ -195,8 +195,11 @@ class FmuInstance:
             self.slave.enterInitializationMode()
             self.slave.exitInitializationMode()
         except FMICallException as error:
-            said = " | ".join(m.strip() for m in self.messages[before:][-6:]) or str(error)
-            raise UserError(f"{self.path.name} refused its initialization: {said}") from None
+            said = [m.split(": ", 1)[-1] for m in self.messages[before:]]
+            raise UserError(
+                f"{self.path.name} refused its parameters: "
+                + ("; ".join(said) if said else f"status {error.status}")
+            ) from None
         self.time = start_time
 
     def do_step(self, t: float, h: float) -> int:

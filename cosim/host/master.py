@@ -75,6 +75,7 @@ def cosimulate(
     t0: float = 0.0,
     progress: Callable[[int], None] | None = None,
     record_every: int = 1,
+    plant_inputs: Mapping[str, Sequence[float]] | None = None,
 ) -> Recording:
     """Run plant and observer for ``len(i_ref)`` steps of ``h`` seconds.
 
@@ -88,6 +89,10 @@ def cosimulate(
         Freshly instantiated FMUs, not yet initialized.
     i_ref : sequence of float
         Current command for each step (A), held over the step; shape ``(N,)``.
+    plant_inputs : mapping of str to sequence of float, optional
+        Other Real inputs of the plant by name (e.g. ``"tau_ext[3]"``, N·m), one
+        value per step like ``i_ref`` (shape ``(N,)``) and held over the step; inputs
+        not named keep their start values.
     h : float
         Communication step (s), finite and > 0.
     record_plant, record_observer : sequence of str
@@ -136,6 +141,13 @@ def cosimulate(
         raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
     currents = [float(x) for x in i_ref]
     steps = len(currents)
+    extra = {name: [float(x) for x in values] for name, values in (plant_inputs or {}).items()}
+    for name, values in extra.items():
+        var = plant.variables.get(name)
+        if name == "i_ref" or var is None or var.causality != "input" or var.type != "Real":
+            raise UserError(f"plant input {name!r}: not a Real input of the plant besides i_ref")
+        if len(values) != steps:
+            raise UserError(f"plant input {name!r}: {len(values)} values for {steps} steps")
     plant.initialize(plant_parameters, t0)
     measured = plant.real_port(MEASURED)
     observer_in = observer.real_port(MEASURED)
@@ -149,8 +161,9 @@ def cosimulate(
     read_plant, read_observer = _recorder(plant, record_plant), _recorder(observer, record_observer)
     plant_log[0], observer_log[0] = read_plant(), read_observer()
     # The hot loop: bare ctypes calls with ctypes arguments made once, no allocation.
-    i_port = plant.real_port(["i_ref"])
+    i_port = plant.real_port(["i_ref", *extra])
     set_i, i_vr, i_value, one = i_port.set_real, i_port.vrs, i_port.values, i_port.count
+    rows = list(zip(currents, *extra.values())) if extra else None
     plant_step, plant_c = plant.step_call()
     observer_step, observer_c = observer.step_call()
     get_sensors, sensors_in = measured.get_real, observer_in.set_real
@@ -169,7 +182,10 @@ def cosimulate(
             > 1
         ):
             _check(2, plant, "passing the sensors on", t)
-        i_value[0] = currents[k]
+        if rows is None:
+            i_value[0] = currents[k]
+        else:
+            i_value[:] = rows[k]
         if set_i(plant_c, i_vr, one, i_value) > 1 or plant_step(plant_c, t_c, h_c, 1) > 1:
             _check(2, plant, "stepping", t)
         if (

@@ -26,6 +26,7 @@ from fmpy.validation import validate_fmu
 from arcosim.errors import UserError
 from arcosim.host.ecos import ecos_binary, run_ecos
 from arcosim.host.instance import FmuInstance
+from arcosim.portability import portability_problems
 
 
 def check_model_description(fmu: Path) -> list[str]:
@@ -155,7 +156,10 @@ def not_an_fmu(path: Path) -> str | None:
 def validate(fmu: Path) -> tuple[list[str], list[str]]:
     """Check one FMU the way a strict FMI host would.
 
-    fmpy's validation, then what it does not check (units from
+    fmpy's validation; portability (no absolute path or libpython among its Linux
+    binaries' NEEDED, RPATH, RUNPATH entries; its Python code under one build-unique
+    package that imports nothing but the standard library by absolute name); then
+    what fmpy does not check (units from
     ``<UnitDefinitions>``, descriptions, generationTool, DefaultExperiment, state
     support), then a run: a clean start and 20 steps with a silent log, refused bad
     steps (NaN input, step size 0, a wrong communication point, a step before
@@ -185,6 +189,7 @@ def validate(fmu: Path) -> tuple[list[str], list[str]]:
         problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
     except Exception as error:  # fmpy's reader raises whatever the file makes it meet
         return [f"fmpy cannot read the model description ({type(error).__name__}: {error})"], []
+    problems += [f"portability: {p}" for p in portability_problems(fmu)]
     problems += check_model_description(fmu)
     try:
         problems += check_runtime(fmu)

@@ -12,6 +12,7 @@ from typing import ClassVar
 
 from ..flexchain import bench
 from ..flexchain.dob import Actuator
+from ..flexchain.load_observer import LOAD_TORQUE_BANDWIDTH, SMOOTHING_RATIO
 from ..flexchain.observer import (
     MODEL_BASED,
     RIGID_IDENTIFICATION,
@@ -150,6 +151,21 @@ class ReactionTorqueObserver(FmuSlave):
                 "Estimator 1: white noise on tau_reac_hat (Kalman design)",
             ),
             par(
+                "load_mass",
+                0,
+                "",
+                "Estimator 1: 0 = off; i = also estimate the external torque on load mass i "
+                "(one mass: constant torques on several masses show only as their sum)",
+            ),
+            par(
+                "load_torque_bandwidth",
+                LOAD_TORQUE_BANDWIDTH,
+                "rad/s",
+                "Estimator 1 with load_mass > 0: bandwidth of the load torque estimate "
+                "(random-walk noise of the Kalman design; the output is smoothed by a "
+                f"second-order low-pass at {SMOOTHING_RATIO:g} times it)",
+            ),
+            par(
                 "omega_min",
                 5.0,
                 "rad/s",
@@ -191,6 +207,12 @@ class ReactionTorqueObserver(FmuSlave):
                 lambda i: f"Mode 2: estimated velocity of load mass {i}",
             ),
             out(
+                "tau_load_hat",
+                "N.m",
+                "Mode 2, estimator 1, load_mass > 0: estimated external torque on load mass "
+                "load_mass (positive accelerates it, as the plant's tau_ext); 0 otherwise",
+            ),
+            out(
                 "id_valid",
                 "",
                 "Mode 0/1: the fit has at least 40 samples and its scaled normal matrix a "
@@ -203,7 +225,15 @@ class ReactionTorqueObserver(FmuSlave):
         n = self.n_masses
         problems = range_problems(
             self.value,
-            positive=["J_mo", "k_to", "g_dist", "g_lpf", *indexed("J", n), *indexed("k", n)],
+            positive=[
+                "J_mo",
+                "k_to",
+                "g_dist",
+                "g_lpf",
+                *indexed("J", n),
+                *indexed("k", n),
+                "load_torque_bandwidth",
+            ],
             non_negative=[
                 "D_m",
                 "f_c",
@@ -238,7 +268,23 @@ class ReactionTorqueObserver(FmuSlave):
                     f"for noise on both; give each from {low:g} to {high:g} N.m, neither more "
                     f"than {NOISE_RATIO:g} times the other (defaults 1e-4 and 1.5e-3)"
                 )
-        return problems
+        return problems + self.load_mass_problems()
+
+    def load_mass_problems(self) -> list[str]:
+        """A sentence if ``load_mass`` names no load mass or the mode cannot run it."""
+        load_mass, mode, estimator = self.values(["load_mass", "mode", "estimator"])
+        n = self.n_masses
+        if not 0 <= load_mass <= n:
+            return [
+                f"parameter load_mass = {load_mass} is not allowed (use 0 = off, or a load "
+                f"mass 1 to {n})"
+            ]
+        if load_mass and not (mode == STATE_ESTIMATION and estimator == MODEL_BASED):
+            return [
+                f"parameter load_mass = {load_mass} needs mode = 2 and estimator = 1 (the "
+                "model-based observer); set load_mass = 0 otherwise"
+            ]
+        return []
 
     def initialize(self) -> None:
         n = self.n_masses
@@ -258,6 +304,8 @@ class ReactionTorqueObserver(FmuSlave):
             encoder_cpr=v("encoder_cpr"),
             torque_noise_std=v("torque_noise_std"),
             tau_noise_std=v("tau_noise_std"),
+            load_mass=v("load_mass"),
+            load_torque_bandwidth=v("load_torque_bandwidth"),
         )
         self.observer = Observer(settings, v("theta_m"), v("omega_m"))
         self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
@@ -275,6 +323,7 @@ class ReactionTorqueObserver(FmuSlave):
             self.out_omega[0] + n,
         )
         self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
+        self.out_load = self.vr["tau_load_hat"] if settings.load_mass else None
 
         if settings.mode == STATE_ESTIMATION:
             for i, x in zip(self.out_theta, self.observer.estimator.theta):
@@ -293,6 +342,8 @@ class ReactionTorqueObserver(FmuSlave):
         if estimator is not None:
             v[t0:t1] = estimator.theta
             v[w0:w1] = estimator.omega
+            if self.out_load is not None:
+                v[self.out_load] = estimator.tau_load
         else:
             self.stale = True  # identification is solved when an output is read
 

@@ -90,6 +90,19 @@ def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Mat
     raise ValueError("the Kalman gain's Riccati iteration did not converge")
 
 
+def theta_noise_covariance(Gamma: Matrix, theta_noise_std: float, h: float) -> Matrix:
+    """Process noise from the motor angle's white noise σ (rad) through the input
+    ``w_k = [θ_m,k−1, v_k]``: ``Γ cov(w) Γᵀ`` (v_k differences two noisy samples)."""
+    s2 = theta_noise_std**2
+    cov_w = [[s2, -s2 / h], [-s2 / h, 2.0 * s2 / (h * h)]]
+    return linalg.matmul(linalg.matmul(Gamma, cov_w), linalg.transpose(Gamma))
+
+
+def measurement_noise(noise: NoiseModel) -> float:
+    """Variance of τ̂_reac's white noise (N·m²), floored so the gain stays finite."""
+    return max(noise.tau_noise_std**2, 1e-30)
+
+
 def step_model(
     J: Sequence[float],
     k: Sequence[float],
@@ -111,14 +124,12 @@ def step_model(
     F[m - 1][: 2 * n] = [b * x for x in c]
     F[m - 1][m - 1] = a
     Gamma = [row[:] for row in chain.Bd] + [[b * d[0], b * d[1]]]
-    s2 = noise.theta_noise_std**2
-    cov_w = [[s2, -s2 / h], [-s2 / h, 2.0 * s2 / (h * h)]]
-    Q = linalg.matmul(linalg.matmul(Gamma, cov_w), linalg.transpose(Gamma))
+    Q = theta_noise_covariance(Gamma, noise.theta_noise_std, h)
     for i in range(n):
         Q[n + i][n + i] += (noise.torque_noise_std * h / J[i]) ** 2
     for i in range(m):  # keeps the Riccati equation regular when every noise is zero
         Q[i][i] += 1e-30
-    r = max(noise.tau_noise_std**2, 1e-30)
+    r = measurement_noise(noise)
     P = filter_riccati(F, Q, r)
     K = [P[i][m - 1] / (P[m - 1][m - 1] + r) for i in range(m)]
     return StepModel(F, Gamma, K)
@@ -169,9 +180,13 @@ class ModelObserver:
         if found is None:
             if len(self._models) >= CACHE_SIZE:
                 self._models.pop(next(iter(self._models)))
-            found = step_model(self.J, self.k, self.B, self.g_dist, self.noise, h)
+            found = self.design(h)
             self._models[h] = found
         return found
+
+    def design(self, h: float) -> StepModel:
+        """The step model for ``h`` (:func:`step_model`; subclasses add states)."""
+        return step_model(self.J, self.k, self.B, self.g_dist, self.noise, h)
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
         """Take the sample that ends a step of ``h`` s (τ̂_reac in N·m, θ_m in rad)."""

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 from .dob import Actuator, ReactionObserver
+from .load_observer import LOAD_TORQUE_BANDWIDTH, LoadTorqueObserver
 from .model_observer import ModelObserver, NoiseModel
 from .recursion import ChainRecursion
 from .rigid_identification import RigidChainIdentifier
@@ -42,6 +43,9 @@ class ObserverSettings:
             observer takes its quantization noise, 2π/cpr/√12 rad, into its gain.
         torque_noise_std: model-based observer: unmodelled torque on each mass (N·m).
         tau_noise_std: model-based observer: noise on τ̂_reac (N·m).
+        load_mass: model-based observer: 0, or the load mass (1 … n) whose external
+            torque is estimated too (:mod:`flexchain.load_observer`).
+        load_torque_bandwidth: bandwidth of that estimate (rad/s), > 0.
     """
 
     mode: int
@@ -58,6 +62,8 @@ class ObserverSettings:
     encoder_cpr: int = 0
     torque_noise_std: float = 1e-4
     tau_noise_std: float = 1.5e-3
+    load_mass: int = 0
+    load_torque_bandwidth: float = LOAD_TORQUE_BANDWIDTH
 
     def angle_offset(self) -> float:
         """Half a count of the encoder (rad), 0 when the angle is not quantized."""
@@ -84,15 +90,31 @@ class Observer:
     def __init__(self, settings: ObserverSettings, theta0: float, omega0: float) -> None:
         self.settings = settings
         s = settings
+        if s.load_mass and not (s.mode == STATE_ESTIMATION and s.estimator == MODEL_BASED):
+            raise ValueError(
+                f"load_mass = {s.load_mass} needs mode 2 and estimator 1 (the model-based "
+                "observer); use load_mass = 0 otherwise"
+            )
         self.dob = ReactionObserver(s.actuator, s.g_dist, theta0, omega0)
         self.identifier: ActuatorIdentifier | RigidChainIdentifier | None = None
-        self.estimator: ChainRecursion | ModelObserver | None = None
+        self.estimator: ChainRecursion | ModelObserver | LoadTorqueObserver | None = None
         self.offset = s.angle_offset() if s.mode == STATE_ESTIMATION else 0.0
         if s.mode == SELF_IDENTIFICATION:
             self.identifier = ActuatorIdentifier(s.g_dist, s.omega_min, s.actuator.k_to, s.g_id)
         elif s.mode == RIGID_IDENTIFICATION:
             self.identifier = RigidChainIdentifier(
                 s.J, s.g_dist, s.kappa_correction, theta0, s.actuator.f_c
+            )
+        elif s.estimator == MODEL_BASED and s.load_mass > 0:
+            self.estimator = LoadTorqueObserver(
+                s.J,
+                s.k,
+                s.B,
+                s.g_dist,
+                s.noise(),
+                theta0 + self.offset,
+                s.load_mass,
+                s.load_torque_bandwidth,
             )
         elif s.estimator == MODEL_BASED:
             self.estimator = ModelObserver(s.J, s.k, s.B, s.g_dist, s.noise(), theta0 + self.offset)

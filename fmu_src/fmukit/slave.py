@@ -27,9 +27,10 @@ from pathlib import Path
 from typing import ClassVar, TextIO
 from xml.etree.ElementTree import Element
 
-from pythonfmu import Fmi2Slave
-from pythonfmu.enums import Fmi2Status
-
+# Inside an FMU, pythonfmu's runtime bundled beside this package; in the source tree,
+# arcosim.fmu.pythonfmu, which re-exports the installed one.
+from ..pythonfmu.enums import Fmi2Status
+from ..pythonfmu.fmi2slave import Fmi2Slave
 from .model_description import ModelInfo, model_description
 from .state import restore, snapshot
 from .variables import Value, Variable, par
@@ -197,13 +198,23 @@ class FmuSlave(Fmi2Slave):
         }
 
     def _set_fmu_state(self, state: dict) -> None:
-        self.v = list(state["values"])
-        self.time = state["time"]
-        self.stale = state["stale"]
-        self.initialized = state["initialized"]
-        self.problems = list(state["problems"])
+        """Restore a state of :meth:`_get_fmu_state`; anything else is refused with an
+        error in the log and leaves the instance as it was."""
+        try:
+            values = list(state["values"])
+            if len(values) != len(self.v):
+                raise ValueError(f"it has {len(values)} values, this FMU {len(self.v)}")
+            algorithm = restore(state["algorithm"])
+            scalars = (state["time"], bool(state["stale"]), bool(state["initialized"]))
+            problems = [str(p) for p in state["problems"]]
+        except Exception as error:  # never fmi2Fatal: the instance stays usable
+            self.report(f"FMU state refused: {error}")
+            return
+        self.v = values
+        self.time, self.stale, self.initialized = scalars
+        self.problems = problems
         self._ready = self.initialized and not self.problems and self.time is not None
-        for name, value in restore(state["algorithm"]).items():
+        for name, value in algorithm.items():
             setattr(self, name, value)
 
     def exit_initialization_mode(self) -> None:
@@ -367,7 +378,10 @@ class FmuSlave(Fmi2Slave):
             if i not in valid:
                 self.report(f"set{vtype}: value reference {i} is not a {vtype} variable; ignored")
             elif i in self._outputs:
-                self.report(f"{self.variables[i].name} is an output and cannot be set; ignored")
+                self.report(
+                    f"{self.variables[i].name} is an output and cannot be set; ignored",
+                    Fmi2Status.warning,
+                )
             elif self.initialized and i in self._parameters:
                 self.report(
                     f"parameter {self.variables[i].name} is fixed after initialization; "

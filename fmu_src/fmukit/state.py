@@ -15,6 +15,8 @@ import importlib
 from typing import Any
 
 _CLASS, _FIELDS, _TUPLE = "__class__", "__fields__", "__tuple__"
+#: Classes a state may name: this FMU's own modules (``<bundle>.`` inside an FMU).
+_OWN = __package__.rpartition(".")[0] + "."
 
 
 def snapshot(value: Any) -> Any:
@@ -40,7 +42,11 @@ def snapshot(value: Any) -> Any:
 
 
 def restore(data: Any) -> Any:
-    """New objects from a :func:`snapshot`."""
+    """New objects from a :func:`snapshot`.
+
+    Raises:
+        ValueError: the data names a class outside this FMU's own package.
+    """
     if data is None or isinstance(data, (bool, int, float, str)):
         return data
     if isinstance(data, list):
@@ -50,6 +56,8 @@ def restore(data: Any) -> Any:
     if _CLASS not in data:
         return {k: restore(x) for k, x in data.items()}
     module, qualname = data[_CLASS].split(":")
+    if not module.startswith(_OWN):
+        raise ValueError(f"the state names class {data[_CLASS]!r}, not one of this FMU's")
     cls: Any = importlib.import_module(module)
     for part in qualname.split("."):
         cls = getattr(cls, part)

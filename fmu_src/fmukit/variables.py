@@ -8,13 +8,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Union
 
 from .units import check_unit
 
 VarType = Literal["Real", "Integer", "Boolean", "String"]
 Causality = Literal["parameter", "input", "output"]
-Value = float | int | bool | str
+# Union, not |: this module runs inside the FMUs, in any CPython >= 3.9
+Value = Union[float, int, bool, str]  # noqa: UP007
 
 
 @dataclass(frozen=True)

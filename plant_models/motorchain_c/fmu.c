@@ -24,7 +24,6 @@
 
 #define TEXT 2048
 #define PATH 1024
-#define STATE_MAGIC 0x4d43504c414e5431ULL /* "MCPLANT1" */
 
 /* Everything an FMU state holds (copied whole by get/set/serialize). */
 typedef struct {
@@ -43,7 +42,10 @@ typedef struct {
     Core core;
     PhysicsCache *cache;
     FILE *trace;
-    fmi2CallbackFunctions callbacks;
+    /* the host's logger, copied: the FMI 2.0 (2014) headers declare the members of
+     * fmi2CallbackFunctions const, so a struct holding one cannot be assigned */
+    fmi2CallbackLogger logger;
+    fmi2ComponentEnvironment environment;
     char name[256];
     int logging;
 } Plant;
@@ -75,7 +77,7 @@ static void repr_double(char *out, size_t size, double x) {
 }
 
 static void log_message(Plant *p, fmi2Status status, const char *format, ...) {
-    if (!p->logging || p->callbacks.logger == NULL) return;
+    if (!p->logging || p->logger == NULL) return;
     static const char *const category[] = {"logAll", "logStatusWarning", "logStatusDiscard",
                                            "logStatusError", "logStatusFatal", "logAll"};
     char text[TEXT + 512];
@@ -92,8 +94,8 @@ static void log_message(Plant *p, fmi2Status status, const char *format, ...) {
         escaped[j++] = text[i];
     }
     escaped[j] = '\0';
-    p->callbacks.logger(p->callbacks.componentEnvironment, p->name, status,
-                        category[status <= fmi2Pending ? status : 0], escaped);
+    p->logger(p->environment, p->name, status, category[status <= fmi2Pending ? status : 0],
+              escaped);
 }
 
 static void add_problem(Core *c, const char *format, ...) {
@@ -243,7 +245,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     (void)fmuResourceLocation;
     (void)visible;
     Plant probe = {0};
-    if (functions) probe.callbacks = *functions;
+    if (functions) {
+        probe.logger = functions->logger;
+        probe.environment = functions->componentEnvironment;
+    }
     snprintf(probe.name, sizeof probe.name, "%s", instanceName ? instanceName : "plant");
     probe.logging = 1;
     if (fmuType != fmi2CoSimulation) {
@@ -314,8 +319,11 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
         physics_cache_clear(p->cache);
         open_trace(p);
     }
-    if (core->problems[0]) log_message(p, fmi2Error, "%s", core->problems);
     core->initialized = 1;
+    if (core->problems[0]) {
+        log_message(p, fmi2Error, "%s", core->problems);
+        return fmi2Error;
+    }
     return fmi2OK;
 }
 
@@ -554,47 +562,123 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
     return fmi2OK;
 }
 
-#define HEADER (2 * sizeof(uint64_t))
+/* A serialized state is the Core in the envelope every arcosim FMU uses (the Python
+ * FMUs' is written by cosim/native/fmu_trampoline.c), all integers little-endian:
+ *   0  8  "ARCOSIMS"                 magic
+ *   8  4  format version (1)
+ *  12  4  flags (unused here: 0)
+ *  16  8  the FMU's time (IEEE 754 double)
+ *  24  4  n, the number of load masses
+ *  28  4  L, length of the identity text
+ *  32  L  identity: "<modelIdentifier> <GUID> <build>"
+ *  32+L    8  P, length of the payload (sizeof(Core))
+ *  40+L    P  the Core
+ *  40+L+P  4  CRC-32 (IEEE 802.3) of every byte before it */
+#define ENVELOPE_VERSION 1u
+static const char ENVELOPE_MAGIC[8] = {'A', 'R', 'C', 'O', 'S', 'I', 'M', 'S'};
+static const char IDENTITY[] = MODEL_IDENTIFIER " " MODEL_GUID " " PLANT_BUILD;
+#define IDENTITY_LENGTH (sizeof IDENTITY - 1)
+#define SERIALIZED (40 + IDENTITY_LENGTH + sizeof(Core) + 4)
+
+static uint32_t crc32(const unsigned char *p, size_t n) {
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) {
+        crc ^= p[i];
+        for (int k = 0; k < 8; k++) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+}
+
+static void put_le(unsigned char *p, uint64_t v, int bytes) {
+    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint64_t get_le(const unsigned char *p, int bytes) {
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; i++) v |= (uint64_t)p[i] << (8 * i);
+    return v;
+}
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
     (void)c;
     (void)state;
-    *size = HEADER + sizeof(Core);
+    *size = SERIALIZED;
     return fmi2OK;
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[],
                                  size_t size) {
     Plant *p = c;
-    if (size < HEADER + sizeof(Core)) {
-        log_message(p, fmi2Error, "serializeFMUstate: buffer of %zu bytes is too small",
-                    size);
+    if (!state || size != SERIALIZED) {
+        log_message(p, fmi2Error, "serializeFMUstate: %zu bytes given, %zu needed (ask "
+                    "fmi2SerializedFMUstateSize)", size, (size_t)SERIALIZED);
         return fmi2Error;
     }
-    uint64_t header[2] = {STATE_MAGIC, sizeof(Core)};
-    memcpy(bytes, header, HEADER);
-    memcpy(bytes + HEADER, state, sizeof(Core));
+    const Core *core = state;
+    unsigned char *out = (unsigned char *)bytes;
+    uint64_t time_bits;
+    memcpy(&time_bits, &core->time, sizeof time_bits);
+    memcpy(out, ENVELOPE_MAGIC, 8);
+    put_le(out + 8, ENVELOPE_VERSION, 4);
+    put_le(out + 12, 0, 4);
+    put_le(out + 16, time_bits, 8);
+    put_le(out + 24, (uint64_t)N_MASSES, 4);
+    put_le(out + 28, IDENTITY_LENGTH, 4);
+    memcpy(out + 32, IDENTITY, IDENTITY_LENGTH);
+    put_le(out + 32 + IDENTITY_LENGTH, sizeof(Core), 8);
+    memcpy(out + 40 + IDENTITY_LENGTH, core, sizeof(Core));
+    put_le(out + SERIALIZED - 4, crc32(out, SERIALIZED - 4), 4);
     return fmi2OK;
+}
+
+static fmi2Status refuse(Plant *p, const char *why) {
+    log_message(p, fmi2Error, "fmi2DeSerializeFMUstate refused: %s; nothing was changed", why);
+    return fmi2Error;
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
                                    fmi2FMUstate *state) {
     Plant *p = c;
-    uint64_t header[2];
-    if (size != HEADER + sizeof(Core)) {
-        log_message(p, fmi2Error,
-                    "deSerializeFMUstate: %zu bytes is not a state of this FMU (%zu expected)",
-                    size, HEADER + sizeof(Core));
-        return fmi2Error;
+    const unsigned char *in = (const unsigned char *)bytes;
+    char why[TEXT];
+    if (!bytes || size < 32) {
+        snprintf(why, sizeof why, "%zu bytes are too few to be a serialized state of this FMU",
+                 size);
+        return refuse(p, why);
     }
-    memcpy(header, bytes, HEADER);
-    if (header[0] != STATE_MAGIC || header[1] != sizeof(Core)) {
-        log_message(p, fmi2Error, "deSerializeFMUstate: the bytes are not a state of this FMU");
-        return fmi2Error;
+    if (memcmp(in, ENVELOPE_MAGIC, 8) != 0)
+        return refuse(p, "the bytes are not an FMU state serialized by an arcosim FMU");
+    if (get_le(in + 8, 4) != ENVELOPE_VERSION) {
+        snprintf(why, sizeof why, "state format version %u; this FMU reads version %u",
+                 (unsigned)get_le(in + 8, 4), ENVELOPE_VERSION);
+        return refuse(p, why);
     }
+    uint64_t length = get_le(in + 28, 4);
+    unsigned n = (unsigned)get_le(in + 24, 4);
+    if (length > size - 32 || size - 32 - length < 12) {
+        snprintf(why, sizeof why, "the identity field runs past the %zu bytes given", size);
+        return refuse(p, why);
+    }
+    if (length != IDENTITY_LENGTH || memcmp(in + 32, IDENTITY, IDENTITY_LENGTH) != 0 ||
+        n != N_MASSES) {
+        char theirs[512];
+        size_t shown = length < sizeof theirs - 1 ? (size_t)length : sizeof theirs - 1;
+        memcpy(theirs, in + 32, shown);
+        theirs[shown] = '\0';
+        snprintf(why, sizeof why, "it is a state of '%s' with n = %u, not of this FMU '%s' "
+                 "with n = %d", theirs, n, IDENTITY, N_MASSES);
+        return refuse(p, why);
+    }
+    if (size != SERIALIZED || get_le(in + 32 + IDENTITY_LENGTH, 8) != sizeof(Core)) {
+        snprintf(why, sizeof why, "%zu bytes arrived, a state of this FMU has %zu (truncated or "
+                 "padded)", size, (size_t)SERIALIZED);
+        return refuse(p, why);
+    }
+    if (crc32(in, size - 4) != (uint32_t)get_le(in + size - 4, 4))
+        return refuse(p, "checksum mismatch: the bytes were altered after serialization");
     Core *copy = *state ? (Core *)*state : malloc(sizeof(Core));
     if (!copy) return fmi2Error;
-    memcpy(copy, bytes + HEADER, sizeof(Core));
+    memcpy(copy, in + 40 + IDENTITY_LENGTH, sizeof(Core));
     *state = copy;
     return fmi2OK;
 }
@@ -640,9 +724,15 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
     return fmi2Discard;
 }
 
+/* fmi2Terminated: true exactly when the parameters were refused at
+ * exitInitializationMode (every doStep is refused until fmi2Reset or a restored state);
+ * a refused step leaves the state unchanged and the master may retry: false. The
+ * Python FMUs answer the same (cosim/native/fmu_trampoline.c). */
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    (void)c, (void)s, (void)value;
-    return fmi2Discard;
+    Plant *p = c;
+    if (s != fmi2Terminated || !value) return fmi2Discard;
+    *value = p->core.initialized && p->core.problems[0] ? fmi2True : fmi2False;
+    return fmi2OK;
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {

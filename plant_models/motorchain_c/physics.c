@@ -459,11 +459,11 @@ double noise_gaussian(uint64_t seed, uint64_t k) {
     uint64_t b = splitmix64(base + 2 * k + 1);
     double u1 = (double)((a >> 11) + 1) * 0x1p-53;
     double u2 = (double)(b >> 11) * 0x1p-53;
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * PH_PI * u2);
 }
 
 double noise_quantize(double theta, int64_t counts_per_rev) {
     if (counts_per_rev <= 0) return theta;
-    double step = 2.0 * M_PI / (double)counts_per_rev;
+    double step = 2.0 * PH_PI / (double)counts_per_rev;
     return floor(theta / step) * step;
 }

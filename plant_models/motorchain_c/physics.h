@@ -11,6 +11,9 @@
 
 #include "chain_size.h" /* generated at build: #define N_MASSES n */
 
+/* π as the double nearest to it, the value of Python's math.pi (C99 has no M_PI) */
+#define PH_PI 3.14159265358979323846
+
 #define PH_SIZE (2 * N_MASSES + 5) /* state length */
 #define PH_INPUTS (N_MASSES + 2)   /* i_ref, τ_fric, τ_ext,1 … τ_ext,n */
 #define PH_CACHE 16                /* discretized matrices kept, by (step, regime) */

@@ -1,1 +1,1 @@
-"""Native parts of the FMUs, compiled at build time (see python_loader.c)."""
+"""Native parts of the FMUs, compiled at build time (see fmu_trampoline.c)."""

@@ -1,0 +1,8 @@
+"""Stand-in, in the source tree, for the pythonfmu runtime each FMU bundles.
+
+Inside an FMU, ``<bundle>/pythonfmu/`` is pythonfmu's own runtime, copied there by
+:mod:`arcosim.build.portable`, and :mod:`..fmukit.slave` imports it relatively, so
+the FMU never runs a host's pythonfmu. Here, where the bundle does not exist, the
+same relative import reaches this package, which re-exports the installed pythonfmu.
+It is never bundled.
+"""

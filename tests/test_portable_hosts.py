@@ -1,0 +1,442 @@
+"""The FMUs off the building machine: source → plant → observer in foreign hosts.
+
+The FMUs are built once with the project's Python. Each host then runs in a private
+mount namespace (``unshare -m``, as root) in which the building Python's installation
+(``sys.base_prefix``) is an empty tmpfs, so nothing of it can be found or loaded:
+- fmpy in a fresh venv of each pyenv CPython 3.9, 3.10, 3.12, 3.13 and of Debian's
+  /usr/bin/python3 (3.11, a static interpreter with a separate libpython);
+- a C host (tests/hosts/chain_host.c: dlopen, no Python linked) with only
+  /usr/bin:/bin on PATH;
+- the ecos C++ engine (``ecospy``) with only /usr/bin:/bin on PATH;
+- libcosimpy (PyPI) under a CPython other than the building one.
+Every output of every FMU must agree with the building environment's fmpy run to
+1e-9 relative (of the output's largest magnitude), the host's environment must be
+unchanged by loading, and at most one libpython may be mapped: the host's own.
+Also: a host that imported its own ``fmukit``, ``flexchain`` and ``pythonfmu`` first
+gets the FMU's results unchanged; two builds of the observer run in one process,
+each with its own code.
+
+Venvs are made once per session under a temporary folder (about 16 s each: venv +
+``pip install --no-deps fmpy numpy lxml attrs``); set ARCOSIM_HOST_VENVS to a folder to
+keep them between sessions.
+"""
+
+from __future__ import annotations
+
+import functools
+import glob
+import json
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arcosim.build.ssp import BENCH, CONNECTIONS
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only")
+
+HERE = Path(__file__).parent / "hosts"
+COMPONENTS = {
+    "source": "ExcitationSource",
+    "plant": "MotorChainPlant",
+    "observer": "ReactionTorqueObserver",
+}
+STOP, H = 1.0, 1e-3
+RTOL = 1e-9
+HIDDEN = Path(sys.base_prefix).resolve()
+BARE_PATH = "/usr/bin:/bin"
+FMPY_PACKAGES = ["fmpy", "numpy", "lxml", "attrs"]
+
+
+# -- the namespace --------------------------------------------------------------------
+
+
+@functools.cache
+def namespace_problem() -> str | None:
+    """Why the building Python cannot be hidden here, or None."""
+    if shutil.which("unshare") is None:
+        return "unshare (util-linux) is not installed"
+    probe = subprocess.run(
+        ["unshare", "-m", "sh", "-c", f"mount -t tmpfs tmpfs {HIDDEN} && ls -A {HIDDEN}"],
+        capture_output=True,
+        text=True,
+    )
+    if probe.returncode != 0:
+        return f"unshare -m with a tmpfs over {HIDDEN} is not permitted: {probe.stderr.strip()}"
+    if probe.stdout.strip():
+        return f"{HIDDEN} is still visible inside the namespace"
+    return None
+
+
+def hidden(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 300):
+    """Run ``command`` with the building Python's installation hidden."""
+    why = namespace_problem()
+    if why:
+        pytest.skip(why)
+    script = f'{shutil.which("mount")} -t tmpfs tmpfs "{HIDDEN}" && exec "$@"'
+    return subprocess.run(
+        [shutil.which("unshare"), "-m", "/bin/sh", "-c", script, "sh", *command],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=cwd,
+        timeout=timeout,
+    )
+
+
+# -- the FMUs and the reference -----------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def fmus(build_fmus) -> dict[str, Path]:
+    folder = build_fmus(3)
+    return {c: folder / f"{name}.fmu" for c, name in COMPONENTS.items()}
+
+
+def spec(fmus: dict[str, Path], shadow: Path | None = None) -> dict:
+    return {
+        "components": {c: str(p) for c, p in fmus.items()},
+        "parameters": BENCH,
+        "connections": [list(c) for c in CONNECTIONS],
+        "stop": STOP,
+        "h": H,
+        "shadow": str(shadow) if shadow else None,
+    }
+
+
+def run_chain(python: str, spec_: dict, workdir: Path, env: dict[str, str], in_namespace: bool):
+    workdir.mkdir(parents=True, exist_ok=True)
+    (workdir / "spec.json").write_text(json.dumps(spec_))
+    command = [python, str(HERE / "chain_run.py"), "spec.json", "out.json"]
+    if in_namespace:
+        result = hidden(command, env, workdir)
+    else:
+        result = subprocess.run(command, capture_output=True, text=True, env=env, cwd=workdir)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return json.loads((workdir / "out.json").read_text())
+
+
+@pytest.fixture(scope="session")
+def reference(fmus, tmp_path_factory) -> dict[str, dict[str, np.ndarray]]:
+    """The building environment's fmpy run (this interpreter, nothing hidden)."""
+    out = run_chain(
+        sys.executable, spec(fmus), tmp_path_factory.mktemp("ref"), dict(os.environ), False
+    )
+    return {c: {k: np.array(v) for k, v in o.items()} for c, o in out["outputs"].items()}
+
+
+def assert_matches(reference, outputs, rows: int | None = None) -> int:
+    """Every output within RTOL of its largest magnitude; returns how many compared."""
+    compared, worst = 0, 0.0
+    for component, signals in reference.items():
+        for name, ref in signals.items():
+            got = np.asarray(outputs[component][name])
+            n = rows or len(ref)
+            assert len(got) >= n, f"{component}.{name}: {len(got)} samples, {n} expected"
+            scale = max(float(np.max(np.abs(ref[:n]))), 1e-300)
+            error = float(np.max(np.abs(got[:n] - ref[:n])))
+            assert error <= RTOL * scale, (
+                f"{component}.{name}: error {error:.3g} (scale {scale:.3g})"
+            )
+            compared += 1
+            worst = max(worst, error / scale)
+    print(f"worst relative error over {compared} outputs: {worst:.3g}")  # shown with -s
+    return compared
+
+
+# -- venvs with fmpy ------------------------------------------------------------------
+
+
+def pythons() -> dict[str, str]:
+    """label → interpreter: pyenv 3.9, 3.10, 3.12, 3.13 and Debian's python3."""
+    found = {}
+    root = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv")) / "versions"
+    for minor in (9, 10, 12, 13):
+        candidates = sorted(glob.glob(str(root / f"3.{minor}.*" / "bin" / f"python3.{minor}")))
+        if candidates:
+            found[f"3.{minor}"] = candidates[-1]
+    if Path("/usr/bin/python3").is_file():
+        found["debian"] = "/usr/bin/python3"
+    return found
+
+
+WANTED = ["3.9", "3.10", "3.12", "3.13", "debian"]
+
+
+@pytest.fixture(scope="session")
+def venvs(tmp_path_factory):
+    """``venvs(label)`` → python of a venv with fmpy for that interpreter (made once)."""
+    keep = os.environ.get("ARCOSIM_HOST_VENVS")
+    root = Path(keep) if keep else tmp_path_factory.mktemp("venvs")
+    made: dict[str, str] = {}
+
+    def get(label: str) -> str:
+        if label in made:
+            return made[label]
+        base = pythons().get(label)
+        if base is None:
+            pytest.skip(f"no CPython {label} on this machine")
+        venv = root / f"fmpy-{label}"
+        python = venv / "bin" / "python"
+        if not (venv / ".ready").is_file():
+            shutil.rmtree(venv, ignore_errors=True)
+            result = subprocess.run([base, "-m", "venv", str(venv)], capture_output=True, text=True)
+            if result.returncode != 0:
+                pytest.skip(f"{base} -m venv failed: {result.stderr.strip()[-300:]}")
+            result = subprocess.run(
+                [str(python), "-m", "pip", "install", "-q", "--no-deps", *FMPY_PACKAGES],
+                capture_output=True,
+                text=True,
+            )
+            assert result.returncode == 0, result.stderr[-2000:]
+            (venv / ".ready").touch()
+        made[label] = str(python)
+        return made[label]
+
+    return get
+
+
+def bare_env(python: str | None = None) -> dict[str, str]:
+    """What a user's shell might hand a host: HOME and a PATH without the venv."""
+    path = BARE_PATH if python is None else f"{Path(python).parent}:{BARE_PATH}"
+    return {"PATH": path, "HOME": str(Path.home()), "LANG": "C.UTF-8"}
+
+
+# -- fmpy hosts ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("label", WANTED)
+def test_chain_in_fmpy_of_another_python(fmus, reference, venvs, tmp_path, label) -> None:
+    python = venvs(label)
+    out = run_chain(python, spec(fmus), tmp_path, bare_env(python), True)
+    assert out["environ_changed"] == [], out["environ_changed"]
+    # the host's own libpython (none for Debian's static python3), never a second one
+    assert out["libpython_after"] == out["libpython_before"], out["libpython_after"]
+    assert len(out["libpython_after"]) <= 1
+    assert not any(str(HIDDEN) in p for p in out["libpython_after"])
+    assert assert_matches(reference, out["outputs"]) == 34  # 1 + 16 + 17 outputs
+
+
+def test_user_pythonhome_for_another_python_changes_nothing(fmus, reference, tmp_path):
+    """PYTHONHOME and PYTHONPATH meant for another Python in a C host's environment: the
+    FMU's interpreter ignores the environment and takes the home of its libpython."""
+    other = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.13.*")))
+    if not other:
+        pytest.skip("no pyenv CPython 3.13 to point PYTHONHOME at")
+    env = {**bare_env(), "PYTHONHOME": other[-1], "PYTHONPATH": f"{other[-1]}/lib/python3.13"}
+    out = run_c_host(fmus, tmp_path, env)
+    assert "environ same" in out["tail"]
+    assert assert_matches(reference, out["outputs"]) == 34
+
+
+# -- the C host and ecos ----------------------------------------------------------------
+
+
+@functools.cache
+def c_host(folder: str) -> Path:
+    from arcosim.build.cplant import fmi_headers
+
+    binary = Path(folder) / "chain_host"
+    command = [
+        shutil.which("cc") or "gcc",
+        "-std=c99",
+        "-O1",
+        "-Wall",
+        "-Wextra",
+        f"-I{fmi_headers()}",
+        str(HERE / "chain_host.c"),
+        "-o",
+        str(binary),
+        "-ldl",
+    ]
+    result = subprocess.run(command, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return binary
+
+
+def host_spec(fmus: dict[str, Path], folder: Path) -> str:
+    """The C host's SPEC: unzip each FMU, parameters, links and outputs by value reference."""
+    from fmpy import read_model_description
+
+    lines, variables = [], {}
+    for component, fmu in fmus.items():
+        target = folder / component
+        with zipfile.ZipFile(fmu) as z:
+            z.extractall(target)
+        md = read_model_description(str(fmu))
+        variables[component] = {v.name: v for v in md.modelVariables}
+        lines.append(f"fmu {component} {target} {md.coSimulation.modelIdentifier} {md.guid}")
+    kinds = {"Real": "real", "Integer": "int", "Boolean": "bool", "String": "string"}
+    for component, values in BENCH.items():
+        for name, value in values.items() if component in fmus else ():
+            v = variables[component][name]
+            lines.append(f"{kinds[v.type]} {component} {v.valueReference} {value}")
+    for a, out, b, inp in (c for c in CONNECTIONS if c[0] in fmus and c[2] in fmus):
+        lines.append(
+            f"link {a} {variables[a][out].valueReference} {b} {variables[b][inp].valueReference}"
+        )
+    order = []
+    for component in fmus:
+        outs = [v for v in variables[component].values() if v.causality == "output"]
+        for v in [v for v in outs if v.type == "Real"] + [v for v in outs if v.type == "Boolean"]:
+            lines.append(
+                f"out {component} {v.valueReference} {'b' if v.type == 'Boolean' else 'r'}"
+            )
+            order.append((component, v.name))
+    lines.append(f"run {STOP} {H}")
+    (folder / "spec.txt").write_text("\n".join(lines) + "\n")
+    return json.dumps(order)
+
+
+def run_c_host(fmus, tmp_path: Path, env: dict[str, str]) -> dict:
+    binary = c_host(str(tmp_path))
+    order = json.loads(host_spec(fmus, tmp_path))
+    result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
+    assert result.returncode == 0, result.stderr[-3000:]
+    rows, tail = [], []
+    for line in (tmp_path / "out.txt").read_text().splitlines():
+        (tail if line[0].isalpha() else rows).append(line)
+    data = np.array([[float(x) for x in r.split(",")] for r in rows])
+    outputs: dict[str, dict[str, np.ndarray]] = {c: {} for c in fmus}
+    for j, (component, name) in enumerate(order):
+        outputs[component][name] = data[:, j + 1]
+    return {"outputs": outputs, "tail": tail, "stderr": result.stderr}
+
+
+def test_chain_in_a_c_host_with_a_bare_path(fmus, reference, tmp_path) -> None:
+    out = run_c_host(fmus, tmp_path, bare_env())
+    assert "environ same" in out["tail"], out["tail"]
+    libpythons = [t for t in out["tail"] if t.startswith("libpython ")]
+    assert len(libpythons) == 1 and str(HIDDEN) not in libpythons[0], libpythons
+    assert "status OK" in out["tail"]
+    assert assert_matches(reference, out["outputs"]) == 34
+
+
+def test_no_python_found_fails_instantiation_cleanly(fmus, tmp_path) -> None:
+    """Nothing on PATH, an ARCOSIM_LIBPYTHON that does not exist: fmi2Instantiate logs
+    what it tried and returns NULL; the host goes on (exit 5, not a crash)."""
+    binary = c_host(str(tmp_path))
+    host_spec({"source": fmus["source"]}, tmp_path)
+    env = {"PATH": "/nonexistent", "ARCOSIM_LIBPYTHON": "/nonexistent/libpython3.12.so.1.0"}
+    result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
+    assert result.returncode == 5, result.stderr
+    assert "ARCOSIM_LIBPYTHON=/nonexistent/libpython3.12.so.1.0: no such file" in result.stderr
+    assert "set ARCOSIM_LIBPYTHON" in result.stderr
+
+
+def test_arcosim_libpython_chooses_the_python(fmus, reference, tmp_path) -> None:
+    chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.12.*/lib/libpython3.12.so.1.0")))
+    if not chosen:
+        pytest.skip("no pyenv CPython 3.12 with a shared libpython")
+    out = run_c_host(fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
+    libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
+    assert libpythons == [str(Path(chosen[-1]).resolve())]
+    assert assert_matches(reference, out["outputs"]) == 34
+
+
+def test_a_libpython_the_host_loaded_privately_is_the_one_used(fmus, reference, tmp_path):
+    """The host dlopen()ed a libpython with RTLD_LOCAL and did not start it; a Debian
+    Python is on PATH. The FMU promotes and starts the host's library, maps no other."""
+    chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.13.*/lib/libpython3.13.so.1.0")))
+    if not chosen:
+        pytest.skip("no pyenv CPython 3.13 with a shared libpython")
+    out = run_c_host(fmus, tmp_path, {**bare_env(), "CHAIN_HOST_LOCAL_LIBPYTHON": chosen[-1]})
+    libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
+    assert libpythons == [str(Path(chosen[-1]).resolve())]
+    assert "environ same" in out["tail"]
+    assert assert_matches(reference, out["outputs"]) == 34
+
+
+def test_chain_in_ecos_with_a_bare_path(fmus, reference, tmp_path) -> None:
+    from arcosim.build.ssp import write_ssp
+    from arcosim.host.ecos import ecos_binary
+
+    ecos, why = ecos_binary()
+    if ecos is None:
+        pytest.skip(why)
+    folder = next(iter(fmus.values())).parent
+    traced = {
+        "trace": {c: {**BENCH[c], "trace_file": str(tmp_path / f"trace_{c}.csv")} for c in BENCH}
+    }
+    ssp = write_ssp(tmp_path / "traced.ssp", folder, traced, stop=STOP)
+    command = [
+        str(ecos),
+        "simulate",
+        "--path",
+        str(ssp),
+        "--stopTime",
+        repr(STOP),
+        "--stepSize",
+        repr(H),
+        "--noParallel",
+        "--parameterSet",
+        "trace",
+    ]
+    result = hidden(command, bare_env(), tmp_path)
+    assert result.returncode == 0, result.stderr[-3000:]
+    outputs = {}
+    for component in BENCH:
+        trace = tmp_path / f"trace_{component}.csv"
+        names = trace.read_text().splitlines()[0].split(",")[1:]
+        data = np.loadtxt(trace, delimiter=",", skiprows=1)
+        outputs[component] = {n: data[:, j + 1] for j, n in enumerate(names)}
+    rows = min(len(v) for o in outputs.values() for v in o.values())
+    assert rows >= 1000  # ecos sums its time and may stop one step short
+    ref = {c: {n: reference[c][n] for n in outputs[c]} for c in outputs}
+    assert assert_matches(ref, outputs, rows) == 34
+
+
+# -- libcosimpy ---------------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def libcosim_python(venvs) -> str:
+    """A venv of a CPython other than the building one with libcosimpy (from PyPI)."""
+    for label in ("3.12", "3.13", "3.10"):
+        if label not in pythons() or f"3.{sys.version_info.minor}" == label:
+            continue
+        python = venvs(label)
+        result = subprocess.run(
+            [python, "-m", "pip", "install", "-q", "libcosimpy"], capture_output=True, text=True
+        )
+        if result.returncode == 0:
+            return python
+    pytest.skip("libcosimpy installs under none of CPython 3.12, 3.13, 3.10 here")
+
+
+def test_chain_in_libcosim_under_another_python(fmus, reference, libcosim_python, tmp_path):
+    from fmpy import read_model_description
+
+    variables = {
+        c: {
+            v.name: [v.valueReference, v.type]
+            for v in read_model_description(str(p)).modelVariables
+        }
+        for c, p in fmus.items()
+    }
+    traces = {c: str(tmp_path / f"trace_{c}.csv") for c in fmus}
+    spec_ = {**spec(fmus), "variables": variables, "traces": traces}
+    (tmp_path / "spec.json").write_text(json.dumps(spec_))
+    env = {**bare_env(libcosim_python), "PYTHONPATH": str(HERE)}
+    command = [libcosim_python, str(HERE / "libcosim_run.py"), "spec.json", "out.json"]
+    result = hidden(command, env, tmp_path)
+    assert result.returncode == 0, result.stderr[-3000:]
+    out = json.loads((tmp_path / "out.json").read_text())
+    assert out["simulated"]
+    assert out["environ_changed"] == [], out["environ_changed"]
+    assert out["libpython_after"] == out["libpython_before"] and len(out["libpython_after"]) == 1
+    outputs = {}
+    for component, path in traces.items():
+        names = Path(path).read_text().splitlines()[0].split(",")[1:]
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        assert np.allclose(data[:, 0], np.arange(len(data)) * H, rtol=0, atol=1e-9)
+        outputs[component] = {n: data[:, j + 1] for j, n in enumerate(names)}
+    rows = min(len(v) for o in outputs.values() for v in o.values())
+    assert rows >= round(STOP / H)
+    ref = {c: {n: reference[c][n] for n in outputs[c]} for c in outputs}
+    assert assert_matches(ref, outputs, rows) == 34
