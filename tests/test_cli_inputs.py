@@ -115,8 +115,45 @@ def test_whole_chain_refuses_a_csv_out_and_observer_a_json_out(capsys, fmus, log
         capsys, "identify", log, "--fmus", fmus, "--method", "whole-chain", "--out", "x.csv"
     )
     assert "--method whole-chain writes its report as JSON" in line
-    line = refused(capsys, "identify", log, "--fmus", fmus, "--out", "x.json")
-    assert "--method observer writes every output over time as CSV" in line
+    for method in ("observer", "load-torque"):
+        line = refused(
+            capsys, "identify", log, "--fmus", fmus, "--method", method, "--out", "x.json"
+        )
+        assert f"--method {method} writes its outputs over time as CSV" in line
+
+
+def test_load_torque_never_writes_over_its_chain(capsys, fmus, log, tmp_path) -> None:
+    chain = tmp_path / "chain.csv"
+    chain.write_text('{"J[1]": 1}')
+    before = snapshot(chain)
+    line = refused(
+        capsys,
+        "identify",
+        log,
+        "--fmus",
+        fmus,
+        "--method",
+        "load-torque",
+        "--chain",
+        chain,
+        "--out",
+        chain,
+        "--force",
+    )
+    assert "that is an input of this command" in line and snapshot(chain) == before
+    for text, phrase in (
+        (b'{"J[1]": "heavy", "k[1]": 1, "B[1]": 0}', "J[1] = 'heavy' is not a number"),
+        (b'{"masses": 2.5}', "masses = 2.5 is not a whole number"),
+        (b'{"masses": 99}', "--masses 99"),
+        (b'\xef\xbb\xbf{"masses": 1, "J[1]": 1}', "missing k[1], B[1]"),
+        (b"\xff{}", "byte 0xff is not UTF-8"),
+    ):
+        bad = tmp_path / "bad.json"
+        bad.write_bytes(text)
+        line = refused(
+            capsys, "identify", log, "--fmus", fmus, "--method", "load-torque", "--chain", bad
+        )
+        assert phrase in line, line
 
 
 def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path) -> None:
@@ -367,20 +404,23 @@ def test_sweep_spec_fields_are_typed(capsys, tmp_path, line, phrase) -> None:
 def test_model_based_observer_refuses_noise_it_cannot_design_for(
     fmus, torque, tau, accepted
 ) -> None:
+    """Refused at initialization (fmi2Error from exitInitializationMode), naming both
+    parameters, instead of a traceback (singular matrix, Riccati) at the first step."""
+    from arcosim.errors import UserError
     from arcosim.host.instance import FmuInstance
 
+    settings = {"mode": 2, "estimator": 1, "torque_noise_std": torque, "tau_noise_std": tau}
     with FmuInstance(fmus / "ReactionTorqueObserver.fmu", "noise") as observer:
-        observer.initialize(
-            {"mode": 2, "estimator": 1, "torque_noise_std": torque, "tau_noise_std": tau}
-        )
-        status = observer.do_step(0.0, 1e-3)
-        said = " ".join(observer.messages)
-    if accepted:
-        assert status == 0 and not observer.messages
-    else:
-        assert status == 2
-        assert "parameters torque_noise_std" in said and "tau_noise_std" in said
-        assert "Traceback" not in said and "Riccati" not in said and "singular" not in said
+        if accepted:
+            observer.initialize(settings)
+            assert observer.do_step(0.0, 1e-3) == 0 and not observer.messages
+            return
+        with pytest.raises(UserError) as refusal:
+            observer.initialize(settings)
+    said = str(refusal.value)
+    assert "refused its parameters" in said
+    assert "parameters torque_noise_std" in said and "tau_noise_std" in said
+    assert "Traceback" not in said and "Riccati" not in said and "singular" not in said
 
 
 # -- no traceback, ever -----------------------------------------------------------------
@@ -411,10 +451,30 @@ def test_argument_errors_are_one_line(capsys) -> None:
         assert line.endswith("--help`)")
 
 
-def test_no_message_shows_a_numpy_repr(capsys, fmus, log) -> None:
-    """The observer refuses a sample of the log: the time in the message is a plain
-    number, not ``np.float64(0.001)``."""
-    line = refused(
-        capsys, "identify", log, "--fmus", fmus, "--set", "estimator=1", "--set", "tau_noise_std=0"
-    )
-    assert "sample at t = 0.001 s: the observer refused it" in line
+def test_no_message_shows_a_numpy_repr(log) -> None:
+    """An observer that refuses the second sample: the time in the message is a plain
+    number (the log's times are numpy floats), not ``np.float64(0.001)``."""
+    from arcosim.errors import UserError
+    from arcosim.host.replay import replay_log
+    from arcosim.logs import read_log
+
+    class Refusing:  # the part of FmuInstance that replay_log uses
+        def __init__(self) -> None:
+            self.messages = ["discard: observer: step refused"]
+
+        def real_writer(self, names):
+            return lambda values: None
+
+        def reader(self, names):
+            return lambda: [0.0] * len(names)
+
+        def initialize(self, parameters, start_time):
+            pass
+
+        def do_step(self, t, h):
+            return 2
+
+    with pytest.raises(UserError) as refusal:
+        replay_log(Refusing(), read_log(log), outputs=["d_hat"])
+    assert "sample at t = 0.001 s: the observer refused it" in str(refusal.value)
+    assert "np.float64" not in str(refusal.value)
