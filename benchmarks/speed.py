@@ -174,7 +174,8 @@ def _bench_sensors(duration: float) -> tuple[list[float], list[float], list[floa
 
 def plain_python_step(duration: float) -> float:
     """µs per step of the observer's algorithms (flexchain) with no FMI in between."""
-    from benchmarks.accuracy import CASES, Observer, settings_for
+    from arcosim.fmu.flexchain.observer import Observer
+    from benchmarks.cases import CASES, settings_for
 
     i_a, w, th = _bench_sensors(duration)
     observer = Observer(settings_for(CASES[0], STATE_ESTIMATION), th[0], w[0])
@@ -187,7 +188,8 @@ def plain_python_step(duration: float) -> float:
 
 def identification_seconds(duration: float) -> float:
     """Seconds to identify k and B by output error from a ``duration`` s bench record."""
-    from benchmarks.accuracy import CASES, broadband, fit_broadband
+    from benchmarks.accuracy import broadband, fit_broadband
+    from benchmarks.cases import CASES
 
     log = broadband(CASES[0], seed=1, duration=duration)
     started = time.perf_counter()

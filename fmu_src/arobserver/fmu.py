@@ -32,6 +32,7 @@ from ..fmukit import (
     par,
     range_problems,
 )
+from ..fmukit.checks import chain_rate_problems
 
 MODES = {
     0: "actuator self-identification",
@@ -248,6 +249,10 @@ class ReactionTorqueObserver(FmuSlave):
         )
         if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
             problems.append("parameters J_mo + dJm must be > 0 (the motor inertia)")
+        if not problems and self.value("mode") == STATE_ESTIMATION:  # the chain is a model
+            problems += chain_rate_problems(
+                self.value, None, indexed("J", n), indexed("k", n), indexed("B", n)
+            )
         for problem in (
             choice_problem("mode", self.value("mode"), MODES),
             choice_problem("estimator", self.value("estimator"), ESTIMATORS),

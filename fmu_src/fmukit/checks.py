@@ -1,9 +1,24 @@
-"""Parameter checks that name the parameter and say what is wrong."""
+"""Parameter checks that name the parameter and say what is wrong.
+
+The numbers every FMU computes in (SI units): a Real parameter or input of magnitude
+above :data:`LARGEST`, a step below :data:`SMALLEST_STEP`, or a chain whose fastest
+mode or decay exceeds :data:`FASTEST_RATE` is refused, so no output can become
+infinite or NaN from them.
+"""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
+
+#: Largest magnitude of a Real parameter or input (SI units).
+LARGEST = 1e15
+#: Smallest communication step (s): below it the discrete filters' differences lose
+#: every digit (a velocity change over 1e-308 s is not a number).
+SMALLEST_STEP = 1e-9
+#: Fastest mode (rad/s) or decay rate (1/s) of a motor–spring–mass chain the models
+#: integrate; a stiffer or more damped chain is refused at initialization.
+FASTEST_RATE = 1e6
 
 
 def range_problems(
@@ -33,6 +48,57 @@ def range_problems(
                 problems.append(f"parameter {name} = {x!r} is not a finite number")
             elif not test(x):
                 problems.append(f"parameter {name} = {x!r} {text}")
+    return problems
+
+
+def number_problem(name: str, x: float) -> str | None:
+    """A sentence if the Real parameter ``name`` is not a finite number within ±LARGEST."""
+    if not math.isfinite(x):
+        return f"parameter {name} = {x!r} is not a finite number"
+    if abs(x) > LARGEST:
+        return (
+            f"parameter {name} = {x!r} is beyond ±{LARGEST:g}, the range the FMU computes "
+            "in (SI units)"
+        )
+    return None
+
+
+def chain_rate_problems(
+    value: Callable[[str], float],
+    motor: str | None,
+    inertias: Sequence[str],
+    springs: Sequence[str],
+    dampers: Sequence[str],
+) -> list[str]:
+    """Sentences for a chain whose fastest mode or decay is beyond :data:`FASTEST_RATE`.
+
+    Body 0 is the motor (inertia ``motor``; None: held still, as in a model driven by
+    the motor's angle), bodies 1 … n the load masses; spring i joins body i − 1 and
+    body i. Gershgorin's bound on the eigenvalues of M⁻¹K: every mode ω satisfies
+    ω² ≤ max_i 2 (k_i + k_{i+1}) / J_i (and every decay rate ≤ the same with the B_i),
+    so a chain within the bound is one the models integrate. Called after the ranges
+    are checked (every value finite and > 0 or ≥ 0).
+    """
+    names = ([motor] if motor else []) + list(inertias)
+    first = 0 if motor else 1  # the body of names[0]
+    problems = []
+    for gains, what, unit, square in (
+        (springs, "a mode", "rad/s", True),
+        (dampers, "a decay", "1/s", False),
+    ):
+        for j, inertia in enumerate(names):
+            body = first + j
+            joined = [gains[i] for i in (body - 1, body) if 0 <= i < len(gains)]
+            sum_ = sum(value(g) for g in joined)
+            bound = 2.0 * sum_ / value(inertia)
+            rate = math.sqrt(bound) if square else bound
+            if rate > FASTEST_RATE:
+                parts = ", ".join(f"{g} = {value(g):g}" for g in joined)
+                problems.append(
+                    f"parameters {parts} on {inertia} = {value(inertia):g} make {what} of up "
+                    f"to {rate:.3g} {unit}; the FMU integrates up to {FASTEST_RATE:g} {unit} "
+                    "(soften or lighten the chain, or add inertia)"
+                )
     return problems
 
 

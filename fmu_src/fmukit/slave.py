@@ -31,6 +31,7 @@ from xml.etree.ElementTree import Element
 # arcosim.fmu.pythonfmu, which re-exports the installed one.
 from ..pythonfmu.enums import Fmi2Status
 from ..pythonfmu.fmi2slave import Fmi2Slave
+from .checks import LARGEST, SMALLEST_STEP, number_problem
 from .model_description import ModelInfo, model_description
 from .state import restore, snapshot
 from .variables import Value, Variable, par
@@ -137,6 +138,7 @@ class FmuSlave(Fmi2Slave):
         # every Real input at once, when they are declared together: set as one slice
         self._input_block = self._real_inputs if self._real_inputs == list(range(lo, hi)) else None
         self._input_slice = slice(lo, hi)
+        self._read_outputs = _tuple_getter(sorted(self._outputs))
         self._last_read: list[int] = []  # the last Reals read, and their getter
         self._read_last = _tuple_getter([])
         self.time: float | None = None
@@ -218,7 +220,9 @@ class FmuSlave(Fmi2Slave):
             setattr(self, name, value)
 
     def exit_initialization_mode(self) -> None:
-        self.problems = self._checked(self.check_parameters)
+        self.problems = self._checked(self._number_problems)
+        if not self.problems:
+            self.problems = self._checked(self.check_parameters)
         if not self.problems:
             self.problems = self._checked(self.initialize)
         if not self.problems:
@@ -227,13 +231,23 @@ class FmuSlave(Fmi2Slave):
             self.report(problem)
         self.initialized = True
         self._ready = not self.problems and self.time is not None
+        # the outputs a step computes (the lazy ones are computed when read)
+        self._read_outputs = _tuple_getter(sorted(self._outputs - self.lazy))
+
+    def _number_problems(self) -> list[str]:
+        """Real parameters that are not finite numbers within ±LARGEST (SI units)."""
+        found = (
+            number_problem(self.variables[i].name, self.v[i])
+            for i in sorted(self._parameters & self._reals)
+        )
+        return [problem for problem in found if problem is not None]
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         if not (  # the common case in few operations; any doubt takes the full checks
             self._ready
-            and 0.0 < step_size < _INF
+            and SMALLEST_STEP <= step_size < _INF
             and -1e-9 <= current_time - self.time <= 1e-9
-            and isfinite(sum(self._read_inputs(self.v)))
+            and sum(map(abs, self._read_inputs(self.v))) <= LARGEST
         ) and not self._step_allowed(current_time, step_size):
             return False
         try:
@@ -243,6 +257,9 @@ class FmuSlave(Fmi2Slave):
             return False
         except Exception:  # a bug must not become fmi2Fatal in the user's host
             self.report("internal error, step refused:\n" + traceback.format_exc())
+            return False
+        if not isfinite(sum(self._read_outputs(self.v))):
+            self._refuse_not_finite(current_time, step_size)
             return False
         self.time = current_time + step_size
         if self._trace is not None:
@@ -296,9 +313,31 @@ class FmuSlave(Fmi2Slave):
         row += [repr(float(v[i])) for i in self._trace_outputs]
         self._trace.write(",".join(row) + "\n")
 
+    def _refuse_not_finite(self, t: float, h: float) -> None:
+        """A step gave a non-finite output: refuse it, and every step after it.
+
+        The filters' state after such a step is not worth stepping from, and the
+        state before it is not kept (a copy per step would cost more than the step):
+        the instance refuses every later step until a saved FMU state is restored.
+        """
+        bad = [
+            self.variables[i].name
+            for i in sorted(self._outputs - self.lazy)
+            if not isfinite(self.v[i])
+        ]
+        problem = (
+            f"the step from t = {t!r} s by {h!r} s gave non-finite outputs "
+            f"({', '.join(bad)}); restore a saved FMU state or instantiate again"
+        )
+        self.problems = [problem]
+        self._ready = False
+        self.report(problem, Fmi2Status.discard)
+
     def _step_problem(self, t: float, h: float) -> str | None:
         if not (math.isfinite(h) and h > 0.0):
             return f"step size {h!r} s refused: it must be a finite number > 0"
+        if h < SMALLEST_STEP:
+            return f"step size {h!r} s refused: it must be at least {SMALLEST_STEP:g} s"
         if not math.isfinite(t):
             return f"communication point {t!r} s refused: it must be finite"
         if self.time is not None and abs(t - self.time) > 1e-9 * max(1.0, abs(t)):
@@ -310,6 +349,11 @@ class FmuSlave(Fmi2Slave):
         for i in self._real_inputs:
             if not math.isfinite(v[i]):
                 return f"input {self.variables[i].name} = {v[i]!r} is not finite; step refused"
+            if abs(v[i]) > LARGEST:
+                return (
+                    f"input {self.variables[i].name} = {v[i]!r} is beyond ±{LARGEST:g} "
+                    "(SI units); step refused"
+                )
         return None
 
     def _checked(self, function) -> list[str]:

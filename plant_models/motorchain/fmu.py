@@ -12,6 +12,7 @@ from typing import ClassVar
 from ...fmu.flexchain import bench
 from ...fmu.flexchain.noise import gaussian, quantize
 from ...fmu.fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
+from ...fmu.fmukit.checks import chain_rate_problems
 from .physics import PlantPhysics
 
 
@@ -133,6 +134,11 @@ class MotorChainPlant(FmuSlave):
         if self.value("encoder_cpr") < 0:
             problems.append(
                 f"parameter encoder_cpr = {self.value('encoder_cpr')} must be >= 0 (0 = ideal)"
+            )
+        if not problems:
+            motor = "J_m" if self.value("attached") else None
+            problems += chain_rate_problems(
+                self.value, motor, indexed("J", n), indexed("k", n), indexed("B", n)
             )
         return problems
 

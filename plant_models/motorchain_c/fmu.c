@@ -24,6 +24,12 @@
 
 #define TEXT 2048
 #define PATH 1024
+/* The numbers the FMU computes in (fmukit/checks.py, the same for every FMU): the
+ * largest magnitude of a Real parameter or input (SI units), the smallest step (s),
+ * the fastest mode (rad/s) or decay (1/s) of the chain. */
+#define LARGEST 1e15
+#define SMALLEST_STEP 1e-9
+#define FASTEST_RATE 1e6
 
 /* Everything an FMU state holds (copied whole by get/set/serialize). */
 typedef struct {
@@ -123,8 +129,65 @@ static void check_range(Core *c, int vr, int count, int positive) {
     }
 }
 
+/* The reference's FmuSlave._number_problems: every Real parameter a finite number
+ * within ±LARGEST. Returns the number of problems. */
+static int check_numbers(Core *c) {
+    int found = 0;
+    for (int vr = 0; vr < N_VARS; vr++) {
+        if (VAR_CAUSALITY[vr] != C_PARAMETER || VAR_TYPE[vr] != T_REAL) continue;
+        double x = c->v[vr];
+        char num[64];
+        repr_double(num, sizeof num, x);
+        if (!isfinite(x)) {
+            add_problem(c, "parameter %s = %s is not a finite number", VAR_NAME[vr], num);
+            found++;
+        } else if (fabs(x) > LARGEST) {
+            add_problem(c,
+                        "parameter %s = %s is beyond \302\261%g, the range the FMU computes "
+                        "in (SI units)",
+                        VAR_NAME[vr], num, LARGEST);
+            found++;
+        }
+    }
+    return found;
+}
+
+/* The reference's chain_rate_problems (fmukit/checks.py): Gershgorin's bound on the
+ * chain's fastest mode (springs) and decay (dampers), body 0 the motor when attached. */
+static void check_rates(Core *c) {
+    const double *v = c->v;
+    int first = v[VR_attached] != 0.0 ? 0 : 1;
+    for (int kind = 0; kind < 2; kind++) {
+        int gains = kind == 0 ? VR_k : VR_B;
+        for (int body = first; body <= N_MASSES; body++) {
+            int inertia = body == 0 ? VR_J_m : VR_J + body - 1;
+            double sum = 0.0;
+            char parts[512] = "";
+            size_t used = 0;
+            for (int i = body - 1; i <= body; i++) {
+                if (i < 0 || i >= N_MASSES) continue;
+                sum += v[gains + i];
+                used += (size_t)snprintf(parts + used, sizeof parts - used, "%s%s = %g",
+                                         used ? ", " : "", VAR_NAME[gains + i], v[gains + i]);
+                if (used >= sizeof parts) used = sizeof parts - 1;
+            }
+            double bound = 2.0 * sum / v[inertia];
+            double rate = kind == 0 ? sqrt(bound) : bound;
+            if (rate > FASTEST_RATE)
+                add_problem(c,
+                            "parameters %s on %s = %g make %s of up to %.3g %s; the FMU "
+                            "integrates up to %g %s (soften or lighten the chain, or add "
+                            "inertia)",
+                            parts, VAR_NAME[inertia], v[inertia], kind == 0 ? "a mode" : "a decay",
+                            rate, kind == 0 ? "rad/s" : "1/s", FASTEST_RATE,
+                            kind == 0 ? "rad/s" : "1/s");
+        }
+    }
+}
+
 /* The reference's check_parameters, in the same order with the same sentences. */
 static void check_parameters(Core *c) {
+    if (check_numbers(c)) return;
     check_range(c, VR_J_m, 1, 1);
     check_range(c, VR_J, N_MASSES, 1);
     check_range(c, VR_D_m, 1, 0);
@@ -141,6 +204,7 @@ static void check_parameters(Core *c) {
     if (c->v[VR_encoder_cpr] < 0)
         add_problem(c, "parameter encoder_cpr = %lld must be >= 0 (0 = ideal)",
                     (long long)c->v[VR_encoder_cpr]);
+    if (!c->problems[0]) check_rates(c);
 }
 
 /* ---- outputs ---- */
@@ -354,6 +418,12 @@ static int step_problem(Plant *p, double t, double h) {
         log_message(p, fmi2Discard, "step size %s s refused: it must be a finite number > 0", a);
         return 1;
     }
+    if (h < SMALLEST_STEP) {
+        repr_double(a, sizeof a, h);
+        log_message(p, fmi2Discard, "step size %s s refused: it must be at least %g s", a,
+                    SMALLEST_STEP);
+        return 1;
+    }
     if (!isfinite(t)) {
         repr_double(a, sizeof a, t);
         log_message(p, fmi2Discard, "communication point %s s refused: it must be finite", a);
@@ -373,6 +443,12 @@ static int step_problem(Plant *p, double t, double h) {
             repr_double(a, sizeof a, c->v[vr]);
             log_message(p, fmi2Discard, "input %s = %s is not finite; step refused",
                         VAR_NAME[vr], a);
+            return 1;
+        } else if (VAR_CAUSALITY[vr] == C_INPUT && fabs(c->v[vr]) > LARGEST) {
+            repr_double(a, sizeof a, c->v[vr]);
+            log_message(p, fmi2Discard,
+                        "input %s = %s is beyond \302\261%g (SI units); step refused",
+                        VAR_NAME[vr], a, LARGEST);
             return 1;
         }
     return 0;
@@ -401,8 +477,26 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
                     "parameters and inputs)");
         return fmi2Discard;
     }
+    double outputs[N_VARS];
+    memcpy(outputs, core->v, sizeof outputs);
+    double theta_measured = core->theta_measured;
     core->sample++;
     write_outputs(core, h);
+    for (int vr = 0; vr < N_VARS; vr++)
+        if (VAR_CAUSALITY[vr] == C_OUTPUT && !isfinite(core->v[vr])) {
+            char a[64], b[64];
+            repr_double(a, sizeof a, t);
+            repr_double(b, sizeof b, h);
+            log_message(p, fmi2Discard,
+                        "the step from t = %s s by %s s gave a non-finite %s; step refused, "
+                        "the state is as it was",
+                        a, b, VAR_NAME[vr]);
+            core->physics = saved;
+            memcpy(core->v, outputs, sizeof outputs);
+            core->theta_measured = theta_measured;
+            core->sample--;
+            return fmi2Discard;
+        }
     core->time = t + h;
     core->time_known = 1;
     if (p->trace) write_trace(p);
