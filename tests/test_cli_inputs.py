@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import zipfile
 from pathlib import Path
 
@@ -222,12 +223,37 @@ def test_simulate_numbers_are_checked_where_they_enter(capsys, fmus, args, phras
 
 
 def test_a_chain_too_stiff_for_the_step_is_refused_not_reported(capsys, fmus) -> None:
-    """k = 1e15 gives NaN (refused by the observer); k = 1e12 finite numbers that a
-    passive chain cannot produce (1.4e4 rad/s against the bound 1.2e4 after 10 s)."""
-    line = refused(capsys, "simulate", "--fmus", fmus, "--set", "plant.k[1]=1e15")
-    assert "not finite" in line
-    line = refused(capsys, "simulate", "--fmus", fmus, "--set", "plant.k[1]=1e12")
-    assert "more than a passive chain" in line and "plant.k[1]=1e12" in line
+    """k = 1e15 gave NaN and 1e12 finite garbage (1.4e4 rad/s where a passive chain
+    reaches at most 1.2e4): the plant now refuses both at initialization."""
+    for k in ("1e15", "1e12"):
+        line = refused(capsys, "simulate", "--fmus", fmus, "--set", f"plant.k[{1}]={k}")
+        assert "MotorChainPlant.fmu refused its parameters" in line and "k[1]" in line
+
+
+def test_a_result_no_passive_chain_can_give_is_refused() -> None:
+    """The second line of defence behind the FMUs' own checks: a recording whose
+    velocity exceeds what the motor's torque can give the chain in the run's time, or
+    that is not finite, is refused (simulate's check_passive)."""
+    import numpy as np
+
+    from arcosim.cli.simulate import check_passive
+    from arcosim.errors import UserError
+    from arcosim.experiments.scenarios import SCENARIOS
+    from arcosim.host.master import Recording
+
+    scenario = SCENARIOS["flexible"]  # 10 s, at most 0.48 A
+    plant = {"k_t": 0.0254, "J_m": 2.09e-5, "J[1]": 6e-4}
+    t = np.arange(11) * 1.0
+    # bound: 2 k_t i_max T / sqrt(J_m J_i) = 2 * 0.0254 * 0.48 * 10 / sqrt(2.09e-5 * 6e-4)
+    bound = 2 * 0.0254 * 0.48 * 10 / np.sqrt(2.09e-5 * 6e-4)
+    fine = Recording(t, {"plant.omega[1]": np.full(11, 0.5 * bound)})
+    check_passive(fine, scenario, plant, 1, 1e-3, [])
+    for series, phrase in (
+        (np.full(11, 2.0 * bound), "more than a passive chain driven by at most"),
+        (np.array([0.0] * 5 + [np.nan] * 6), "plant.omega[1] is not finite from t = 5 s"),
+    ):
+        with pytest.raises(UserError, match=re.escape(phrase)):
+            check_passive(Recording(t, {"plant.omega[1]": series}), scenario, plant, 1, 1e-3, [])
 
 
 @pytest.mark.parametrize("value", ["0", "nan", "inf", "-3", "1e300", "1e-300"])

@@ -165,9 +165,10 @@ def check_passive(
     UserError
         When a signal is not finite or a velocity exceeds the bound.
     """
+    given = f" (settings: {' '.join(settings)})" if settings else ""
     hint = (
-        f" (settings: {' '.join(settings)}): the model cannot be integrated at "
-        f"--step {h:g} s with these parameters; use other values or a smaller step"
+        f"{given}: the model cannot be integrated at --step {h:g} s with these "
+        "parameters; use other values or a smaller step"
     )
     for name, series in recording.signals.items():
         bad = np.flatnonzero(~np.isfinite(series))
