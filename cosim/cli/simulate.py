@@ -11,9 +11,9 @@ with ``--force``, and never with one of the FMUs the run reads.
 
 The run is refused (exit 2) when its step and duration give no step or more than
 10⁷, and its result when a recorded signal is not finite or the plant moves
-faster than a passive chain driven by its current can (:func:`check_passive`):
-parameters such as ``--set plant.k[1]=1e12`` make the chain too stiff for the
-plant's integration at this step.
+faster than a passive chain driven by its current can (:func:`check_passive`), the
+check behind the FMUs' own limits on their parameters (before them,
+``--set plant.k[1]=1e12`` gave such numbers at 1 ms).
 """
 
 from __future__ import annotations
