@@ -44,8 +44,9 @@ ESTIMATORS = {0: "the paper's recursion", 1: "model-based observer"}
 #: torque_noise_std and tau_noise_std each in this range, neither more than
 #: NOISE_RATIO times the other. Checked over n = 1, 3, 8 masses, encoders of 0 (none),
 #: 64, 2000 and 2^20 counts, steps 1e-5 … 1e-2 s and g_dist 10 … 1000 rad/s: 3312
-#: designs, none failed; outside it (a noise of 0, or one 1e10 times the other) the
-#: Riccati iteration fails to converge or meets a singular matrix.
+#: designs, none failed (``python -m benchmarks.noise_envelope``); outside it (a noise
+#: of 0, or one 1e10 times the other) the Riccati iteration fails to converge or meets
+#: a singular matrix. The load-torque state (load_mass > 0) was not part of that check.
 NOISE_RANGE = (1e-9, 1e4)
 NOISE_RATIO = 1e8
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
