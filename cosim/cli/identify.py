@@ -13,7 +13,10 @@ Contract (scripts rely on it)::
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
-* ``--out FILE``: every output over time as CSV (``time`` first).
+* ``--out FILE``: every output over time as CSV (``time`` first); with
+  ``--method output-error`` or ``whole-chain``, the report ``--json`` prints, as a
+  JSON file (its name must end in ``.json``; the observer's CSV may not). An
+  existing file is replaced only with ``--force``; the log itself never.
 * ``--method output-error``: instead of replaying the observer FMU, fit the uniform
   chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
   from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
@@ -43,14 +46,17 @@ Contract (scripts rely on it)::
   ``tau_load_hat``, ``tau_reac_hat``, ``theta_hat[i]``, ``omega_hat[i]`` and the
   innovation; ``--json`` prints a summary. The step may vary.
 
-A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
-error naming the row or column, and exit status 2.
+A bad log (missing column, non-increasing time, NaN, empty file, not UTF-8) gives a
+one-line error naming the row or column, and exit status 2. So does a ``--start-k``
+outside the band the log can show (the first clamped mode between one period in the
+record and the Nyquist frequency π/h), and a fit that ends on non-finite numbers.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -58,7 +64,7 @@ import numpy as np
 
 from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import OBSERVER, check_masses
-from arcosim.cli.options import add_fmus_option, fmu_folder
+from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
@@ -67,9 +73,19 @@ from arcosim.host.overrides import parse_assignment
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
 from arcosim.identification import load_torque
 from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
+from arcosim.identification.output_error import (
+    Fit,
+    MotorRecord,
+    clamped_frequencies,
+    motor_record,
+    uniform_chain,
+)
 from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import DriveLog, parse_scales, read_log, write_csv
+from arcosim.outputs import check_output, write_text
+
+#: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
+OFFLINE = ("output-error", "whole-chain")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -104,7 +120,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="multiply a log column to get SI units, repeatable",
     )
     p.add_argument("--json", action="store_true", help="print the final outputs as one JSON object")
-    p.add_argument("--out", type=Path, help="write every output over time to this CSV file")
+    p.add_argument(
+        "--out",
+        type=Path,
+        help="observer, load-torque: every output over time as CSV; output-error, "
+        "whole-chain: the report as a .json file",
+    )
+    force_option(p)
     p.add_argument(
         "--method",
         choices=("observer", "output-error", "whole-chain", "load-torque"),
@@ -133,26 +155,41 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--start-k",
-        type=float,
-        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan",
+        type=number(0.0, low_open=True, unit="N.m/rad"),
+        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
+        "it must put the chain's first mode in the band the log shows",
     )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
+    for given, option in (
+        (args.start_k is not None, "--start-k"),
+        (args.fit_inertia_scale, "--fit-inertia-scale"),
+    ):
+        if given and args.method != "output-error":
+            raise UserError(f"{option} is for --method output-error (not {args.method})")
+    if args.mode is not None and args.method != "observer":
+        raise UserError(f"--mode is for --method observer (not {args.method})")
+    _check_out(args, [])
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else _masses(args.masses)
-        return _whole_chain(args, log, fmu_folder(args, 3), masses)
+        folder = fmu_folder(args, 3)
+        _check_out(args, fmu_inputs(folder))
+        return _whole_chain(args, log, folder, masses)
     if args.method == "load-torque":
         chain = read_chain(args.chain) if args.chain else {}
         n = int(chain.pop("masses")) if "masses" in chain else _masses(args.masses)
-        return _load_torque(args, log, fmu_folder(args, check_masses(n)), n, chain)
+        folder = fmu_folder(args, check_masses(n))
+        _check_out(args, fmu_inputs(folder))
+        return _load_torque(args, log, folder, n, chain)
     if args.chain:
         raise UserError("--chain is for --method load-torque")
     n = _masses(args.masses)
     folder = fmu_folder(args, n)
+    _check_out(args, fmu_inputs(folder))
     if args.method == "output-error":
         return _output_error(args, log, folder, n)
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
@@ -162,12 +199,78 @@ def _execute(args: argparse.Namespace) -> int:
     if args.out:
         columns = {"time": recording.time}
         columns.update({k.split(".", 1)[1]: v for k, v in recording.signals.items()})
-        write_csv(args.out, columns)
+        write_csv(args.out, columns, force=args.force)
     if args.json:
         print(json.dumps(final, indent=2))
     else:
         _print_summary(final, len(log), args.out)
     return 0
+
+
+def _check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
+    """Refuse ``--out`` before any work: a name that does not fit the method's format,
+    an existing file without ``--force``, the log or an FMU."""
+    if args.out is None:
+        return
+    is_json = args.out.suffix.lower() == ".json"
+    if args.method in OFFLINE and not is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
+        )
+    if args.method not in OFFLINE and is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its outputs over time as CSV; "
+            "name a .csv file (--json prints a summary)"
+        )
+    chain = [args.chain] if args.chain else []
+    check_output(args.out, inputs=[args.log, *chain, *fmus], force=args.force)
+
+
+def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None:
+    """Refuse a report with a non-finite estimate; write it to ``--out`` if given."""
+    bad = [
+        key
+        for key, value in [*report.items(), *dict(report.get("std") or {}).items()]
+        if isinstance(value, float) and not math.isfinite(value)
+    ]
+    if bad:
+        raise UserError(
+            f"{args.log}: the fit ended on non-finite numbers ({', '.join(bad[:6])}): the log "
+            "does not determine them; check --set and the excitation"
+        )
+    if args.out:
+        write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
+
+
+#: Largest reaction torque (N.m) an offline fit takes: far beyond any drive, and small
+#: enough that the fits' sums of squares over 10⁷ samples stay finite.
+MAX_TORQUE = 1e100
+
+
+def check_record(record: MotorRecord, settings: Sequence[str]) -> None:
+    """Refuse a record whose reaction torque is not finite or absurdly large (the
+    actuator terms given with ``--set`` in the wrong units, say)."""
+    peak = float(np.max(np.abs(record.tau_hat))) if record.tau_hat.size else 0.0
+    if not peak <= MAX_TORQUE:
+        given = f" (--set {' --set '.join(settings)})" if settings else ""
+        raise UserError(
+            f"the log's reaction torque through the actuator terms{given} reaches {peak:.3g} "
+            f"N.m (at most {MAX_TORQUE:g}): check J_mo, k_to, g_dist and the --scale factors"
+        )
+
+
+def check_start_k(k: float, J: Sequence[float], record: MotorRecord) -> None:
+    """Refuse a ``--start-k`` whose uniform chain's first clamped mode lies outside the
+    band the record can show: from one period in its length to the Nyquist frequency."""
+    unit = float(clamped_frequencies([float(x) for x in J], [1.0] * len(J))[0])
+    low_w, high_w = 2.0 * math.pi / record.duration, math.pi / record.h
+    low, high = (low_w / unit) ** 2, (high_w / unit) ** 2
+    if not low <= k <= high:
+        raise UserError(
+            f"--start-k {k:g}: give a stiffness from {low:.3g} to {high:.3g} N.m/rad for this "
+            f"log and J (the chain's first mode between one period in {record.duration:g} s, "
+            f"{low_w:.3g} rad/s, and the Nyquist frequency, {high_w:.3g} rad/s)"
+        )
 
 
 def _print_summary(final: dict, samples: int, out: Path | None) -> None:
@@ -194,7 +297,7 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     """The actuator terms among the observer's parameters."""
     for name in ("J_mo", "k_to", "g_dist"):
         if not values[name] > 0:
-            raise UserError(f"{name} = {values[name]!r} must be > 0")
+            raise UserError(f"{name} = {float(values[name]):g} must be > 0")
     return Actuator(
         values["J_mo"], values["k_to"], values["dkt"], values["dJm"], values["D_m"], values["f_c"]
     )
@@ -209,11 +312,15 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
+    check_record(record, args.set)
+    if args.start_k is not None:
+        check_start_k(args.start_k, J, record)
     result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
     names = {"k": "k_hat", "B": "B_hat", "J_scale": "J_scale"}
     report = {names[k]: v for k, v in result.as_dict().items()}
     report["std"] = {names[k]: v for k, v in result.std_dict().items()}
     report.update(evidence(result, record))
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -245,6 +352,7 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     c = log.columns
     g_dist = values["g_dist"]
     record = motor_record(log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
+    check_record(record, args.set)
     cpr = int(values["encoder_cpr"])
     encoder = None
     if cpr > 0:
@@ -283,6 +391,7 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
         report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
     if "load_torque_range" in result.extra:
         report["load_torque_range"] = result.extra["load_torque_range"]
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
@@ -302,10 +411,19 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
 
 
 def read_chain(path: Path) -> dict[str, float]:
-    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report."""
+    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report.
+
+    Raises
+    ------
+    UserError
+        When the file is not UTF-8 JSON, or a value is missing, not a finite number,
+        or ``masses`` not a supported number of masses.
+    """
+    from arcosim.logs import read_text_file
+
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
+        data = json.loads(read_text_file(path, "chain"))
+    except ValueError as error:
         raise UserError(f"--chain {path}: cannot read it as JSON ({error})") from None
     if not isinstance(data, dict):
         raise UserError(f"--chain {path}: expected a JSON object with J[i], k[i], B[i]")
@@ -314,10 +432,18 @@ def read_chain(path: Path) -> dict[str, float]:
         for k, v in data.items()
         if (k.split("[")[0] in ("J", "k", "B") and k.endswith("]")) or k == "masses"
     }
-    n = int(chain.get("masses", sum(k.startswith("J[") for k in chain)))
+    for key, value in chain.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise UserError(f"--chain {path}: {key} = {value!r:.40} is not a number")
+        if not math.isfinite(value):
+            raise UserError(f"--chain {path}: {key} = {value} is not a finite number")
+    masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
+    if masses != int(masses):
+        raise UserError(f"--chain {path}: masses = {masses} is not a whole number")
+    n = check_masses(int(masses))
     missing = [f"{p}[{i}]" for p in "JkB" for i in range(1, n + 1) if f"{p}[{i}]" not in chain]
-    if n < 1 or missing:
-        raise UserError(f"--chain {path}: missing {', '.join(missing) or 'J[1]'}")
+    if missing:
+        raise UserError(f"--chain {path}: missing {', '.join(missing)}")
     return {**{k: float(v) for k, v in chain.items()}, "masses": n}
 
 
@@ -353,9 +479,15 @@ def _load_torque(
     if not settings.load_torque_bandwidth > 0:
         raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
     c = log.columns
-    result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+    try:
+        result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+    except (ValueError, ZeroDivisionError, OverflowError) as error:  # the Kalman design
+        raise UserError(
+            f"--method load-torque: no estimator for these settings ({error}); check "
+            "torque_noise_std, tau_noise_std, load_torque_bandwidth and the chain"
+        ) from None
     if args.out:
-        write_csv(args.out, result.columns())
+        write_csv(args.out, result.columns(), force=args.force)
     last = log.time >= log.time[-1] - 1.0
     report = {
         "method": "load-torque",
