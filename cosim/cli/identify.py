@@ -62,7 +62,6 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import OBSERVER, check_masses
 from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
 from arcosim.errors import UserError
@@ -72,7 +71,7 @@ from arcosim.host.instance import FmuInstance
 from arcosim.host.overrides import parse_assignment
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
 from arcosim.identification import load_torque
-from arcosim.identification.encoder_fit import encoder_record
+from arcosim.identification.drive import identify_drive
 from arcosim.identification.output_error import (
     Fit,
     MotorRecord,
@@ -80,7 +79,6 @@ from arcosim.identification.output_error import (
     motor_record,
     uniform_chain,
 )
-from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import DriveLog, parse_scales, read_log, write_csv
 from arcosim.outputs import check_output, write_text
 
@@ -176,22 +174,18 @@ def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else _masses(args.masses)
-        folder = fmu_folder(args, 3)
-        _check_out(args, fmu_inputs(folder))
-        return _whole_chain(args, log, folder, masses)
+        return _whole_chain(args, log, masses)
     if args.method == "load-torque":
         chain = read_chain(args.chain) if args.chain else {}
-        n = int(chain.pop("masses")) if "masses" in chain else _masses(args.masses)
-        folder = fmu_folder(args, check_masses(n))
-        _check_out(args, fmu_inputs(folder))
-        return _load_torque(args, log, folder, n, chain)
+        n = check_masses(int(chain.pop("masses")) if "masses" in chain else _masses(args.masses))
+        return _load_torque(args, log, n, chain)
     if args.chain:
         raise UserError("--chain is for --method load-torque")
     n = _masses(args.masses)
+    if args.method == "output-error":
+        return _output_error(args, log, n)
     folder = fmu_folder(args, n)
     _check_out(args, fmu_inputs(folder))
-    if args.method == "output-error":
-        return _output_error(args, log, folder, n)
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
         recording = replay_log(observer, log, parameters)
@@ -242,23 +236,6 @@ def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> Non
         write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
 
 
-#: Largest reaction torque (N.m) an offline fit takes: far beyond any drive, and small
-#: enough that the fits' sums of squares over 10⁷ samples stay finite.
-MAX_TORQUE = 1e100
-
-
-def check_record(record: MotorRecord, settings: Sequence[str]) -> None:
-    """Refuse a record whose reaction torque is not finite or absurdly large (the
-    actuator terms given with ``--set`` in the wrong units, say)."""
-    peak = float(np.max(np.abs(record.tau_hat))) if record.tau_hat.size else 0.0
-    if not peak <= MAX_TORQUE:
-        given = f" (--set {' --set '.join(settings)})" if settings else ""
-        raise UserError(
-            f"the log's reaction torque through the actuator terms{given} reaches {peak:.3g} "
-            f"N.m (at most {MAX_TORQUE:g}): check J_mo, k_to, g_dist and the --scale factors"
-        )
-
-
 def check_start_k(k: float, J: Sequence[float], record: MotorRecord) -> None:
     """Refuse a ``--start-k`` whose uniform chain's first clamped mode lies outside the
     band the record can show: from one period in its length to the Nyquist frequency."""
@@ -281,9 +258,12 @@ def _print_summary(final: dict, samples: int, out: Path | None) -> None:
         print(f"wrote {out}")
 
 
-def known_parameters(folder: Path, assignments: Sequence[str]) -> dict[str, float]:
-    """The observer FMU's parameter defaults with ``--set`` applied (offline methods)."""
-    variables = fmu_variables(folder)["observer"]
+def known_parameters(n: int, assignments: Sequence[str]) -> dict[str, float]:
+    """The observer's parameter defaults for ``n`` masses with ``--set`` applied, from the
+    observer FMU's own declaration (the offline methods need no built FMU)."""
+    from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
+
+    variables = ReactionTorqueObserver.interface(n)
     values: dict[str, float] = {
         name: float(v.start)
         for name, v in variables.items()
@@ -303,8 +283,8 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     )
 
 
-def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int) -> int:
-    values = known_parameters(folder, args.set)
+def _output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
+    values = known_parameters(n, args.set)
     J = [values[f"J[{i}]"] for i in range(1, n + 1)]
     if any(not x > 0 for x in J):
         raise UserError(f"the load inertias must be > 0, got J = {J}")
@@ -312,7 +292,6 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
-    check_record(record, args.set)
     if args.start_k is not None:
         check_start_k(args.start_k, J, record)
     result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
@@ -342,71 +321,48 @@ def _masses(text: str) -> int:
     return check_masses(n)
 
 
-def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: int | str) -> int:
-    values = known_parameters(folder, args.set)
+def _whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
+    values = known_parameters(masses if isinstance(masses, int) else 3, args.set)
     given = {parse_assignment(text)[0] for text in args.set}
-    friction_given = {"D_m", "f_c"} <= given
-    if not friction_given:  # fitted: the DOB's τ̂ (the modal start) is computed without
-        values["D_m"] = values["f_c"] = 0.0
+    friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
     actuator = actuator_of(values)
     c = log.columns
-    g_dist = values["g_dist"]
-    record = motor_record(log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
-    check_record(record, args.set)
-    cpr = int(values["encoder_cpr"])
-    encoder = None
-    if cpr > 0:
-        encoder = encoder_record(
-            log.time, c["i_a"], c["theta_m"], actuator, cpr, friction_given, args.load
-        )
-    elif not friction_given or args.load != "none":
-        raise UserError(
-            "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
-            "(--set D_m=… --set f_c=…) and no load torque (--load none)"
-        )
-    choice = identify_chain(record, masses, encoder)
-    result = choice.fit
-    report: dict[str, object] = {"masses": choice.n, **result.as_dict()}
-    report["std"] = result.std_dict()
-    report.update(evidence(result, record), method="whole-chain")
-    report.update(
-        modes_rad_s=result.extra["modes_rad_s"],
-        damping_ratios=result.extra["damping_ratios"],
-        residue_t_values=result.extra["residue_t_values"],
-        weak_modes=result.extra["weak_modes"],
-        refused={str(n): why for n, why in choice.refused.items()},
-        assumptions=result.extra["assumptions"],
-        warnings=result.extra["warnings"],
-        criterion={str(n): v for n, v in choice.criterion.items()},
-        masses_seen=choice.seen,
+    result = identify_drive(
+        log.time,
+        c["i_a"],
+        c["omega_m"],
+        c["theta_m"],
+        k_t=actuator.k_to + actuator.dkt,
+        J_m=actuator.J_mo + actuator.dJm,
+        encoder_cpr=int(values["encoder_cpr"]),
+        masses=masses,
+        load=args.load,
+        g_dist=values["g_dist"],
+        **friction,
     )
     defaults = [name for name in ("J_mo", "k_to", "encoder_cpr") if name not in given]
     if defaults:
-        result.extra["assumptions"]["defaults"] = (
+        result.assumptions["defaults"] = (
             "not given, so the paper bench's value was used: "
             + ", ".join(f"{name} = {values[name]:g}" for name in defaults)
             + " (give your drive's with --set)"
         )
-    if choice.singular_values is not None:
-        report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
-    if "load_torque_range" in result.extra:
-        report["load_torque_range"] = result.extra["load_torque_range"]
+    report = result.report()
     _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
-    print(f"{len(log)} samples, whole-chain fit ({choice.n} masses):")
-    for key in result.names:
-        print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
+    print(f"{len(log)} samples, whole-chain fit ({result.masses} masses):")
+    for key, value in result.parameters.items():
+        print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
     for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
         print(f"  {key}: {report[key]}")
-    for key, text in result.extra["assumptions"].items():
+    for key, text in result.assumptions.items():
         print(f"  assumption, {key}: {text}")
-    for text in result.extra["warnings"]:
+    for text in result.warnings:
         print(f"  warning: {text}")
-    chain = {k: v for k, v in result.as_dict().items() if k[0] in "JkB" and "[" in k}
-    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in chain.items())
-    print(f"observer in mode 2 with this chain: --masses {choice.n} {settings}")
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.chain().items())
+    print(f"observer in mode 2 with this chain: --masses {result.masses} {settings}")
     return 0
 
 
@@ -447,10 +403,8 @@ def read_chain(path: Path) -> dict[str, float]:
     return {**{k: float(v) for k, v in chain.items()}, "masses": n}
 
 
-def _load_torque(
-    args: argparse.Namespace, log: DriveLog, folder: Path, n: int, chain: dict[str, float]
-) -> int:
-    values = known_parameters(folder, args.set)
+def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[str, float]) -> int:
+    values = known_parameters(n, args.set)
     values.update({k: v for k, v in chain.items() if k not in _set_names(args.set)})
     load_mass = int(values["load_mass"])
     if not 1 <= load_mass <= n:

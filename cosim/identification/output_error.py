@@ -61,6 +61,11 @@ class MotorRecord:
         return self.h * (len(self.theta_m) - 1)
 
 
+#: Largest reaction torque (N·m) a record may carry: far beyond any drive, and small
+#: enough that the fits' sums of squares over 10⁷ samples stay finite.
+MAX_TORQUE = 1e100
+
+
 def through_g(x: np.ndarray, g: float, h: float) -> np.ndarray:
     """``x`` (shape ``(N,)``, any unit) through the DOB's ``G(s) = g / (s + g)`` (g in
     rad/s) at a constant step ``h`` (s), held input: the FMU's own discretization
@@ -132,7 +137,8 @@ def motor_record(
     Raises
     ------
     IdentificationError
-        A log with fewer than 3 samples or a varying step.
+        A log with fewer than 3 samples or a varying step, or a reaction torque beyond
+        :data:`MAX_TORQUE` (actuator terms in the wrong units, say).
 
     Examples
     --------
@@ -160,6 +166,13 @@ def motor_record(
         if k:
             step(h, i, w, th)
             tau[k] = dob.tau_reac_hat
+    peak = float(np.max(np.abs(tau))) if tau.size else 0.0
+    if not peak <= MAX_TORQUE:
+        raise IdentificationError(
+            f"the log's reaction torque through the actuator terms reaches {peak:.3g} N·m "
+            f"(at most {MAX_TORQUE:g}): check J_m, k_t, g_dist and the units of the log's "
+            "columns"
+        )
     return MotorRecord(h, np.asarray(theta_m, dtype=float), tau, g_dist, source)
 
 
