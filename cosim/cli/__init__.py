@@ -26,7 +26,18 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from arcosim.cli import bench, build, identify, reproduce, simulate, ssp, sweep, validate
+from arcosim.cli import (
+    bench,
+    build,
+    check,
+    excite,
+    identify,
+    reproduce,
+    simulate,
+    ssp,
+    sweep,
+    validate,
+)
 from arcosim.errors import ArcosimError
 from arcosim.version import __version__
 
@@ -53,7 +64,18 @@ def make_parser() -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(
         title="commands", metavar="COMMAND", parser_class=OneLineParser
     )
-    for module in (build, simulate, identify, reproduce, sweep, ssp, validate, bench):
+    for module in (
+        build,
+        simulate,
+        excite,
+        check,
+        identify,
+        reproduce,
+        sweep,
+        ssp,
+        validate,
+        bench,
+    ):
         module.add_parser(subparsers)
     return parser
 
