@@ -277,11 +277,12 @@ SPEED = (
 )
 
 
-def speed(repeats: int = 3) -> list[dict]:
+def speed(repeats: int = 3, quick: bool = False) -> list[dict]:
     """Wall and CPU seconds of the identification (log → result, simulation excluded),
-    median of ``repeats``; the three-mass 1 kHz row without its load model."""
+    median of ``repeats``; the three-mass 1 kHz row without its load model (``quick``:
+    that row only)."""
     out = []
-    for label, name, seconds in SPEED:
+    for label, name, seconds in SPEED[1:2] if quick else SPEED:
         row = ROWS[name]
         if row.load != "none":
             row = replace(row, load="none", drive=replace(row.drive, load_sine=(0.0, 0.0)))
