@@ -45,7 +45,7 @@ from arcosim.errors import UserError
 from arcosim.experiments import excitation
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.observer import (
     MODEL_BASED,
     RECURSION,
@@ -185,9 +185,9 @@ def b_honesty(seeds: Sequence[int], progress: Callable[[str], None]) -> dict[str
     for seed in seeds:
         progress(f"B's standard error: seed {seed}")
         _, oe = broadband_fit(case, seed)
-        inside += abs(oe.values[1] - bench.B) <= 2 * oe.std[1]
-        sigmas.append(100 * oe.std[1] / bench.B)
-        errors.append(percent_error(oe.values[1], bench.B))
+        inside += abs(oe.values[1] - defaults.B) <= 2 * oe.std[1]
+        sigmas.append(100 * oe.std[1] / defaults.B)
+        errors.append(percent_error(oe.values[1], defaults.B))
     return {
         "seeds": len(seeds),
         "inside_2_sigma": int(inside),
@@ -206,8 +206,8 @@ def record_lengths(
         for seed in seeds:
             progress(f"bench broadband record of {duration:g} s, seed {seed}")
             _, oe = broadband_fit(CASES[0], seed, duration)
-            errors.append(percent_error(oe.values[1], bench.B))
-            sigmas.append(100 * oe.std[1] / bench.B)
+            errors.append(percent_error(oe.values[1], defaults.B))
+            sigmas.append(100 * oe.std[1] / defaults.B)
         rows.append({"duration_s": duration, "B_error_percent": errors, "B_std_percent": sigmas})
     return rows
 

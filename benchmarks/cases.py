@@ -7,14 +7,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from arcosim.experiments.scenarios import Scenario, run_scenario
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.defaults import ENCODER_CPR, G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import ObserverSettings
 
-ACTUATOR = Actuator(bench.J_M, bench.K_T, 0.0, 0.0, bench.D_M, bench.F_C)
-G_DIST = 100.0
-ENCODER_CPR = 2000
+ACTUATOR = Actuator(defaults.J_M, defaults.K_T, 0.0, 0.0, defaults.D_M, defaults.F_C)
 
 
 @dataclass(frozen=True)
@@ -40,17 +39,17 @@ class Case:
 
     def first_mode(self) -> float:
         """Lowest flexible mode of motor + chain (rad/s)."""
-        M = np.diag([bench.J_M, *self.J])
+        M = np.diag([defaults.J_M, *self.J])
         K = np.array(spring_matrix(self.k))
         w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
         return float(np.sqrt(w2[1]))
 
 
 CASES = (
-    Case("bench (n=3)", bench.J, (bench.K,) * 3, (bench.B,) * 3),
+    Case("bench (n=3)", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3),
     Case("two-mass", (4e-4, 8e-4), (0.3, 0.3), (2e-5, 2e-5)),
     Case("five-mass", (2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4), (0.4,) * 5, (1.5e-5,) * 5),
-    Case("bench, non-uniform k", bench.J, (0.12, bench.K, 0.21), (bench.B,) * 3),
+    Case("bench, non-uniform k", defaults.J, (0.12, defaults.K, 0.21), (defaults.B,) * 3),
 )
 
 

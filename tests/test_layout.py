@@ -121,7 +121,7 @@ def test_identification_needs_no_fmi_host_build_or_cli_code() -> None:
         for m in GRAPH[name]
         if m not in MODULES and not in_package(m, "arcosim")
     }
-    assert third_party - set(sys.stdlib_module_names) <= {"numpy", "scipy"}
+    assert third_party - set(sys.stdlib_module_names) <= {"numpy", "scipy", "threadpoolctl"}
 
 
 def test_code_inside_the_fmus_uses_the_standard_library_and_relative_imports_only() -> None:

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from arcosim.experiments.scenarios import LoadProfile, recording_columns, run_scenario
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.load_observer import LoadTorqueObserver
 from arcosim.fmu.flexchain.model_observer import NoiseModel
 from arcosim.host.instance import FmuInstance
@@ -52,14 +52,16 @@ def test_ideal_sensors_follow_the_filters_own_prediction(build_fmus) -> None:
             ["omega_m_true"],
             ["tau_load_hat"],
             IDEAL,
-            {"encoder_cpr": 0, "D_m": bench.D_M, "estimator": 1, "load_mass": 3},
+            {"encoder_cpr": 0, "D_m": defaults.D_M, "estimator": 1, "load_mass": 3},
             plant_inputs={"tau_ext[3]": tau},
         )
         assert not o.messages, o.messages
     estimate = run["observer.tau_load_hat"]
     alpha = np.max(np.abs(np.diff(run["plant.omega_m_true"]))) / H
-    bound = bench.K * alpha * H**2 / 8 + bench.B * alpha * H / 2
-    obs = LoadTorqueObserver(bench.J, (bench.K,) * 3, (bench.B,) * 3, 100.0, _noise(), 0.0, 3)
+    bound = defaults.K * alpha * H**2 / 8 + defaults.B * alpha * H / 2
+    obs = LoadTorqueObserver(
+        defaults.J, (defaults.K,) * 3, (defaults.B,) * 3, 100.0, _noise(), 0.0, 3
+    )
     model = obs.model(H)
     e = predicted_error(model, len(t) - start)
     expected = np.zeros(len(t) + 1)
@@ -82,16 +84,18 @@ def _noise() -> NoiseModel:
 def test_offline_tool_gives_the_fmus_estimate(build_fmus, tmp_path: Path) -> None:
     """``arcosim identify LOG --method load-torque`` runs the FMU's code: same numbers."""
     profile = LoadProfile(duration=4.0, sine_time=2.5)
-    observer = {"D_m": bench.D_M, "f_c": bench.F_C}
+    observer = {"D_m": defaults.D_M, "f_c": defaults.F_C}
     recording = run_scenario(profile.scenario(), 3, observer=observer, fmu_dir=build_fmus(3))
     log = write_csv(tmp_path / "log.csv", recording_columns(recording))
     (tmp_path / "dist").symlink_to(build_fmus(3), target_is_directory=True)
-    chain = {"masses": 3, **{f"J[{i + 1}]": x for i, x in enumerate(bench.J)}}
-    chain.update({f"{p}[{i}]": v for i in (1, 2, 3) for p, v in (("k", bench.K), ("B", bench.B))})
+    chain = {"masses": 3, **{f"J[{i + 1}]": x for i, x in enumerate(defaults.J)}}
+    chain.update(
+        {f"{p}[{i}]": v for i in (1, 2, 3) for p, v in (("k", defaults.K), ("B", defaults.B))}
+    )
     (tmp_path / "chain.json").write_text(json.dumps(chain))
     command = [sys.executable, "-m", "arcosim", "identify", str(log), "--method", "load-torque"]
     command += ["--chain", "chain.json", "--set", "load_mass=3", "--out", "est.csv", "--json"]
-    command += ["--set", f"D_m={bench.D_M}", "--set", f"f_c={bench.F_C}"]
+    command += ["--set", f"D_m={defaults.D_M}", "--set", f"f_c={defaults.F_C}"]
     result = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)

@@ -11,9 +11,9 @@ import pytest
 from scipy import signal
 
 from arcosim.cli import main
-from arcosim.errors import UserError
 from arcosim.experiments.scenarios import SCENARIOS, run_scenario
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     MotorRecord,
     constant_step,
@@ -35,37 +35,37 @@ def synthetic(seconds: float, noise: float, seed: int = 0) -> MotorRecord:
         0.05 / w * np.sin(w * t + rng.uniform(0, 2 * np.pi)) for w in (3, 7, 13, 17, 22, 30, 60)
     )
     clean = MotorRecord(H, theta, np.zeros_like(t), 100.0)
-    tau = predict(clean, bench.J, [bench.K] * 3, [bench.B] * 3)
+    tau = predict(clean, defaults.J, [defaults.K] * 3, [defaults.B] * 3)
     a = math.exp(-100.0 * H)
     tau = tau + signal.lfilter([1 - a], [1, -a], noise * rng.standard_normal(len(t)))
     return MotorRecord(H, theta, tau, 100.0)
 
 
 def test_fit_recovers_k_and_b_with_an_honest_standard_error() -> None:
-    fit = uniform_chain(synthetic(10.0, 2e-4), bench.J)
+    fit = uniform_chain(synthetic(10.0, 2e-4), defaults.J)
     k, B = fit.values
-    assert k == pytest.approx(bench.K, rel=1e-3)
-    assert abs(B - bench.B) <= 3 * fit.std[1]
+    assert k == pytest.approx(defaults.K, rel=1e-3)
+    assert abs(B - defaults.B) <= 3 * fit.std[1]
     assert fit.std[0] > 0 and fit.std[1] > 0
     assert "scan of the cost" in fit.start_note
 
 
 def test_noise_free_fit_is_exact() -> None:
-    fit = uniform_chain(synthetic(5.0, 0.0), bench.J)
-    assert fit.values[0] == pytest.approx(bench.K, rel=1e-6)
-    assert fit.values[1] == pytest.approx(bench.B, rel=1e-4)
+    fit = uniform_chain(synthetic(5.0, 0.0), defaults.J)
+    assert fit.values[0] == pytest.approx(defaults.K, rel=1e-6)
+    assert fit.values[1] == pytest.approx(defaults.B, rel=1e-4)
 
 
 def test_a_record_without_torque_is_refused() -> None:
     """A log whose reaction torque never moved cannot show a resonance."""
     t = np.arange(5001) * H
     record = MotorRecord(H, 0.5 * np.sin(t), np.zeros_like(t), 100.0)
-    with pytest.raises(UserError, match="shows no resonance"):
-        uniform_chain(record, bench.J)
+    with pytest.raises(IdentificationError, match="shows no resonance"):
+        uniform_chain(record, defaults.J)
 
 
 def test_a_variable_step_is_refused() -> None:
-    with pytest.raises(UserError, match="constant sample step"):
+    with pytest.raises(IdentificationError, match="constant sample step"):
         constant_step(np.array([0.0, 1e-3, 2e-3, 4e-3]))
 
 
@@ -85,7 +85,7 @@ def test_prediction_matches_the_observer_on_an_ideal_co_simulation(build_fmus) -
         recording.time, s["plant.i_a"], s["plant.omega_m"], s["plant.theta_m"], ACTUATOR, 100.0
     )
     assert record.velocity_source == "measured"
-    model = predict(record, bench.J, [bench.K] * 3, [bench.B] * 3)
+    model = predict(record, defaults.J, [defaults.K] * 3, [defaults.B] * 3)
     error = np.sqrt(np.mean((model - record.tau_hat) ** 2))
     assert error < 0.03 * np.sqrt(np.mean(record.tau_hat**2))  # measured 1.9 %
 
@@ -98,7 +98,7 @@ def test_identify_output_error_cli(build_fmus, tmp_path, capsys) -> None:
     assert main([*args, "--set", "D_m=2e-5", "--set", "f_c=2e-3"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert set(report["std"]) == {"k_hat", "B_hat"}
-    assert report["k_hat"] == pytest.approx(bench.K, rel=0.005)
+    assert report["k_hat"] == pytest.approx(defaults.K, rel=0.005)
     assert "backward difference" in report["velocity"]
     assert main([*args, "--set", "J[7]=1"]) == 2
     assert "has no variable 'J[7]'" in capsys.readouterr().err

@@ -14,6 +14,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 from xml.etree.ElementTree import Element, SubElement
 
+from arcosim.fmu.flexchain.defaults import D_M, ENCODER_CPR, F_C, I_NOISE_STD
 from arcosim.fmu.fmukit.variables import type_of
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -45,8 +46,8 @@ BENCH = {
         "lines": 10,
         "seed": 1,
     },
-    "plant": {"encoder_cpr": 2000, "i_noise_std": 0.005, "seed": 1},
-    "observer": {"mode": 2, "D_m": 2e-5, "f_c": 2e-3},
+    "plant": {"encoder_cpr": ENCODER_CPR, "i_noise_std": I_NOISE_STD, "seed": 1},
+    "observer": {"mode": 2, "D_m": D_M, "f_c": F_C},
 }
 
 

@@ -23,11 +23,15 @@ Contract (scripts rely on it)::
   Needs a constant sample step.
 * ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
   damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
-  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, encoder_cpr: with counts, the fit is refined
-  from the current to the encoder). ``--masses auto`` reads the number of
-  masses from the record. ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
-  own parameter names: pass them back with ``--set`` in mode 2), their standard errors
-  under ``std``, and the evidence (modes seen, singular values, criterion per n).
+  J_mo, k_to, dkt, dJm, g_dist, encoder_cpr; D_m and f_c when known, else they are
+  fitted with the chain; with counts the fit is the prediction-error fit from the
+  current to the encoder). ``--load constant|slow``: a load torque on the last mass is
+  part of the model (fitted, reported as ``tau_load``). ``--masses auto`` reads the
+  number of masses from the record. The report's ``assumptions`` say what the result
+  is conditional on (and any drive parameter left at the bench's default). ``--json``
+  prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's own parameter names: pass them
+  back with ``--set`` in mode 2), their standard errors under ``std``, and the evidence
+  (modes seen and their residue t values, weak modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
@@ -119,6 +123,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--fit-inertia-scale",
         action="store_true",
         help="output-error: also fit a common scale on the load inertias J[i]",
+    )
+    p.add_argument(
+        "--load",
+        choices=("none", "constant", "slow"),
+        default="none",
+        help="whole-chain: model a load torque on the last mass (constant, or constant "
+        "plus a slow drift), fitted and reported",
     )
     p.add_argument(
         "--start-k",
@@ -226,6 +237,10 @@ def _masses(text: str) -> int:
 
 def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: int | str) -> int:
     values = known_parameters(folder, args.set)
+    given = {parse_assignment(text)[0] for text in args.set}
+    friction_given = {"D_m", "f_c"} <= given
+    if not friction_given:  # fitted: the DOB's τ̂ (the modal start) is computed without
+        values["D_m"] = values["f_c"] = 0.0
     actuator = actuator_of(values)
     c = log.columns
     g_dist = values["g_dist"]
@@ -233,7 +248,14 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     cpr = int(values["encoder_cpr"])
     encoder = None
     if cpr > 0:
-        encoder = encoder_record(log.time, c["i_a"], c["theta_m"], actuator, cpr)
+        encoder = encoder_record(
+            log.time, c["i_a"], c["theta_m"], actuator, cpr, friction_given, args.load
+        )
+    elif not friction_given or args.load != "none":
+        raise UserError(
+            "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
+            "(--set D_m=… --set f_c=…) and no load torque (--load none)"
+        )
     choice = identify_chain(record, masses, encoder)
     result = choice.fit
     report: dict[str, object] = {"masses": choice.n, **result.as_dict()}
@@ -242,28 +264,40 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: 
     report.update(
         modes_rad_s=result.extra["modes_rad_s"],
         damping_ratios=result.extra["damping_ratios"],
-        criterion={str(n): v for n, v in choice.criterion.items()},
-        rms_residual_per_masses={str(n): v for n, v in choice.rms_residual.items()},
+        residue_t_values=result.extra["residue_t_values"],
+        weak_modes=result.extra["weak_modes"],
         refused={str(n): why for n, why in choice.refused.items()},
+        assumptions=result.extra["assumptions"],
+        warnings=result.extra["warnings"],
+        criterion={str(n): v for n, v in choice.criterion.items()},
+        masses_seen=choice.seen,
     )
+    defaults = [name for name in ("J_mo", "k_to", "encoder_cpr") if name not in given]
+    if defaults:
+        result.extra["assumptions"]["defaults"] = (
+            "not given, so the paper bench's value was used: "
+            + ", ".join(f"{name} = {values[name]:g}" for name in defaults)
+            + " (give your drive's with --set)"
+        )
     if choice.singular_values is not None:
-        report["masses_seen"] = choice.seen
         report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
+    if "load_torque_range" in result.extra:
+        report["load_torque_range"] = result.extra["load_torque_range"]
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
     print(f"{len(log)} samples, whole-chain fit ({choice.n} masses):")
     for key in result.names:
-        print(f"  {key:6s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
-    for key in ("start", "rms_residual", "rms_data", "criterion", "refused"):
+        print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
+    for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
         print(f"  {key}: {report[key]}")
-    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.as_dict().items())
+    for key, text in result.extra["assumptions"].items():
+        print(f"  assumption, {key}: {text}")
+    for text in result.extra["warnings"]:
+        print(f"  warning: {text}")
+    chain = {k: v for k, v in result.as_dict().items() if k[0] in "JkB" and "[" in k}
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in chain.items())
     print(f"observer in mode 2 with this chain: --masses {choice.n} {settings}")
-    if values["D_m"] == 0.0 and values["f_c"] == 0.0:
-        print(
-            "note: the motor's friction is taken as zero (D_m = f_c = 0); give it with "
-            "--set D_m=… --set f_c=… (mode 0 measures it), or the fit may add a mode for it"
-        )
     return 0
 
 

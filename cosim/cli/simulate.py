@@ -21,6 +21,7 @@ from arcosim.build.recipes import check_masses
 from arcosim.cli.options import add_fmus_option, fmu_folder
 from arcosim.errors import UserError
 from arcosim.experiments.scenarios import SCENARIOS, recording_columns, run_scenario
+from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.master import ORDERINGS
 from arcosim.host.overrides import split_overrides
 from arcosim.logs import write_csv
@@ -49,7 +50,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--ordering", choices=ORDERINGS, default="gauss-seidel")
     p.add_argument(
-        "--step", type=float, default=1e-3, help="communication step in s (default 0.001)"
+        "--step", type=float, default=STEP, help=f"communication step in s (default {STEP:g})"
     )
     p.add_argument("--duration", type=float, help="length in s (default: the scenario's)")
     p.add_argument("--out", type=Path, help="CSV of every recorded signal (a log for identify)")

@@ -15,6 +15,7 @@ import argparse
 from pathlib import Path
 
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.ssp import run_ssp
 from arcosim.logs import write_csv
 
@@ -32,7 +33,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--stop", type=float, help="stop time in s (default: the SSP's DefaultExperiment)"
     )
     p.add_argument(
-        "--step", type=float, default=1e-3, help="communication step in s (default 0.001)"
+        "--step", type=float, default=STEP, help=f"communication step in s (default {STEP:g})"
     )
     p.add_argument("--out", type=Path, help="CSV of every output of every component")
     p.set_defaults(execute=_execute)

@@ -28,7 +28,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import lfilter
 
 from arcosim.build.builder import ensure_built, fmu_variables
 from arcosim.experiments.metrics import flexible_score, percent_error
@@ -49,7 +48,8 @@ from arcosim.experiments.scenarios import (
     recording_columns,
     run_scenario,
 )
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.defaults import G_DIST, STEP
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
 from arcosim.host.master import Recording
@@ -57,7 +57,7 @@ from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.load_torque import score_profile, step_truth
 from arcosim.identification.offline_observer import estimate_states
-from arcosim.identification.output_error import motor_record
+from arcosim.identification.output_error import motor_record, through_g
 from arcosim.identification.whole_chain import Choice
 from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import write_csv
@@ -65,8 +65,7 @@ from arcosim.version import __version__
 
 N_MASSES = 3
 SEEDS = (1, 2, 3, 4, 5)
-TRUE = {"D_m": bench.D_M, "f_c": bench.F_C, "k": bench.K, "B": bench.B}
-G_DIST = 100.0
+TRUE = {"D_m": defaults.D_M, "f_c": defaults.F_C, "k": defaults.K, "B": defaults.B}
 
 
 @dataclass
@@ -94,11 +93,11 @@ def reproduce(
     folder = ensure_built(N_MASSES, fmu_dir)
     out.mkdir(parents=True, exist_ok=True)
     steps = (
-        round(SCENARIOS["selfid"].duration / 1e-3)
-        + len(SEEDS) * round(SCENARIOS["rigid"].duration / 1e-3)
-        + 2 * round(SCENARIOS["flexible"].duration / 1e-3)
-        + round(SCENARIOS["identification"].duration / 1e-3)
-        + 2 * round(LOAD_PROFILE.duration / 1e-3)
+        round(SCENARIOS["selfid"].duration / STEP)
+        + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
+        + 2 * round(SCENARIOS["flexible"].duration / STEP)
+        + round(SCENARIOS["identification"].duration / STEP)
+        + 2 * round(LOAD_PROFILE.duration / STEP)
     )
     results = Results()
     with tqdm(
@@ -200,7 +199,7 @@ def reproduce(
 TRUE_CHAIN = {
     f"{p}[{i}]": v
     for i in range(1, N_MASSES + 1)
-    for p, v in (("J", bench.J[i - 1]), ("k", bench.K), ("B", bench.B))
+    for p, v in (("J", defaults.J[i - 1]), ("k", defaults.K), ("B", defaults.B))
 }
 
 
@@ -222,9 +221,9 @@ def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, fig
         actuator=_terms(results.actuator),
         g_dist=G_DIST,
         g_lpf=G_DIST,
-        J=tuple(bench.J),
-        k=(bench.K,) * N_MASSES,
-        B=(bench.B,) * N_MASSES,
+        J=tuple(defaults.J),
+        k=(defaults.K,) * N_MASSES,
+        B=(defaults.B,) * N_MASSES,
         estimator=MODEL_BASED,
         encoder_cpr=cpr,
     )
@@ -242,8 +241,8 @@ def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, fig
 def _terms(actuator: dict[str, float]) -> Actuator:
     """The actuator terms experiment 1 identified, on the bench's nominal J_m and k_t."""
     return Actuator(
-        bench.J_M,
-        bench.K_T,
+        defaults.J_M,
+        defaults.K_T,
         actuator["dkt_hat"],
         actuator["dJm_hat"],
         actuator["D_m_hat"],
@@ -270,9 +269,9 @@ def whole_chain_rows(results: Results) -> list[list[str]]:
     rows = []
     for i in range(1, results.masses + 1):
         for p, unit, truth in (
-            ("J", "kg·m²", bench.J[i - 1] if i <= N_MASSES else None),
-            ("k", "N·m/rad", bench.K),
-            ("B", "N·m·s/rad", bench.B),
+            ("J", "kg·m²", defaults.J[i - 1] if i <= N_MASSES else None),
+            ("k", "N·m/rad", defaults.K),
+            ("B", "N·m·s/rad", defaults.B),
         ):
             value = results.whole_chain[f"{p}[{i}]"]
             sigma = results.whole_chain_std[f"{p}[{i}]"]
@@ -291,11 +290,10 @@ def _figures(
     b_hat: float,
     model_based: Recording | None,
 ) -> list[Path]:
-    a = math.exp(-G_DIST * 1e-3)
     raw = k_hat * (rigid["plant.theta_m_true"] - rigid["plant.theta[1]"]) + b_hat * (
         rigid["plant.omega_m_true"] - rigid["plant.omega[1]"]
     )
-    rebuilt = lfilter([1 - a], [1, -a], raw)
+    rebuilt = through_g(raw, G_DIST, float(rigid.time[1] - rigid.time[0]))
     return [
         figure_reaction_torque(rigid, rebuilt, out / "fig4_reaction_torque.png", k_hat, b_hat),
         figure_flexible_response(flexible, N_MASSES, out / "fig5_flexible_response.png"),
@@ -314,7 +312,7 @@ def _whole_chain_figure(out: Path, identification: Recording, results: Results) 
     """Fig. 7: experiment 4's parameters against the truth, and its model's response."""
     true = {}
     for i in range(1, N_MASSES + 1):
-        true.update({f"J[{i}]": bench.J[i - 1], f"k[{i}]": bench.K, f"B[{i}]": bench.B})
+        true.update({f"J[{i}]": defaults.J[i - 1], f"k[{i}]": defaults.K, f"B[{i}]": defaults.B})
     lines = IDENTIFICATION_LINES
     measured = measured_response(
         identification.time,

@@ -19,7 +19,8 @@ import numpy as np
 from arcosim.build.builder import ensure_built
 from arcosim.build.recipes import OBSERVER, PLANT
 from arcosim.experiments import excitation
-from arcosim.fmu.flexchain import bench
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import Recording, cosimulate
 
@@ -147,8 +148,8 @@ class LoadProfile:
 
     def size(self) -> float:
         """The step (N·m): ``fraction`` of the bench drive's peak torque over the run."""
-        t = np.arange(round(self.duration / 1e-3)) * 1e-3
-        return self.fraction * bench.K_T * float(np.max(np.abs(self.current(t))))
+        t = np.arange(round(self.duration / STEP)) * STEP
+        return self.fraction * defaults.K_T * float(np.max(np.abs(self.current(t))))
 
     def torque(self, t: np.ndarray) -> np.ndarray:
         """The external torque (N·m) held over the step starting at each of ``t`` (s)."""
@@ -250,7 +251,7 @@ def run_scenario(
     n: int = 3,
     plant: Mapping[str, float | int | bool] | None = None,
     observer: Mapping[str, float | int | bool] | None = None,
-    h: float = 1e-3,
+    h: float = STEP,
     ordering: str = "gauss-seidel",
     ideal: bool = False,
     record_plant: Sequence[str] | None = None,

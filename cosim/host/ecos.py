@@ -10,6 +10,8 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+from arcosim.fmu.flexchain.defaults import STEP
+
 
 def ecos_binary() -> tuple[Path | None, str | None]:
     """``(path, None)`` if ecos can run here, else ``(None, why not)``."""
@@ -32,7 +34,7 @@ def run_ecos(
     path: Path,
     workdir: Path,
     stop: float,
-    step: float = 1e-3,
+    step: float = STEP,
     parameter_set: str | None = None,
     timeout: float = 300.0,
 ) -> subprocess.CompletedProcess:

@@ -21,6 +21,7 @@ from xml.etree import ElementTree
 import numpy as np
 
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import Recording
 
@@ -75,7 +76,7 @@ def run_ssp(
     path: Path,
     parameter_set: str | None = "bench",
     stop: float | None = None,
-    h: float = 1e-3,
+    h: float = STEP,
     extra: Mapping[str, Mapping[str, float | int | bool | str]] | None = None,
 ) -> Recording:
     """Run an SSP system with a fixed-step Jacobi master.

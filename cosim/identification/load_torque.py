@@ -17,8 +17,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, Observer, ObserverSettings
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.offline_observer import replay
 
 #: A step counts as settled once the estimate stays within this fraction of its size.
@@ -69,14 +69,14 @@ def estimate(
         i_a, omega_m, theta_m: the log's current (A), velocity (rad/s), angle (rad).
 
     Raises:
-        UserError: for settings that do not estimate a load torque.
+        IdentificationError: for settings that do not estimate a load torque.
     """
     if not (
         settings.mode == STATE_ESTIMATION
         and settings.estimator == MODEL_BASED
         and 1 <= settings.load_mass <= len(settings.J)
     ):
-        raise UserError(
+        raise IdentificationError(
             f"the load torque estimator needs mode 2, estimator 1 and a load mass 1 … "
             f"{len(settings.J)}, got mode {settings.mode}, estimator {settings.estimator}, "
             f"load_mass {settings.load_mass}"

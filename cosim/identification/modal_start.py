@@ -26,9 +26,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
-from arcosim.errors import UserError
+from arcosim.fmu.flexchain.filters import lowpass_pole
 from arcosim.identification.chain_modes import chain_from_modes
-from arcosim.identification.output_error import MotorRecord
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.output_error import (
+    MotorRecord,
+    decorrelation_lag,
+    newey_west_covariance,
+    through_g,
+)
 
 #: Block rows of the subspace method's Hankel matrices (decimated samples).
 ROWS = 60
@@ -65,20 +71,20 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     """The n clamped modes of the chain in ``record`` and their residues.
 
     Raises:
-        UserError: when the record is too short, or shows fewer than n modes.
+        IdentificationError: when the record is too short, or shows fewer than n modes.
     """
     band = _band(record)
     u, y, step = _decimated(record, band)
     rows = max(2 * n + 4, min(ROWS, len(u) // 8))
     if len(u) < 8 * (2 * n + 4):
-        raise UserError(
+        raise IdentificationError(
             f"the record ({record.duration:g} s) is too short to find {n} modes below "
             f"{band:.0f} rad/s; record at least {8 * (2 * n + 4) * step:.1f} s (20 s advised)"
         )
     frequency, damping, singular = _modes(u, y, n, rows, step, band)
     if len(frequency) < n:
         found = ", ".join(f"{w:.1f}" for w in frequency) or "none"
-        raise UserError(
+        raise IdentificationError(
             f"the record shows {len(frequency)} lightly damped mode(s) below {band:.0f} rad/s "
             f"({found} rad/s), {chain_of(n)} has {n}: excite every mode (a multi-sine "
             "with many lines across the band, `arcosim simulate --scenario identification`) "
@@ -87,11 +93,225 @@ def record_modes(record: MotorRecord, n: int) -> Modes:
     residue = residues(record, frequency, damping)
     if np.any(residue <= 0.0):
         missing = ", ".join(f"{w:.1f}" for w in frequency[residue <= 0.0])
-        raise UserError(
+        raise IdentificationError(
             f"the mode(s) at {missing} rad/s carry no reaction torque when the record is "
             f"read as {chain_of(n)}: try another number of masses (--masses auto)"
         )
     return Modes(frequency, damping, residue, singular / singular[0], band)
+
+
+#: Model orders the stabilization diagram runs over: 2 … 2·(largest n + this).
+EXTRA_PAIRS = 4
+#: Two poles of neighbouring orders are the same mode when their frequencies differ by
+#: less than this fraction and their damping ratios by less than
+#: :data:`DAMPING_TOLERANCE` (absolute) or half their own.
+FREQUENCY_TOLERANCE = 0.02
+DAMPING_TOLERANCE = 0.01
+#: A mode must be found at this many model orders (of the diagram's) to count.
+STABLE_ORDERS = 4
+#: A mode's residue must exceed this many of its standard errors to count as excited.
+RESIDUE_T = 4.0
+#: With ``lines`` given to :func:`detect_modes`, a pole this lightly damped within
+#: :data:`LINE_TOLERANCE` (relative, or a quarter of the record's bin 2π/T) of an
+#: excitation line is taken for the line (a multi-sine is itself the output of undamped
+#: oscillators). The whole-chain fit does not ask for it: a lightly damped mode may sit
+#: on a line (the bench's first mode does), and the information criterion decides.
+LINE_DAMPING = 0.003
+LINE_TOLERANCE = 0.005
+#: An excitation line stands this many times above the current spectrum's median.
+LINE_PROMINENCE = 30.0
+
+
+@dataclass(frozen=True)
+class Detected:
+    """The record's modes, read from a stabilization diagram (see :func:`detect_modes`).
+
+    Attributes:
+        frequency: clamped frequencies p_i of the modes that count (rad/s), ascending.
+        damping: their damping ratios.
+        residue: their residues (N·m/rad·s⁻²).
+        t_value: residue / its standard error, per mode that counts.
+        weak: modes found stable but too weakly excited: (frequency, t value) pairs.
+        lines: stable poles taken for excitation lines (rad/s).
+        orders: per mode that counts, the number of model orders it was found at.
+        band: highest frequency sought (rad/s).
+        singular_values: of the subspace step, relative to the first.
+    """
+
+    frequency: np.ndarray
+    damping: np.ndarray
+    residue: np.ndarray
+    t_value: np.ndarray
+    weak: list[tuple[float, float]]
+    lines: list[float]
+    orders: np.ndarray
+    band: float
+    singular_values: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.frequency)
+
+    def modes(self, n: int | None = None) -> Modes:
+        """The first ``n`` (default all) as :class:`Modes` for the chain's start."""
+        n = self.n if n is None else n
+        return Modes(
+            self.frequency[:n], self.damping[:n], self.residue[:n], self.singular_values, self.band
+        )
+
+
+def excitation_lines(current: np.ndarray, h: float) -> np.ndarray:
+    """Frequencies (rad/s) of the lines of a multi-sine in ``current`` (any unit):
+    spectral peaks :data:`LINE_PROMINENCE` times above the median, shape (L,)."""
+    x = np.asarray(current, dtype=float)
+    x = (x - x.mean()) * np.hanning(len(x))
+    power = np.abs(np.fft.rfft(x)) ** 2
+    frequency = 2.0 * np.pi * np.fft.rfftfreq(len(x), h)
+    floor = max(float(np.median(power[1:])), 1e-300)
+    peak = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
+    strong = power[1:-1] > LINE_PROMINENCE * floor
+    j = np.flatnonzero(peak & strong) + 1
+    # parabolic interpolation of the log power: the line between the bins
+    left, mid, right = (np.log(power[j + d]) for d in (-1, 0, 1))
+    shift = (
+        0.5 * (left - right) / np.where(left - 2 * mid + right == 0, -1.0, left - 2 * mid + right)
+    )
+    return frequency[j] + np.clip(shift, -0.5, 0.5) * (frequency[1] - frequency[0])
+
+
+def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = None) -> Detected:
+    """The clamped modes a record shows, and which of them it excites enough.
+
+    One PO-MOESP decomposition (:func:`moesp`) gives models of every even order
+    2 … 2·(``largest`` + :data:`EXTRA_PAIRS`); a lightly damped pole below the band that
+    comes back at neighbouring orders within :data:`FREQUENCY_TOLERANCE` (a physical
+    mode does, a pole fitted to noise wanders) is a mode when it does so at
+    :data:`STABLE_ORDERS` orders or more. The residues of all such modes are then
+    fitted together by least squares (modes held); a mode whose residue is below
+    :data:`RESIDUE_T` standard errors (Newey–West) is too weakly excited to count.
+    A stable pole as lightly damped as :data:`LINE_DAMPING` at one of ``lines`` (the
+    excitation's, :func:`excitation_lines`) is that line. Nothing here depends on the
+    spacing of the modes or the size of their residues.
+
+    Raises:
+        IdentificationError: when the record is too short.
+    """
+    band = _band(record)
+    u, y, step = _decimated(record, band)
+    top = 2 * (largest + EXTRA_PAIRS)
+    rows = max(top + 2, min(ROWS, len(u) // 8))
+    if len(u) < 8 * (top // 2 + 4):
+        raise IdentificationError(
+            f"the record ({record.duration:g} s) is too short to show its modes below "
+            f"{band:.0f} rad/s; record at least {8 * (top // 2 + 4) * step:.1f} s (20 s advised)"
+        )
+    observability, singular = _observability(u, y, rows)
+    per_order = []
+    for order in range(2, top + 1, 2):
+        A = np.linalg.lstsq(observability[:-1, :order], observability[1:, :order], rcond=None)[0]
+        eigenvalues = np.linalg.eigvals(A)
+        poles = np.log(eigenvalues[eigenvalues.imag > 0].astype(complex)) / step
+        frequency = np.abs(poles)
+        damping = -poles.real / np.maximum(frequency, 1e-300)
+        keep = (frequency < band) & (damping > DAMPING_RANGE[0]) & (damping < DAMPING_RANGE[1])
+        per_order.append(np.column_stack([frequency[keep], damping[keep]]))
+    clusters = _stable_clusters(per_order)
+    taken: list[float] = []
+    if lines is not None and len(lines):
+        bin_width = 2.0 * np.pi / max(record.duration, 1e-300)
+        kept = []
+        for c in clusters:
+            distance = float(np.min(np.abs(np.asarray(lines) - c[0])))
+            if abs(c[1]) < LINE_DAMPING and distance < max(LINE_TOLERANCE * c[0], bin_width / 4):
+                taken.append(c[0])
+            else:
+                kept.append(c)
+        clusters = kept
+    if not clusters:
+        empty = np.empty(0)
+        return Detected(
+            empty, empty, empty, empty, [], taken, np.empty(0, int), band, singular / singular[0]
+        )
+    frequency = np.array([c[0] for c in clusters])
+    damping = np.array([c[1] for c in clusters])
+    orders = np.array([c[2] for c in clusters])
+    residue, std = residues_with_errors(record, frequency, damping)
+    t_value = residue / np.maximum(std, 1e-300)
+    counts = t_value >= RESIDUE_T
+    weak = [(float(w), float(t)) for w, t, c in zip(frequency, t_value, counts) if not c]
+    while np.any(counts) and not np.all(counts):  # refit without the weak ones, until
+        residue_c, std_c = residues_with_errors(record, frequency[counts], damping[counts])
+        residue[counts], std[counts] = residue_c, std_c
+        t_value[counts] = residue_c / np.maximum(std_c, 1e-300)
+        still = t_value >= RESIDUE_T
+        if np.all(still[counts]):  # every mode kept stands on its own
+            break
+        weak += [
+            (float(w), float(t))
+            for w, t in zip(frequency[counts & ~still], t_value[counts & ~still])
+        ]
+        counts &= still
+    return Detected(
+        frequency[counts],
+        damping[counts],
+        residue[counts],
+        t_value[counts],
+        weak,
+        taken,
+        orders[counts],
+        band,
+        singular / singular[0],
+    )
+
+
+def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, int]]:
+    """Modes of the stabilization diagram: chains of poles of increasing orders that
+    match the chain so far (its median frequency and damping, within tolerance; one
+    order may be skipped), at least :data:`STABLE_ORDERS` poles long; each as (median
+    frequency, median damping, length), one per frequency."""
+    chains: list[list[tuple[float, float]]] = []
+    open_chains: list[tuple[list[tuple[float, float]], int]] = []  # (poles, misses)
+    for poles in per_order:
+        extended: list[tuple[list[tuple[float, float]], int]] = []
+        used = np.zeros(len(poles), dtype=bool)
+        for chain, misses in open_chains:
+            w, z = np.median(np.array(chain), axis=0)
+            if len(poles):
+                df = np.abs(poles[:, 0] - w) / w
+                dz = np.abs(poles[:, 1] - z)
+                ok = (
+                    (df < FREQUENCY_TOLERANCE)
+                    & (dz < np.maximum(DAMPING_TOLERANCE, 0.5 * np.abs(z)))
+                    & ~used
+                )
+                if np.any(ok):
+                    j = int(np.flatnonzero(ok)[np.argmin(df[ok])])
+                    used[j] = True
+                    chain.append((float(poles[j, 0]), float(poles[j, 1])))
+                    extended.append((chain, 0))
+                    continue
+            if misses == 0:
+                extended.append((chain, 1))  # one order without it: keep it open
+            else:
+                chains.append(chain)
+        for j in np.flatnonzero(~used):
+            extended.append(([(float(poles[j, 0]), float(poles[j, 1]))], 0))
+        open_chains = extended
+    chains += [chain for chain, _ in open_chains]
+    found = []
+    for chain in chains:
+        if len(chain) >= STABLE_ORDERS:
+            tail = np.array(chain[-STABLE_ORDERS:])  # the highest orders: least biased
+            found.append((float(np.median(tail[:, 0])), float(np.median(tail[:, 1])), len(chain)))
+    found.sort()
+    merged: list[tuple[float, float, int]] = []
+    for mode in found:  # one mode per frequency: two chains of one mode merge
+        if merged and abs(mode[0] - merged[-1][0]) < FREQUENCY_TOLERANCE * mode[0]:
+            if mode[2] > merged[-1][2]:
+                merged[-1] = mode
+            continue
+        merged.append(mode)
+    return merged
 
 
 def singular_values(record: MotorRecord) -> np.ndarray:
@@ -101,7 +321,9 @@ def singular_values(record: MotorRecord) -> np.ndarray:
     u, y, _ = _decimated(record, band)
     rows = min(ROWS, len(u) // 8)
     if rows < 4:
-        raise UserError(f"the record ({record.duration:g} s) is too short to show its modes")
+        raise IdentificationError(
+            f"the record ({record.duration:g} s) is too short to show its modes"
+        )
     singular = moesp(u, y, 2, rows)[1]
     return singular / singular[0]
 
@@ -126,8 +348,7 @@ def chain_of(n: int) -> str:
 def _decimated(record: MotorRecord, band: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Motor angle through G(s) and τ̂_reac, both low-passed (zero phase) and decimated
     so that the Nyquist frequency is about ``band``; and the new step (s)."""
-    a = np.exp(-record.g_dist * record.h)
-    u = signal.lfilter([1.0 - a], [1.0, -a], record.theta_m - record.theta_m[0])
+    u = through_g(record.theta_m - record.theta_m[0], record.g_dist, record.h)
     y = record.tau_hat
     factor = max(1, int(np.pi / (band * record.h)))
     if factor > 1:
@@ -166,15 +387,21 @@ def moesp(u: np.ndarray, y: np.ndarray, order: int, rows: int) -> tuple[np.ndarr
     """PO-MOESP for one input, one output: the eigenvalues of the order-``order``
     state matrix (discrete time) and the singular values of the projected output
     Hankel matrix (shape (rows,)); past inputs and outputs are the instruments."""
+    observability, singular = _observability(u, y, rows)
+    A = np.linalg.lstsq(observability[:-1, :order], observability[1:, :order], rcond=None)[0]
+    return np.linalg.eigvals(A), singular
+
+
+def _observability(u: np.ndarray, y: np.ndarray, rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """PO-MOESP's extended observability matrix (every order; its first ``order``
+    columns are the order-``order`` model's, shape (rows, rows)) and singular values."""
     columns = len(u) - 2 * rows + 1
     past_u, future_u = _hankel(u, rows, columns), _hankel(u[rows:], rows, columns)
     past_y, future_y = _hankel(y, rows, columns), _hankel(y[rows:], rows, columns)
     L = np.linalg.qr(np.vstack([future_u, past_u, past_y, future_y]).T, mode="r").T
     projected = L[3 * rows : 4 * rows, rows : 3 * rows]
     left, singular, _ = np.linalg.svd(projected)
-    observability = left[:, :order] * np.sqrt(singular[:order])
-    A = np.linalg.lstsq(observability[:-1], observability[1:], rcond=None)[0]
-    return np.linalg.eigvals(A), singular
+    return left * np.sqrt(singular), singular
 
 
 def _hankel(x: np.ndarray, rows: int, columns: int) -> np.ndarray:
@@ -188,17 +415,41 @@ def residues(record: MotorRecord, frequency: np.ndarray, damping: np.ndarray) ->
     (so the static torque k_1 − Σ r_i / p_i² is zero, as it is for a free load chain);
     0 means the mode does not explain the record.
     """
+    regressors = _modal_regressors(record, frequency, damping)
+    norms = np.linalg.norm(regressors, axis=0)
+    norms[norms == 0.0] = 1.0
+    r, _ = optimize.nnls(regressors / norms, record.tau_hat)
+    return r / norms
+
+
+def _modal_regressors(
+    record: MotorRecord, frequency: np.ndarray, damping: np.ndarray
+) -> np.ndarray:
+    """The motor angle through ``1/p² − 1/(s² + 2ζps + p²)`` and G(s), per mode (N, n)."""
     h = record.h
     u = record.theta_m - record.theta_m[0]
-    a = np.exp(-record.g_dist * h)
+    a = lowpass_pole(record.g_dist, h)
     columns = []
     for p, zeta in zip(frequency, np.clip(damping, 1e-4, None)):
         numerator = [1.0, 2.0 * zeta * p, 0.0]
         denominator = [p**2, 2.0 * zeta * p**3, p**4]
         b, a_, _ = signal.cont2discrete((numerator, denominator), h, method="bilinear")
         columns.append(signal.lfilter([1.0 - a], [1.0, -a], signal.lfilter(b.ravel(), a_, u)))
-    regressors = np.array(columns).T
+    return np.array(columns).T
+
+
+def residues_with_errors(
+    record: MotorRecord, frequency: np.ndarray, damping: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Residues r_i of the modal model on the record, the modes held, by ordinary
+    least squares (any sign), and their Newey–West standard errors (shapes (n,))."""
+    regressors = _modal_regressors(record, frequency, damping)
     norms = np.linalg.norm(regressors, axis=0)
     norms[norms == 0.0] = 1.0
-    r, _ = optimize.nnls(regressors / norms, record.tau_hat)
-    return r / norms
+    X = regressors / norms
+    r = np.linalg.lstsq(X, record.tau_hat, rcond=None)[0]
+    residual = record.tau_hat - X @ r
+    lag = decorrelation_lag(residual, int(np.ceil(5.0 / (record.g_dist * record.h))))
+    cov = newey_west_covariance(X, residual, lag)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return r / norms, std / norms

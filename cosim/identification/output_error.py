@@ -28,10 +28,13 @@ import numpy as np
 import scipy.linalg
 from scipy import optimize, signal
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.defaults import VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver
 from arcosim.fmu.flexchain.driven_chain import discretize
+from arcosim.fmu.flexchain.filters import lowpass_pole
+from arcosim.identification.blas import single_threaded
+from arcosim.identification.errors import IdentificationError
 
 
 @dataclass(frozen=True)
@@ -58,18 +61,26 @@ class MotorRecord:
         return self.h * (len(self.theta_m) - 1)
 
 
+def through_g(x: np.ndarray, g: float, h: float) -> np.ndarray:
+    """``x`` (shape ``(N,)``, any unit) through the DOB's ``G(s) = g / (s + g)`` (g in
+    rad/s) at a constant step ``h`` (s), held input: the FMU's own discretization
+    (:func:`~arcosim.fmu.flexchain.filters.lowpass_pole`)."""
+    a = lowpass_pole(g, h)
+    return signal.lfilter([1.0 - a], [1.0, -a], x)
+
+
 def constant_step(time: np.ndarray, what: str = "the log") -> float:
     """The step of a uniformly sampled time column (s).
 
     Raises:
-        UserError: if the step varies by more than 1e-6 of its mean.
+        IdentificationError: if the step varies by more than 1e-6 of its mean.
     """
     steps = np.diff(np.asarray(time, dtype=float))
     if len(steps) < 2:
-        raise UserError(f"{what} has fewer than 3 samples; output-error needs a record")
+        raise IdentificationError(f"{what} has fewer than 3 samples; output-error needs a record")
     h = float(np.mean(steps))
     if np.max(np.abs(steps - h)) > 1e-6 * h:
-        raise UserError(
+        raise IdentificationError(
             f"{what}: output-error identification needs a constant sample step "
             f"(steps range {steps.min():.6g} … {steps.max():.6g} s); resample the log"
         )
@@ -101,9 +112,9 @@ def motor_record(
     velocity = np.asarray(omega_m, dtype=float)
     source = "measured"
     if is_backward_difference(theta_m, velocity, h):
-        velocity = smooth_velocity(theta_m, h, 4.0 * g_dist)
+        velocity = smooth_velocity(theta_m, h, VELOCITY_SMOOTHING * g_dist)
         source = (
-            f"derivative of theta_m smoothed at {4.0 * g_dist:g} rad/s without lag "
+            f"derivative of theta_m smoothed at {VELOCITY_SMOOTHING * g_dist:g} rad/s without lag "
             "(the log's omega_m is its backward difference)"
         )
     dob = ReactionObserver(actuator, g_dist, float(theta_m[0]), float(velocity[0]))
@@ -152,9 +163,7 @@ def predict(
     w = np.vstack([u[:-1], np.diff(u) / record.h])  # inputs of steps 1 … N−1
     x = linear_recursion(Ad, Bd, w, np.zeros(len(c)))  # x_0 … x_{N−1}
     torque = c @ x[:, :-1] + d @ w
-    a = np.exp(-record.g_dist * record.h)
-    filtered = signal.lfilter([1.0 - a], [1.0, -a], torque)
-    return np.concatenate([[0.0], filtered])
+    return np.concatenate([[0.0], through_g(torque, record.g_dist, record.h)])
 
 
 def linear_recursion(F: np.ndarray, G: np.ndarray, u: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -241,7 +250,7 @@ def fit(
     """
     start = np.asarray(start, dtype=float)
     if np.any(~np.isfinite(start)) or np.any(start <= 0):
-        raise UserError(f"output-error start values must be finite and > 0, got {start}")
+        raise IdentificationError(f"output-error start values must be finite and > 0, got {start}")
     lower = 1e-3 * start if lower is None else np.asarray(lower, dtype=float)
     data = record.tau_hat
 
@@ -338,10 +347,10 @@ def check_excited(record: MotorRecord) -> None:
     """Refuse a record whose motor never moved or whose reaction torque never changed.
 
     Raises:
-        UserError: naming what is missing and what to do.
+        IdentificationError: naming what is missing and what to do.
     """
     if not np.any(record.tau_hat) or np.ptp(record.theta_m) == 0.0:
-        raise UserError(
+        raise IdentificationError(
             "the log shows no resonance of the chain (its reaction torque or motor angle "
             "never changes): excite it (a multi-sine or chirp across the modes, see "
             "`arcosim simulate --scenario flexible`) or give a start with --start-k"
@@ -409,6 +418,7 @@ def continued_fit(
         seconds *= 2.0
 
 
+@single_threaded
 def uniform_chain(
     record: MotorRecord,
     J: Sequence[float],
@@ -423,7 +433,7 @@ def uniform_chain(
     then runs on longer and longer openings of the record (:func:`continued_fit`).
 
     Raises:
-        UserError: when the record shows no motion or no reaction torque.
+        IdentificationError: when the record shows no motion or no reaction torque.
     """
     J = [float(x) for x in J]
     n = len(J)

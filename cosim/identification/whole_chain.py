@@ -21,17 +21,34 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy import optimize
 
-from arcosim.errors import UserError
+from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import EncoderRecord, refine
-from arcosim.identification.modal_start import masses_seen, record_modes, singular_values
-from arcosim.identification.output_error import Fit, MotorRecord, check_excited, continued_fit
+from arcosim.identification.encoder_fit import opening as encoder_opening
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.modal_start import Detected, Modes, chain_of, detect_modes, record_modes
+from arcosim.identification.output_error import (
+    Fit,
+    MotorRecord,
+    check_excited,
+    continued_fit,
+    predict,
+    through_g,
+)
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
+#: A mode whose residue is below this many standard errors is reported as weakly
+#: determined (the result's warnings).
+T_CONFIRM = 30.0
+#: Length (s) of the opening the order check's fits run on (``auto``: the n modes seen,
+#: then without the weakest, one at a time while the BIC falls).
+CONFIRM_SECONDS = 5.0
 
 
 def names(n: int) -> list[str]:
@@ -41,7 +58,7 @@ def names(n: int) -> list[str]:
 
 def split(p: np.ndarray, n: int) -> tuple[list[float], list[float], list[float]]:
     """``(J, k, B)`` from the stacked parameter vector (kg·m², N·m/rad, N·m·s/rad)."""
-    return list(p[:n]), list(p[n : 2 * n]), list(p[2 * n :])
+    return list(p[:n]), list(p[n : 2 * n]), list(p[2 * n : 3 * n])
 
 
 def _lower(n: int) -> Callable[[np.ndarray], np.ndarray]:
@@ -49,7 +66,7 @@ def _lower(n: int) -> Callable[[np.ndarray], np.ndarray]:
     return lambda p: np.concatenate([1e-3 * p[: 2 * n], np.zeros(n)])
 
 
-def fit_chain(record: MotorRecord, n: int) -> Fit:
+def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Fit:
     """Fit every J_i, k_i, B_i of an n-mass chain to ``record`` (steps in the module doc).
 
     Returns:
@@ -57,13 +74,14 @@ def fit_chain(record: MotorRecord, n: int) -> Fit:
         ``damping_ratios``) and the subspace singular values (``singular_values``).
 
     Raises:
-        UserError: for n < 1, or a record that shows no motion, no reaction torque or
+        IdentificationError: for n < 1, or a record that shows no motion, no reaction torque or
             fewer than n modes.
     """
     if n < 1:
-        raise UserError(f"the chain needs at least one load mass, got {n}")
+        raise IdentificationError(f"the chain needs at least one load mass, got {n}")
     check_excited(record)
-    modes = record_modes(record, n)
+    if modes is None:
+        modes = record_modes(record, n)
     J0, k0 = modes.chain()
     zeta = float(np.mean(np.clip(modes.damping, 1e-4, 0.05)))
     B0 = 2.0 * zeta * k0 / modes.frequency[0]
@@ -115,48 +133,269 @@ class Choice:
     singular_values: np.ndarray | None = None
 
 
+@single_threaded
 def identify(
     record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
 ) -> Choice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
-    With ``"auto"``: the record's subspace singular values show n modes
-    (:func:`~cosim.modal_start.masses_seen`); chains of n − 1, n and n + 1 masses are
-    fitted and the smallest criterion wins (one lag for all, the largest: the residual
-    of a good fit is the most correlated). An n the record cannot support (fewer modes
-    seen, or a mode that carries no reaction torque) is refused and reported.
+    The record's modes come from a stabilization diagram of the subspace step
+    (:func:`~cosim.modal_start.detect_modes`): a mode counts when it comes back at
+    several model orders and its residue stands above its standard error; ``auto``
+    takes n = the number that count. An n the record cannot support is refused, naming
+    the modes it shows, the ones too weakly excited, and what would fix the record.
 
-    With ``encoder`` (the same log's current and encoder counts), the chosen fit is
-    refined by the prediction-error fit (:mod:`cosim.encoder_fit`), which takes the
-    counts for what they are; without it the output-error fit is the result.
+    With ``encoder`` (the same log's current and encoder counts) the chain is fitted by
+    the prediction-error fit from the current to the encoder (:mod:`cosim.encoder_fit`:
+    with the motor's friction and a load torque when the record asks for them) straight
+    from the modal start; without it, by the output-error fit to τ̂_reac.
 
     Raises:
-        UserError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
-            record cannot support even one mass.
+        IdentificationError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
+            record cannot support the chain asked for.
     """
-    if masses != "auto":
-        n = _masses(masses)
-        result = fit_chain(record, n)
-        ic = information_criterion(result, record)
-        return Choice(n, _refined(result, record, encoder, n), {n: ic}, {n: result.rms_residual})
+    auto = masses == "auto"
+    n_asked = None if auto else _masses(masses)
     check_excited(record)
-    singular = singular_values(record)
-    seen = masses_seen(singular, MAX_AUTO_MASSES)
-    fits: dict[int, Fit] = {}
-    refused: dict[int, str] = {}
-    for n in range(max(seen - 1, 1), min(seen + 1, MAX_AUTO_MASSES) + 1):
-        try:
-            fits[n] = fit_chain(record, n)
-        except UserError as error:
-            refused[n] = str(error)
-    if not fits:
-        raise UserError(" ".join(refused.values()))
-    lag = max(f.lag for f in fits.values())
-    criterion = {n: information_criterion(f, record, lag) for n, f in fits.items()}
-    best = min(criterion, key=criterion.__getitem__)
-    residual = {n: f.rms_residual for n, f in fits.items()}
-    chosen = _refined(fits[best], record, encoder, best)
-    return Choice(best, chosen, criterion, residual, refused, seen, singular)
+    lines = None  # excitation lines are not rejected: a lightly damped mode may sit on one
+    largest = max(MAX_AUTO_MASSES, n_asked or 0)
+    detected = detect_modes(record, largest, lines)
+    unknown = encoder is not None and not encoder.friction_given
+    raw = record
+    if unknown and detected.n:
+        # τ̂ was computed without friction: estimate it from the first modes, take it
+        # out of τ̂, and read the modes again
+        modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
+        J0, k0 = modes.chain()
+        D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
+        record = without_friction(raw, encoder, D_m, f_c)
+        encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+        detected = detect_modes(record, largest, lines)
+    n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    if unknown:
+        # the fit's friction is far better than the start's: read the modes once more
+        # with it, and fit again if they changed
+        D_m, f_c = result.extra["D_m"], result.extra["f_c"]
+        again = detect_modes(without_friction(raw, encoder, D_m, f_c), largest, lines)
+        if not _same_modes(again, detected):
+            record = without_friction(raw, encoder, D_m, f_c)
+            encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+            detected = again
+            n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    result.extra.update(
+        detected_modes_rad_s=[float(w) for w in detected.frequency],
+        residue_t_values=[float(t) for t in detected.t_value],
+        weak_modes=[{"rad_s": w, "t": t} for w, t in detected.weak],
+        excitation_lines_taken=[float(w) for w in detected.lines],
+        assumptions=assumptions(encoder),
+        warnings=[
+            f"the mode at {w:.1f} rad/s is weakly determined (residue t = {t:.0f} < "
+            f"{T_CONFIRM:g}); the information criterion chose {n} masses"
+            for w, t in zip(detected.frequency, detected.t_value)
+            if t < T_CONFIRM
+        ],
+    )
+    refused = {}
+    if detected.weak:
+        refused[n + 1] = missing_modes(detected, n + 1, record)
+    return Choice(
+        n,
+        result,
+        criterion,
+        {n: result.rms_residual},
+        refused,
+        detected.n,
+        detected.singular_values,
+    )
+
+
+def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes: Modes) -> Fit:
+    """The prediction-error fit of the chain with ``modes`` (:func:`refine`) from the
+    modal start (:meth:`Modes.chain`, dampers from the modal damping)."""
+    n = len(modes.frequency)
+    J0, k0 = modes.chain()
+    B0 = modal_damping(J0, k0, modes)
+    start = np.concatenate([J0, k0, B0])
+    note = (
+        "chain with the record's clamped modes "
+        + ", ".join(f"{w:.4g}" for w in modes.frequency)
+        + " rad/s (subspace stabilization diagram) and their residues"
+    )
+    first = Fit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
+    first.extra.update(_mode_evidence(modes))
+    result = refine(encoder, record, first, n)
+    if record is not None:
+        result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
+    return result
+
+
+def _same_modes(a: Detected, b: Detected, tolerance: float = 5e-3) -> bool:
+    """Two mode readings agree: as many modes, each within ``tolerance`` (relative)."""
+    if a.n != b.n:
+        return False
+    return bool(np.all(np.abs(a.frequency - b.frequency) <= tolerance * b.frequency))
+
+
+def _choose_and_fit(
+    record: MotorRecord,
+    encoder: EncoderRecord | None,
+    detected: Detected,
+    auto: bool,
+    n_asked: int | None,
+) -> tuple[int, Fit, dict[int, float]]:
+    """n (read, or asked and checked), the fit, and the criterion per n tried."""
+    n = detected.n if auto else n_asked
+    if n < 1 or detected.n < n:
+        raise IdentificationError(missing_modes(detected, n if n >= 1 else None, record))
+    if float(np.max(detected.t_value)) < T_CONFIRM:
+        raise IdentificationError(
+            "every mode the record shows is weakly determined (residue t values "
+            + ", ".join(f"{t:.0f}" for t in detected.t_value)
+            + f", all under {T_CONFIRM:g}): "
+            + missing_modes(detected, None, record)
+        )
+    criterion: dict[int, float] = {}
+    if encoder is None:
+        result = fit_chain(record, n, _strongest(detected, n))
+        criterion[n] = information_criterion(result, record)
+        return n, result, criterion
+    if auto and n >= 2:
+        # the data decide: BIC of the fits without the weakest modes, on the record's
+        # first CONFIRM_SECONDS, as long as dropping one more lowers it (a pole of the
+        # noise or of an excitation line adds nothing to the prediction of the encoder)
+        short = encoder_opening(encoder, CONFIRM_SECONDS)
+
+        def bic(m: int) -> float:
+            try:
+                trial = _prediction_error(None, short, _strongest(detected, m))
+                return trial.extra["information_criterion"]
+            except (IdentificationError, ValueError, np.linalg.LinAlgError):
+                return float("inf")  # no chain of m masses fits the opening
+
+        criterion[n] = bic(n)
+        while n >= 2:
+            criterion[n - 1] = bic(n - 1)
+            if not criterion[n - 1] < criterion[n]:
+                break
+            n -= 1
+    return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
+
+
+def _strongest(detected: Detected, n: int) -> Modes:
+    """The n modes with the largest residue t values, by frequency."""
+    if detected.n == n:
+        return detected.modes()
+    keep = np.sort(np.argsort(-detected.t_value)[:n])
+    return Modes(
+        detected.frequency[keep],
+        detected.damping[keep],
+        detected.residue[keep],
+        detected.singular_values,
+        detected.band,
+    )
+
+
+def _mode_evidence(modes: Modes) -> dict:
+    return {
+        "modes_rad_s": [float(w) for w in modes.frequency],
+        "damping_ratios": [float(z) for z in modes.damping],
+        "singular_values": [float(x) for x in modes.singular_values[:20]],
+    }
+
+
+def modal_damping(J: np.ndarray, k: np.ndarray, modes: Modes) -> np.ndarray:
+    """Spring dampers B_i ≥ 0 whose clamped modal damping matches the modes' (first
+    order in the damping: 2 ζ_i p_i = Σ_j B_j (φ_ji − φ_(j−1)i)², φ the mass-normalized
+    clamped mode shapes, φ_0 = 0), shape (n,); a floor of 1e-3 of their mean."""
+    n = len(J)
+    root = np.sqrt(np.asarray(J, dtype=float))
+    K = np.array(spring_matrix([float(x) for x in k]))[1:, 1:]
+    eigenvalues, shapes = np.linalg.eigh(K / root[:, None] / root[None, :])
+    phi = shapes / root[:, None]  # mass-normalized, rows: masses
+    stretch = np.diff(np.vstack([np.zeros(n), phi]), axis=0) ** 2  # (spring j, mode i)
+    target = 2.0 * np.clip(modes.damping, 1e-4, 0.2) * np.sqrt(eigenvalues)
+    B, _ = optimize.nnls(stretch.T, target)
+    floor = 1e-3 * max(float(np.mean(B)), 1e-12)
+    return np.maximum(B, floor)
+
+
+def friction_start(
+    record: MotorRecord, encoder: EncoderRecord, J: np.ndarray, k: np.ndarray, B: np.ndarray
+) -> tuple[float, float]:
+    """Start values ``(D_m, f_c)`` (N·m·s/rad, N·m) for a record whose τ̂_reac was
+    computed without friction: what the start chain leaves of τ̂ is
+    ``G[D_m ω + f_c sgn ω]``, linear in both (least squares; each at least a small
+    positive value)."""
+
+    def G(x: np.ndarray) -> np.ndarray:
+        return through_g(x, record.g_dist, record.h)
+
+    left = record.tau_hat - predict(record, J, k, B)
+    omega = encoder.velocity
+    X = np.column_stack([G(omega), G(np.sign(omega))])
+    coef = np.linalg.lstsq(X[1:], left[1:], rcond=None)[0]
+    torque = float(np.sqrt(np.mean(encoder.drive**2)))
+    return max(float(coef[0]), 1e-9), max(float(coef[1]), 1e-3 * torque)
+
+
+def without_friction(
+    record: MotorRecord, encoder: EncoderRecord, D_m: float, f_c: float
+) -> MotorRecord:
+    """``record`` with ``G[D_m ω + f_c s]`` taken out of τ̂_reac (ω, s: the encoder
+    record's velocity and friction sign)."""
+    friction = D_m * encoder.velocity + f_c * encoder.sign
+    friction[0] = 0.0
+    tau = record.tau_hat - through_g(friction, record.g_dist, record.h)
+    return replace(record, tau_hat=tau)
+
+
+def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
+    """What the result is conditional on, one line each (for the report)."""
+    scale = (
+        "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
+        "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
+        "homogeneous in torque); one of them alone off distorts the chain unevenly, by "
+        "up to about 1.5 ε (measured on a five-mass chain: k_t +5 % gave J_i, k_i "
+        "−1.5 … +7.3 %, J_m +5 % gave −0.5 … +4.2 %)"
+    )
+    out = {"actuator": scale}
+    if encoder is None:
+        out["fit"] = "output-error fit to τ̂_reac (no encoder counts given: encoder_cpr = 0)"
+        return out
+    out["encoder"] = f"{2 * np.pi / encoder.count:.0f} counts per revolution, error q²/12"
+    if encoder.friction_given:
+        out["friction"] = f"given: D_m = {encoder.D_m:.4g} N·m·s/rad, f_c = {encoder.f_c:.4g} N·m"
+    else:
+        out["friction"] = "fitted (D_m, f_c with standard errors)"
+    out["load"] = {
+        "none": "no load torque modelled",
+        "constant": "a constant load torque on the last mass, fitted",
+        "slow": "a constant plus slowly varying load torque on the last mass, fitted",
+    }[encoder.load]
+    return out
+
+
+def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str:
+    """Why the record cannot support n masses (n None: not even one), and what to do."""
+    found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
+    text = (
+        f"the record shows {detected.n} excited mode(s) below {detected.band:.0f} rad/s "
+        f"({found} rad/s)"
+    )
+    if n is not None:
+        text += f", {chain_of(n)} has {n}"
+    if detected.weak:
+        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
+        text += f"; seen but too weakly excited: {weak}"
+    if detected.lines:
+        lines = ", ".join(f"{w:.1f}" for w in detected.lines)
+        text += f"; poles at excitation lines ({lines} rad/s) were taken for the lines"
+    return text + (
+        ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
+        "lines on both sides of each mode, up to the band; a longer record; a finer "
+        f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
+        "see `excite`, or fit fewer masses"
+    )
 
 
 def _refined(result: Fit, record: MotorRecord, encoder: EncoderRecord | None, n: int) -> Fit:
@@ -169,5 +408,5 @@ def _masses(masses: int | str) -> int:
     except ValueError:
         n = 0
     if n < 1 or str(masses).strip() not in (str(n), "auto"):
-        raise UserError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
+        raise IdentificationError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
     return n

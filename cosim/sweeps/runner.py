@@ -71,7 +71,7 @@ def _materialize(blobs: Mapping[str, bytes]) -> Path:
 
 def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dict[str, float]:
     from arcosim.experiments.scenarios import SCENARIOS, run_scenario
-    from arcosim.fmu.flexchain import bench
+    from arcosim.fmu.flexchain import defaults
 
     settings = {**spec.fixed, **values}
     variables = fmu_variables(folder)
@@ -109,13 +109,13 @@ def _metrics(spec: SweepSpec, folder: Path, values: Mapping[str, object]) -> dic
     out: dict[str, float] = {}
     for metric in spec.metrics:
         if metric == "k_error":
-            out[metric] = percent_error(r["observer.k_hat"][-1], plant.get("k[1]", bench.K))
+            out[metric] = percent_error(r["observer.k_hat"][-1], plant.get("k[1]", defaults.K))
         elif metric == "B_error":
-            out[metric] = percent_error(r["observer.B_hat"][-1], plant.get("B[1]", bench.B))
+            out[metric] = percent_error(r["observer.B_hat"][-1], plant.get("B[1]", defaults.B))
         elif metric == "D_m_error":
-            out[metric] = percent_error(r["observer.D_m_hat"][-1], plant.get("D_m", bench.D_M))
+            out[metric] = percent_error(r["observer.D_m_hat"][-1], plant.get("D_m", defaults.D_M))
         elif metric == "f_c_error":
-            out[metric] = percent_error(r["observer.f_c_hat"][-1], plant.get("f_c", bench.F_C))
+            out[metric] = percent_error(r["observer.f_c_hat"][-1], plant.get("f_c", defaults.F_C))
         elif metric == "theta_error":
             motor = r["plant.theta_m_true"]
             for i in range(1, n + 1):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from ..flexchain import bench
+from ..flexchain import defaults
 from ..flexchain.dob import Actuator
 from ..flexchain.load_observer import LOAD_TORQUE_BANDWIDTH, SMOOTHING_RATIO
 from ..flexchain.observer import (
@@ -67,7 +67,7 @@ class ReactionTorqueObserver(FmuSlave):
     @classmethod
     def declare(cls) -> list[Variable]:
         n = cls.n_masses
-        J = bench.inertias(n)
+        J = defaults.inertias(n)
         return [
             inp(
                 "i_a",
@@ -84,11 +84,19 @@ class ReactionTorqueObserver(FmuSlave):
                 "0 = actuator self-identification (load detached), 1 = chain identification "
                 "from a rigid maneuver, 2 = state estimation",
             ),
-            par("J_mo", bench.J_M, "kg.m2", "Nominal motor inertia"),
-            par("k_to", bench.K_T, "N.m/A", "Nominal torque constant"),
-            par("g_dist", 100.0, "rad/s", "Bandwidth of the disturbance observer G(s) = g/(s+g)"),
+            par("J_mo", defaults.J_M, "kg.m2", "Nominal motor inertia"),
+            par("k_to", defaults.K_T, "N.m/A", "Nominal torque constant"),
             par(
-                "g_lpf", 100.0, "rad/s", "Bandwidth of the filter on later stages of the recursion"
+                "g_dist",
+                defaults.G_DIST,
+                "rad/s",
+                "Bandwidth of the disturbance observer G(s) = g/(s+g)",
+            ),
+            par(
+                "g_lpf",
+                defaults.G_LPF,
+                "rad/s",
+                "Bandwidth of the filter on later stages of the recursion",
             ),
             par("dkt", 0.0, "N.m/A", "Torque-constant error k_t - k_to (result of mode 0)"),
             par("dJm", 0.0, "kg.m2", "Motor inertia error J_m - J_mo (result of mode 0)"),
@@ -98,14 +106,14 @@ class ReactionTorqueObserver(FmuSlave):
             *array(
                 par,
                 "k",
-                [bench.K] * n,
+                [defaults.K] * n,
                 "N.m/rad",
                 lambda i: f"Stiffness of spring {i}, used in mode 2",
             ),
             *array(
                 par,
                 "B",
-                [bench.B] * n,
+                [defaults.B] * n,
                 "N.m.s/rad",
                 lambda i: f"Damping of spring {i}, used in mode 2",
             ),
@@ -125,7 +133,7 @@ class ReactionTorqueObserver(FmuSlave):
             ),
             par(
                 "encoder_cpr",
-                2000,
+                defaults.ENCODER_CPR,
                 "",
                 "Counts per revolution of the motor encoder (0 = angle not quantized). Mode 2 "
                 "takes the angle at the middle of its count (+pi/cpr); estimator 1 designs its "

@@ -23,8 +23,9 @@ observer keeps the value in that interval closest to its previous estimate
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+
+from .filters import lowpass_pole
 
 
 @dataclass(frozen=True)
@@ -141,7 +142,7 @@ class ReactionObserver:
         """
         if h != self._h:
             self._h = h
-            self._a = math.exp(-self.g * h)
+            self._a = lowpass_pole(self.g, h)
         a = self._a
         b = 1.0 - a
         w0 = self.omega

@@ -13,6 +13,13 @@ from __future__ import annotations
 import math
 
 
+def lowpass_pole(g: float, h: float) -> float:
+    """``e^{−g h}``: the pole of ``G(s) = g / (s + g)`` over a step of ``h`` (s) with the
+    input held, g in rad/s. The one discretization of G(s) in the project: the DOB, the
+    observers and the offline fits all take it from here."""
+    return math.exp(-g * h)
+
+
 class LowPassBank:
     """Several filters with one corner frequency, advanced together.
 
@@ -32,7 +39,7 @@ class LowPassBank:
 
     def step(self, h: float, u: list[float]) -> list[float]:
         """Advance every channel by ``h`` (s) with inputs ``u``; return the outputs."""
-        a = math.exp(-self.g * h)
+        a = lowpass_pole(self.g, h)
         b = 1.0 - a
         self.y = [a * y + b * x for y, x in zip(self.y, u)]
         return self.y

@@ -69,6 +69,7 @@ from dataclasses import dataclass
 
 from . import linalg
 from .driven_chain import continuous_matrices, discretize
+from .filters import lowpass_pole
 from .linalg import Matrix
 from .model_observer import (
     ModelObserver,
@@ -164,7 +165,7 @@ def load_step_model(
     chain = discretize(J, k, B, h)
     b_d = load_column(J, k, B, h, load_mass)
     m = 2 * n + 2
-    a = math.exp(-g_dist * h)
+    a = lowpass_pole(g_dist, h)
     b = 1.0 - a
     c, du = chain.torque_row()
     e_d = sum(J[i] / h * b_d[n + i] for i in range(n)) - 1.0  # τ̄ per unit d over the step

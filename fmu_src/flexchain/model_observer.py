@@ -21,13 +21,13 @@ angle, so the numbers stay small however far the drive has turned.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from operator import mul
 
 from . import linalg
 from .driven_chain import discretize
+from .filters import lowpass_pole
 from .linalg import Matrix
 
 #: Discretizations kept for distinct step sizes (a variable-step master may use a few).
@@ -115,7 +115,7 @@ def step_model(
     chain = discretize(J, k, B, h)
     n = chain.n
     m = 2 * n + 1
-    a = math.exp(-g_dist * h)
+    a = lowpass_pole(g_dist, h)
     b = 1.0 - a
     c, d = chain.torque_row()
     F = linalg.zeros(m, m)

@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from .filters import lowpass_pole
+
 #: Per step size: e^{−g_dist h}, e^{−g_lpf h}, and per stage (i, e^{−k_i h/B_i}, gain, J_i).
 Coefficients = tuple[float, float, list[tuple[int, float, float, float]]]
 
@@ -65,7 +67,7 @@ class ChainRecursion:
             (i, e, (1.0 - e) / k, J) for i, (e, k, J) in enumerate(zip(decay, self.k, self.J))
         ]
         self._h = h
-        self._coefficients = (math.exp(-self.g_dist * h), math.exp(-self.g_lpf * h), stages)
+        self._coefficients = (lowpass_pole(self.g_dist, h), lowpass_pole(self.g_lpf, h), stages)
         return self._coefficients
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from ...fmu.flexchain import bench
+from ...fmu.flexchain import defaults
 from ...fmu.flexchain.noise import gaussian, quantize
 from ...fmu.fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
 from ...fmu.fmukit.checks import chain_rate_problems
@@ -29,16 +29,16 @@ class MotorChainPlant(FmuSlave):
     @classmethod
     def declare(cls) -> list[Variable]:
         n = cls.n_masses
-        J = bench.inertias(n)
+        J = defaults.inertias(n)
         v: list[Variable] = [
             inp("i_ref", 0.0, "A", "Current command; held over each communication step"),
             *array(inp, "tau_ext", [0.0] * n, "N.m", lambda i: f"External torque on load mass {i}"),
-            par("J_m", bench.J_M, "kg.m2", "Motor (rotor) inertia"),
-            par("k_t", bench.K_T, "N.m/A", "Motor torque constant"),
-            par("D_m", bench.D_M, "N.m.s/rad", "Motor viscous friction coefficient"),
+            par("J_m", defaults.J_M, "kg.m2", "Motor (rotor) inertia"),
+            par("k_t", defaults.K_T, "N.m/A", "Motor torque constant"),
+            par("D_m", defaults.D_M, "N.m.s/rad", "Motor viscous friction coefficient"),
             par(
                 "f_c",
-                bench.F_C,
+                defaults.F_C,
                 "N.m",
                 "Motor Coulomb friction; the motor sticks while |drive torque| <= f_c",
             ),
@@ -46,14 +46,14 @@ class MotorChainPlant(FmuSlave):
             *array(
                 par,
                 "k",
-                [bench.K] * n,
+                [defaults.K] * n,
                 "N.m/rad",
                 lambda i: f"Stiffness of spring {i} (mass {i - 1} to {i})",
             ),
             *array(
                 par,
                 "B",
-                [bench.B] * n,
+                [defaults.B] * n,
                 "N.m.s/rad",
                 lambda i: f"Damping of spring {i} (mass {i - 1} to {i})",
             ),
@@ -66,12 +66,17 @@ class MotorChainPlant(FmuSlave):
             ),
             par(
                 "encoder_cpr",
-                2000,
+                defaults.ENCODER_CPR,
                 "",
                 "Encoder counts per revolution after quadrature (0 = ideal: exact angle "
                 "and true velocity)",
             ),
-            par("i_noise_std", 0.005, "A", "Standard deviation of the current sensor noise"),
+            par(
+                "i_noise_std",
+                defaults.I_NOISE_STD,
+                "A",
+                "Standard deviation of the current sensor noise",
+            ),
             par("seed", 1, "", "Seed of the current-noise sequence (same seed, same noise)"),
             par(
                 "current_bandwidth",

@@ -1,0 +1,335 @@
+"""Whole-chain rows on drives the project never tuned on (part of the accuracy benchmark).
+
+Logs come from :mod:`cosim.field_sim`, a drive simulator written apart from the
+project's plant; the chains are not the project's. Per row: a drive, an excitation and
+what the user gives (k_t, J_m, the encoder's counts; the friction or not; a load torque
+modelled or not); ``masses="auto"`` every time. Per seed (the seed changes the current
+noise and the multi-sine's phases): the n chosen, the errors of every J_i, k_i, B_i
+(and D_m, f_c, the load torque when fitted) and their standard errors, the wall and CPU
+time of the identification.
+
+Run: ``python -m cosim.field_accuracy [--seeds 20] [--rows NAME ...] [--out FILE.json]``
+(prints the markdown table); ``--speed`` times the identification instead (five-mass and
+three-mass at 1 kHz, three-mass at 4 kHz, 20 s; five-mass 10 and 40 s for the growth
+with record length).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from arcosim.errors import UserError
+from arcosim.fmu.flexchain.defaults import G_DIST
+from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
+from arcosim.identification.encoder_fit import encoder_record
+from arcosim.identification.output_error import motor_record
+from arcosim.identification.whole_chain import identify, split
+from benchmarks import field_sim
+
+#: The motor of most rows: the paper bench's EC motor class (kg·m², N·m/A, N·m·s/rad, N·m).
+J_M, K_T, D_M, F_C = 2.09e-5, 0.0406, 2e-5, 2e-3
+#: Identification multi-sine of most rows: 40 log-spaced lines 3–150 rad/s, 3 A peak, 20 s.
+LINES = np.geomspace(3.0, 150.0, 40)
+AMPLITUDE = 3.0
+DURATION = 20.0
+
+
+def _five_mass(top_share: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The chain whose clamped modes are 14.3, 42.3, 70.0, 86.8, 106.6 rad/s, residue
+    shares r_i/p_i² of k_1 = 0.4 N·m/rad: 0.2, 0.1, 0.05, 0.03 and ``top_share``."""
+    p = np.array([14.3, 42.3, 70.0, 86.8, 106.6])
+    r = p**2 * np.array([0.2, 0.1, 0.05, 0.03, top_share])
+    J, k = chain_from_modes(p, r)
+    return tuple(float(x) for x in J), tuple(float(x) for x in k)
+
+
+def _modal_chain(p: Sequence[float], shares: Sequence[float]):
+    """The chain with clamped modes ``p`` (rad/s) and residue shares r_i/p_i² (N·m/rad)."""
+    p = np.asarray(p, dtype=float)
+    J, k = chain_from_modes(p, p**2 * np.asarray(shares, dtype=float))
+    return tuple(float(x) for x in J), tuple(float(x) for x in k)
+
+
+def _damped(J: Sequence[float], k: Sequence[float], zeta: float) -> tuple[float, ...]:
+    """Spring dampers proportional to the springs, ζ = ``zeta`` on the first clamped mode."""
+    first = float(driving_point_modes(J, k)[0][0])
+    return tuple(2.0 * zeta * float(x) / first for x in k)
+
+
+@dataclass(frozen=True)
+class Row:
+    """One benchmark row.
+
+    Attributes:
+        name: row label.
+        drive: the simulated drive (truth).
+        h: sample step (s).
+        g_dist: DOB bandwidth for the modal start (rad/s).
+        lines: multi-sine lines (rad/s).
+        amplitude: current peak (A), or speed reference peak (rad/s) with ``speed_loop``.
+        speed_loop: PI gains (kp A·s/rad, ki A/rad) of a closed speed loop, or None.
+        friction_given: the user gives D_m, f_c.
+        load: the load model the user asks for.
+        note: one line for the table.
+    """
+
+    name: str
+    drive: field_sim.Drive
+    h: float = 1e-3
+    g_dist: float = G_DIST
+    lines: np.ndarray = field(default_factory=lambda: LINES)
+    amplitude: float = AMPLITUDE
+    speed_loop: tuple[float, float] | None = None
+    friction_given: bool = True
+    load: str = "none"
+    note: str = ""
+
+    def log(self, seed: int) -> field_sim.Log:
+        """Simulate the row's record for ``seed``."""
+        drive = replace(self.drive)
+        if self.speed_loop is None:
+            current = field_sim.multisine(self.lines, self.amplitude, seed=seed)
+            return field_sim.simulate(drive, self.h, DURATION, current=current, seed=seed)
+        kp, ki = self.speed_loop
+        # speed lines ∝ frequency: about equal torque per line, as an open-loop current
+        reference = field_sim.multisine(self.lines, self.amplitude, seed=seed, slope=1.0)
+        loop = field_sim.SpeedLoop(kp, ki, reference, limit=10.0)
+        return field_sim.simulate(drive, self.h, DURATION, speed_loop=loop, seed=seed)
+
+
+def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
+    base = dict(J_m=J_M, k_t=K_T, D_m=D_M, f_c=F_C, current_noise=0.005, counts=2000)
+    base.update(kw)
+    return field_sim.Drive(J=tuple(J), k=tuple(k), B=_damped(J, k, zeta), **base)
+
+
+_FIVE = _five_mass(0.005)
+_THREE = ((3e-4, 5e-4, 4e-4), (0.25, 0.4, 0.15))
+_CLOSE = _modal_chain((20.0, 40.0, 42.0), (0.3, 0.1, 0.1))  # two modes 5 % apart
+_BELT = ((6e-4, 3e-4), (20.0, 10.0))
+
+ROWS: dict[str, Row] = {
+    r.name: r
+    for r in (
+        Row("five-mass, weak top mode", _drive(*_FIVE), note="modes 14.3–106.6, top share 0.5 %"),
+        Row(
+            "five-mass, friction fitted",
+            _drive(*_FIVE),
+            friction_given=False,
+            note="only k_t, J_m given",
+        ),
+        Row("three-mass, 4 kHz", _drive(*_THREE), h=2.5e-4),
+        Row("three-mass, 10 kHz", _drive(*_THREE), h=1e-4),
+        Row(
+            "closely spaced modes",
+            _drive(*_CLOSE),
+            note="clamped modes 20, 40, 42 rad/s",
+        ),
+        Row(
+            "belt-like two-mass, 4 kHz, friction",
+            _drive(
+                *_BELT, J_m=1.2e-4, k_t=0.1, D_m=1e-4, f_c=0.01, current_noise=0.01, counts=2**14
+            ),
+            h=2.5e-4,
+            g_dist=400.0,
+            lines=np.geomspace(10.0, 600.0, 40),
+            amplitude=6.0,
+            note="J_m 1.2e-4, k 20/10, 16384 counts, lines 10–600",
+        ),
+        Row(
+            "five-mass, PI speed loop",
+            _drive(*_FIVE),
+            amplitude=40.0,
+            speed_loop=(0.3, 2.25),
+            note="closed loop, speed lines ∝ frequency, 40 rad/s peak",
+        ),
+        Row(
+            "three-mass, slow load torque",
+            _drive(*_THREE, load_sine=(0.01, 0.3)),
+            load="slow",
+            note="0.01 N·m sine at 0.3 rad/s on the last mass",
+        ),
+        Row(
+            "three-mass, PI loop, constant load",
+            _drive(*_THREE, load_torque=0.01),
+            amplitude=40.0,
+            speed_loop=(0.3, 2.25),
+            load="constant",
+            note="0.01 N·m on the last mass, held by the speed loop",
+        ),
+    )
+}
+
+
+def run_row(row: Row, seed: int) -> dict:
+    """Identify one record of ``row``: errors (%) and standard errors (%) per parameter."""
+    log = row.log(seed)
+    d = row.drive
+    D_m, f_c = (d.D_m, d.f_c) if row.friction_given else (0.0, 0.0)
+    actuator = Actuator(d.J_m, d.k_t, 0.0, 0.0, D_m, f_c)
+    wall, cpu = time.perf_counter(), time.process_time()
+    record = motor_record(log.time, log.i_a, log.omega_m, log.theta_m, actuator, row.g_dist)
+    encoder = encoder_record(
+        log.time, log.i_a, log.theta_m, actuator, d.counts, row.friction_given, row.load
+    )
+    out: dict = {"seed": seed, "stuck_fraction": log.stuck_fraction}
+    try:
+        choice = identify(record, "auto", encoder)
+    except UserError as error:
+        out.update(n=0, error=str(error))
+        choice = None
+    out["seconds"] = time.perf_counter() - wall
+    out["cpu_seconds"] = time.process_time() - cpu
+    if choice is None:
+        return out
+    n = choice.n
+    out.update(n=n, modes=choice.fit.extra["modes_rad_s"], weak=choice.fit.extra["weak_modes"])
+    if n != d.n:
+        return out
+    fit = choice.fit
+    J, k, B = split(fit.values, n)
+    std = fit.std
+    truth = {"J": d.J, "k": d.k, "B": d.B}
+    for key, values, offset in (("J", J, 0), ("k", k, n), ("B", B, 2 * n)):
+        out[key] = [100.0 * (v / t - 1.0) for v, t in zip(values, truth[key])]
+        out[key + "_std"] = [100.0 * s / t for s, t in zip(std[offset : offset + n], truth[key])]
+    values = fit.as_dict()
+    stds = fit.std_dict()
+    extra_truth = {"D_m": d.D_m, "f_c": d.f_c}
+    if row.load != "none":
+        extra_truth["tau_load"] = d.load_torque
+    for name, t in extra_truth.items():
+        if name in values:
+            out[name] = {"value": values[name], "std": stds[name], "truth": t}
+    return out
+
+
+def summary(results: list[dict], row: Row) -> dict:
+    """Counts over seeds: n right, largest |J_i|, |k_i| error, B_i (and J_i, k_i) within 2σ."""
+    right = [r for r in results if r.get("n") == row.drive.n]
+
+    def inside(key: str) -> tuple[int, int]:
+        hits = sum(abs(e) <= 2 * s for r in right for e, s in zip(r[key], r[key + "_std"]))
+        return int(hits), len(right) * row.drive.n
+
+    def worst(key: str) -> float:
+        return max((abs(e) for r in right for e in r[key]), default=float("nan"))
+
+    return {
+        "seeds": len(results),
+        "n_right": len(right),
+        "n_chosen": [r.get("n") for r in results],
+        "max_abs_J_error_percent": worst("J"),
+        "max_abs_k_error_percent": worst("k"),
+        "B_inside_2_sigma": inside("B"),
+        "J_inside_2_sigma": inside("J"),
+        "k_inside_2_sigma": inside("k"),
+        "median_abs_B_error_percent": float(np.median([abs(e) for r in right for e in r["B"]]))
+        if right
+        else float("nan"),
+        "seconds_median": float(np.median([r["seconds"] for r in results])),
+        "seconds_max": float(np.max([r["seconds"] for r in results])),
+        "cpu_seconds_median": float(np.median([r["cpu_seconds"] for r in results])),
+        "stuck_fraction_median": float(np.median([r["stuck_fraction"] for r in results])),
+    }
+
+
+def markdown(summaries: dict[str, dict]) -> str:
+    """The table."""
+    lines = [
+        "| row | n right | max abs J_i err % | max abs k_i err % | B_i within 2σ "
+        "| J_i, k_i within 2σ | B_i err % (median abs) | s wall (median / max) | s CPU (median) |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name, s in summaries.items():
+        b, j, k = s["B_inside_2_sigma"], s["J_inside_2_sigma"], s["k_inside_2_sigma"]
+        lines.append(
+            f"| {name} | {s['n_right']} of {s['seeds']} | {s['max_abs_J_error_percent']:.2f} "
+            f"| {s['max_abs_k_error_percent']:.2f} | {b[0]} of {b[1]} "
+            f"| {j[0] + k[0]} of {j[1] + k[1]} | {s['median_abs_B_error_percent']:.1f} "
+            f"| {s['seconds_median']:.1f} / {s['seconds_max']:.1f} "
+            f"| {s['cpu_seconds_median']:.1f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+#: Speed rows: (label, row, record length s).
+SPEED = (
+    ("five-mass, 1 kHz, 20 s", "five-mass, weak top mode", 20.0),
+    ("three-mass, 1 kHz, 20 s", "three-mass, slow load torque", 20.0),
+    ("three-mass, 4 kHz, 20 s", "three-mass, 4 kHz", 20.0),
+    ("five-mass, 1 kHz, 10 s", "five-mass, weak top mode", 10.0),
+    ("five-mass, 1 kHz, 40 s", "five-mass, weak top mode", 40.0),
+)
+
+
+def speed(repeats: int = 3) -> list[dict]:
+    """Wall and CPU seconds of the identification (log → result, simulation excluded),
+    median of ``repeats``; the three-mass 1 kHz row without its load model."""
+    global DURATION
+    out = []
+    for label, name, seconds in SPEED:
+        row = ROWS[name]
+        if row.load != "none":
+            row = replace(row, load="none", drive=replace(row.drive, load_sine=(0.0, 0.0)))
+        saved, DURATION = DURATION, seconds
+        try:
+            runs = [run_row(row, seed) for seed in range(1, repeats + 1)]
+        finally:
+            DURATION = saved
+        out.append(
+            {
+                "what": label,
+                "n_right": sum(r.get("n") == row.drive.n for r in runs),
+                "seconds": float(np.median([r["seconds"] for r in runs])),
+                "cpu_seconds": float(np.median([r["cpu_seconds"] for r in runs])),
+                "load_average": os.getloadavg()[0],
+            }
+        )
+    return out
+
+
+def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = print) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--rows", nargs="*", default=list(ROWS))
+    parser.add_argument("--out", type=Path)
+    parser.add_argument("--speed", action="store_true", help="time the speed rows instead")
+    args = parser.parse_args(argv)
+    if args.speed:
+        rows = speed()
+        print("| what | n right | s wall (median of 3) | s CPU | load average |")
+        print("|---|---|---|---|---|")
+        for r in rows:
+            print(
+                f"| {r['what']} | {r['n_right']} of 3 | {r['seconds']:.2f} "
+                f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
+            )
+        return 0
+    results: dict[str, list[dict]] = {}
+    summaries: dict[str, dict] = {}
+    for name in args.rows:
+        row = ROWS[name]
+        results[name] = []
+        for seed in range(1, args.seeds + 1):
+            r = run_row(row, seed)
+            results[name].append(r)
+            progress(f"{name}, seed {seed}: n = {r.get('n')}, {r['seconds']:.1f} s")
+        summaries[name] = summary(results[name], row)
+        if args.out:
+            args.out.write_text(json.dumps({"summary": summaries, "runs": results}, indent=1))
+    print(markdown(summaries))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,181 @@
+"""The excitation a user plays on a drive for whole-chain identification (offline design).
+
+:func:`excite` turns a band and a current limit into a multi-sine: as arrays, and (for a
+current) as the ExcitationSource FMU's parameters, which play the same signal (the same
+``flexchain.excitation`` functions). What the design rests on, measured on the
+whole-chain rows (README):
+
+* many lines across the band (40 log-spaced lines; 11 let the subspace step take lines
+  for modes), lines on both sides of every mode, the top line below the band the
+  sample rate leaves (0.3/h) and below 3·g_dist;
+* enough torque that the motor rarely sticks: an rms torque k_t·A/√(2L) of at least
+  :data:`TORQUE_PER_FRICTION` times f_c (the bench motor at 1 A on 40 lines stuck 18 %
+  of the time and biased J_i by 1.5 %; at 3 A, 0.2 % and within 0.1 %);
+* motion the encoder sees at the top of the band: a line there, moving the motor by a
+  (rad) against the counts' noise q/√12 per sample, is seen with t = a·√(6N)/q over N
+  samples; below :data:`LINE_T` (rigid-body motion, J_total known: a lower bound) the
+  modes up there sink into the counts (the stiff belt drive of issue 19: t ≈ 1.6);
+* in a closed speed loop, a speed reference whose lines grow with frequency (about equal
+  torque per line, as an open-loop current): equal speed lines leave the top modes
+  unexcited.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from arcosim.fmu.flexchain import excitation
+from arcosim.fmu.flexchain.defaults import STEP
+
+#: Lines of the multi-sine (log-spaced over the band).
+LINES = 40
+#: Record length (s).
+DURATION = 20.0
+#: Least rms drive torque, in units of the Coulomb friction f_c.
+TORQUE_PER_FRICTION = 5.0
+#: Least t value of the top line's motor motion against the encoder's counts.
+LINE_T = 5.0
+#: ExcitationSource's multi-sine signal code (fmu_src/arsource/fmu.py).
+MULTISINE = 1
+
+
+class ExcitationError(ValueError):
+    """A band or limit no excitation can meet; the message says what to change."""
+
+
+@dataclass
+class Excitation:
+    """A designed multi-sine.
+
+    Attributes:
+        kind: ``"current"`` (A) or ``"speed"`` (rad/s, a speed loop's reference).
+        time: sample times (s), shape (N,).
+        signal: the command at each sample (A or rad/s), shape (N,).
+        frequencies: the lines (rad/s), shape (L,).
+        amplitudes: each line's amplitude (A or rad/s), shape (L,).
+        phases: each line's phase (rad), shape (L,).
+        source_parameters: ExcitationSource parameters that play the same current
+            (``None`` for a speed reference: the FMU's lines are all equal).
+        warnings: what the design could not meet, one line each.
+    """
+
+    kind: str
+    time: np.ndarray
+    signal: np.ndarray
+    frequencies: np.ndarray
+    amplitudes: np.ndarray
+    phases: np.ndarray
+    source_parameters: dict | None
+    warnings: list[str] = field(default_factory=list)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """CSV columns: ``time`` and ``i_ref`` (current) or ``omega_ref`` (speed)."""
+        return {"time": self.time, "i_ref" if self.kind == "current" else "omega_ref": self.signal}
+
+
+def excite(
+    band: tuple[float, float],
+    current_limit: float,
+    h: float = STEP,
+    duration: float = DURATION,
+    lines: int = LINES,
+    kind: str = "current",
+    seed: int = 1,
+    k_t: float | None = None,
+    f_c: float | None = None,
+    J_total: float | None = None,
+    counts: int | None = None,
+    g_dist: float | None = None,
+    speed_gain: float | None = None,
+) -> Excitation:
+    """Design the identification multi-sine.
+
+    Args:
+        band: lowest and highest line (rad/s).
+        current_limit: the drive's peak current (A): a current multi-sine's lines add up
+            to it, so the command never exceeds it.
+        h: sample step (s).
+        duration: record length (s).
+        lines: number of log-spaced lines.
+        kind: ``"current"`` (open loop) or ``"speed"`` (reference of a PI speed loop with
+            proportional gain ``speed_gain``, A·s/rad: lines ∝ frequency, whose currents
+            through the gain add up to ``current_limit``).
+        seed: phases (the ExcitationSource's seed).
+        k_t, f_c, J_total, counts, g_dist: when given, the design is checked against the
+            friction (sticking), the encoder (motion at the top line) and the DOB band.
+
+    Raises:
+        ExcitationError: for a band that is empty or above what the sample rate leaves,
+            a non-positive limit, or a speed design without ``speed_gain``.
+    """
+    low, high = (float(x) for x in band)
+    if not 0.0 < low < high:
+        raise ExcitationError(f"the band must be 0 < low < high rad/s, got {band}")
+    if high > 0.3 / h:
+        raise ExcitationError(
+            f"the top line {high:g} rad/s is above 0.3/h = {0.3 / h:.0f} rad/s: sample faster "
+            "or lower the band"
+        )
+    if not current_limit > 0:
+        raise ExcitationError(f"the current limit must be > 0 A, got {current_limit}")
+    if lines < 1:
+        raise ExcitationError(f"need at least one line, got {lines}")
+    if kind not in ("current", "speed"):
+        raise ExcitationError(f"kind must be 'current' or 'speed', got {kind!r}")
+    frequencies = np.array(excitation.log_spaced(low, high, lines))
+    phases = np.array(excitation.multisine_phases(lines, seed))
+    time = np.arange(round(duration / h) + 1) * h
+    warnings: list[str] = []
+    if kind == "current":
+        amplitudes = np.full(lines, current_limit / lines)
+        parameters = {
+            "signal": MULTISINE,
+            "amplitude": float(current_limit),
+            "frequency": low,
+            "frequency_end": high,
+            "lines": int(lines),
+            "seed": int(seed),
+        }
+        per_line_current = amplitudes
+    else:
+        if not speed_gain or speed_gain <= 0:
+            raise ExcitationError("a speed reference needs the loop's gain (speed_gain, A·s/rad)")
+        # above the loop's bandwidth the loop turns the reference r into kp·r of current;
+        # lines ∝ frequency, scaled so that those currents add up to the limit
+        shape = frequencies / high
+        amplitudes = (current_limit / speed_gain) * shape / shape.sum()
+        parameters = None
+        per_line_current = speed_gain * amplitudes
+        warnings.append(
+            "a speed reference with lines growing with frequency is not an ExcitationSource "
+            "signal: play the CSV"
+        )
+    signal = np.sin(np.outer(time, frequencies) + phases) @ amplitudes
+    if k_t and f_c:
+        rms_torque = k_t * float(np.sqrt(np.sum(per_line_current**2) / 2.0))
+        if rms_torque < TORQUE_PER_FRICTION * f_c:
+            need = TORQUE_PER_FRICTION * f_c / rms_torque
+            warnings.append(
+                f"rms drive torque {rms_torque:.3g} N·m is under {TORQUE_PER_FRICTION:g}·f_c: "
+                f"the motor will stick often; raise the current {need:.1f}× or use fewer lines"
+            )
+    if k_t and J_total and counts:
+        motion = k_t * float(per_line_current[-1]) / (J_total * high**2)
+        seen = motion / (2.0 * math.pi / counts)
+        t_value = seen * math.sqrt(6.0 * len(time))
+        if t_value < LINE_T:
+            warnings.append(
+                f"a line at {high:g} rad/s moves the motor by about {seen:.2g} counts "
+                f"(t = {t_value:.1f} over the record): the encoder cannot see the modes up "
+                "there; raise the current, use fewer lines, a longer record, a lower band "
+                "or a finer encoder"
+            )
+    if g_dist and high > 3.0 * g_dist:
+        warnings.append(
+            f"lines above 3·g_dist = {3 * g_dist:g} rad/s: the modal start reads modes only "
+            "below it (raise g_dist)"
+        )
+    return Excitation(kind, time, signal, frequencies, amplitudes, phases, parameters, warnings)

@@ -1,0 +1,227 @@
+"""Identify a drive from its log: every J_i, k_i, B_i of the load chain (and n), from the
+motor's current and encoder alone, with only the motor's datasheet values known.
+
+:func:`identify_drive` is the one call for the whole job (what ``arcosim identify LOG
+--method whole-chain`` runs): it builds the records the fits need from the log
+(:func:`~arcosim.identification.output_error.motor_record`,
+:func:`~arcosim.identification.encoder_fit.encoder_record`), runs
+:func:`~arcosim.identification.whole_chain.identify`, and returns the result with what
+it rests on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from arcosim.fmu.flexchain.defaults import G_DIST
+from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.encoder_fit import LOADS, encoder_record
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.output_error import MotorRecord, motor_record
+from arcosim.identification.whole_chain import Choice, identify
+
+
+@dataclass(frozen=True)
+class DriveIdentification:
+    """The identified drive, and the evidence and assumptions it rests on.
+
+    Parameters
+    ----------
+    masses : int
+        Number of load masses (a count), read from the record with ``masses="auto"``.
+    parameters : dict of str to float
+        ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad) — the observer
+        FMU's own parameter names — and, when fitted, ``D_m`` (N·m·s/rad), ``f_c``
+        (N·m) and the load torque (N·m).
+    std : dict of str to float
+        Their standard errors (Newey–West), same names and units.
+    assumptions : dict of str to str
+        What the result is conditional on (k_t and J_m given, the encoder's counts,
+        friction given or fitted, the load model), one sentence each.
+    warnings : list of str
+        What may limit the result (a weakly determined mode), one sentence each.
+    choice : Choice
+        The whole-chain fit's evidence (modes, criterion per n, refusals).
+    record : MotorRecord
+        The reaction-torque record the fit started from.
+
+    Examples
+    --------
+    >>> from arcosim.identification.drive import DriveIdentification
+    >>> sorted(DriveIdentification.__dataclass_fields__)[:3]
+    ['assumptions', 'choice', 'masses']
+    """
+
+    masses: int
+    parameters: dict[str, float]
+    std: dict[str, float]
+    assumptions: dict[str, str]
+    warnings: list[str] = field(default_factory=list)
+    choice: Choice | None = None
+    record: MotorRecord | None = None
+
+    def chain(self) -> dict[str, float]:
+        """``J[i]``, ``k[i]``, ``B[i]`` only: the observer's parameters for mode 2."""
+        return {k: v for k, v in self.parameters.items() if k[0] in "JkB" and "[" in k}
+
+    def report(self) -> dict[str, object]:
+        """Everything, JSON-able (what ``arcosim identify --json`` prints)."""
+        fit = self.choice.fit
+        record = self.record
+        extra = fit.extra
+        out: dict[str, object] = {"method": "whole-chain", "masses": self.masses}
+        out.update(self.parameters)
+        out["std"] = dict(self.std)
+        out.update(
+            start=fit.start_note,
+            velocity=record.velocity_source,
+            rms_residual=fit.rms_residual,
+            rms_data=fit.rms_data,
+            newey_west_lag=fit.lag,
+            duration=record.duration,
+            evaluations=fit.evaluations,
+            modes_rad_s=extra["modes_rad_s"],
+            damping_ratios=extra["damping_ratios"],
+            residue_t_values=extra["residue_t_values"],
+            weak_modes=extra["weak_modes"],
+            refused={str(n): why for n, why in self.choice.refused.items()},
+            assumptions=dict(self.assumptions),
+            warnings=list(self.warnings),
+            criterion={str(n): v for n, v in self.choice.criterion.items()},
+            masses_seen=self.choice.seen,
+        )
+        if self.choice.singular_values is not None:
+            out["singular_values"] = [float(x) for x in self.choice.singular_values[:16]]
+        if "load_torque_range" in extra:
+            out["load_torque_range"] = extra["load_torque_range"]
+        return out
+
+
+def identify_drive(
+    time: Sequence[float] | np.ndarray,
+    i_a: Sequence[float] | np.ndarray,
+    omega_m: Sequence[float] | np.ndarray,
+    theta_m: Sequence[float] | np.ndarray,
+    *,
+    k_t: float,
+    J_m: float,
+    encoder_cpr: int,
+    masses: int | str = "auto",
+    D_m: float | None = None,
+    f_c: float | None = None,
+    load: str = "none",
+    g_dist: float = G_DIST,
+) -> DriveIdentification:
+    """Every J_i, k_i, B_i of the load chain, and n, from a drive log.
+
+    Only the motor's datasheet values are needed: k_t and J_m (a common error of both
+    scales every J_i, k_i, B_i by the same factor; the result says so). The motor's
+    friction is fitted with the chain unless both ``D_m`` and ``f_c`` are given.
+
+    Parameters
+    ----------
+    time : array_like
+        Sample times (s), shape ``(N,)``, a constant step.
+    i_a : array_like
+        Motor current (A), shape ``(N,)``: the current that acted over the step ending
+        at each sample (the timing contract).
+    omega_m : array_like
+        Motor velocity (rad/s), shape ``(N,)`` (the encoder's backward difference is
+        fine: it is recognised and replaced by a lag-free derivative).
+    theta_m : array_like
+        Motor angle (rad), shape ``(N,)``, as the encoder gives it (whole counts).
+    k_t : float
+        Torque constant (N·m/A), from the datasheet.
+    J_m : float
+        Motor inertia (kg·m²), from the datasheet.
+    encoder_cpr : int
+        The encoder's counts per revolution (a count); 0 for an angle that is not
+        quantized (then the friction must be given and no load torque modelled).
+    masses : int or "auto"
+        Number of load masses (a count), or ``"auto"`` to read it from the record.
+    D_m, f_c : float, optional
+        Motor viscous (N·m·s/rad) and Coulomb (N·m) friction, when known; fitted
+        otherwise.
+    load : {"none", "constant", "slow"}
+        A load torque on the last mass in the model: none, constant, or constant
+        plus a slow drift (fitted and reported).
+    g_dist : float
+        Bandwidth of the disturbance observer that computes τ̂_reac (rad/s).
+
+    Returns
+    -------
+    DriveIdentification
+        The chain, its standard errors, and what the result rests on.
+
+    Raises
+    ------
+    IdentificationError
+        A record that cannot support the chain (the message names the missing or weak
+        mode and what would fix the record), or settings the fit cannot use.
+
+    Examples
+    --------
+    A two-mass chain simulated here (the project's own simulator of the plant's
+    physics), identified from the motor's current and encoder:
+
+    >>> from arcosim.plant.motorchain.physics import PlantPhysics
+    >>> from arcosim.fmu.flexchain import excitation
+    >>> h, J, k, B = 1e-3, [4e-4, 8e-4], [0.3, 0.2], [2e-5, 1.5e-5]
+    >>> plant = PlantPhysics(J_m=2.09e-5, k_t=0.0406, D_m=0.0, f_c=0.0, J=J, k=k, B=B)
+    >>> lines = excitation.log_spaced(3.0, 150.0, 40)
+    >>> phases = excitation.multisine_phases(40, 1)
+    >>> t = np.arange(20001) * h
+    >>> current = [excitation.multisine(x, 3.0, lines, phases) for x in t]
+    >>> angle = [0.0]
+    >>> for i in current[1:]:
+    ...     angle.append(plant.step(h, i)[0])
+    >>> counts = 2.0 * np.pi / 16384
+    >>> theta = np.floor(np.array(angle) / counts) * counts
+    >>> omega = np.concatenate([[0.0], np.diff(theta) / h])
+    >>> result = arcosim.identify_drive(
+    ...     t, current, omega, theta, k_t=0.0406, J_m=2.09e-5, encoder_cpr=16384,
+    ...     D_m=0.0, f_c=0.0)
+    >>> result.masses
+    2
+    >>> [round(result.parameters[f"k[{i}]"], 3) for i in (1, 2)]
+    [0.3, 0.2]
+    """
+    if not (k_t > 0 and J_m > 0):
+        raise IdentificationError(f"k_t and J_m must be > 0, got k_t = {k_t}, J_m = {J_m}")
+    if load not in LOADS:
+        raise IdentificationError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
+    friction_given = D_m is not None and f_c is not None
+    # fitted friction: the DOB's τ̂ (the modal start) is computed without it
+    actuator = (
+        Actuator(J_m, k_t, 0.0, 0.0, D_m or 0.0, f_c or 0.0)
+        if friction_given
+        else (Actuator(J_m, k_t))
+    )
+    time, i_a, omega_m, theta_m = (
+        np.asarray(x, dtype=float) for x in (time, i_a, omega_m, theta_m)
+    )
+    record = motor_record(time, i_a, omega_m, theta_m, actuator, g_dist)
+    encoder = None
+    if encoder_cpr > 0:
+        encoder = encoder_record(
+            time, i_a, theta_m, actuator, encoder_cpr, friction_given, load, g_dist
+        )
+    elif not friction_given or load != "none":
+        raise IdentificationError(
+            "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
+            "(D_m and f_c) and no load torque model"
+        )
+    choice = identify(record, masses, encoder)
+    fit = choice.fit
+    return DriveIdentification(
+        masses=choice.n,
+        parameters=fit.as_dict(),
+        std=fit.std_dict(),
+        assumptions=dict(fit.extra["assumptions"]),
+        warnings=list(fit.extra["warnings"]),
+        choice=choice,
+        record=record,
+    )
