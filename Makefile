@@ -17,7 +17,7 @@ build: $(STAMP)
 	$(BIN)/arcosim build --out dist
 
 demo: build
-	$(BIN)/arcosim reproduce --fmus dist
+	$(BIN)/arcosim reproduce --fmus dist --force
 
 test: build
 	$(BIN)/arcosim validate dist/*.fmu

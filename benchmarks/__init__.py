@@ -4,8 +4,8 @@
   (``arcosim bench accuracy``, or ``python -m benchmarks.accuracy``);
 - :mod:`benchmarks.speed`: µs per co-simulation step and seconds per fit
   (``arcosim bench speed``, or ``python -m benchmarks.speed``);
-- :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`: one-off measurements, run as
-  scripts.
+- :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`, :mod:`benchmarks.noise_envelope`:
+  one-off measurements, run as scripts.
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """

@@ -21,7 +21,7 @@ then run again on the recorded logs, offline, in every configuration (the same
 
 The bench also gets the honesty check of B's standard error (over ``--b-seeds`` seeds)
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
-within 10 %. Then the whole-chain identification rows (``cosim/chain_accuracy.py``:
+within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accuracy.py``:
 three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
 Last, the load torque rows (``cosim/load_accuracy.py``: the two- and five-mass chains,
 the load on the last and on a middle mass, a model with springs 5 % off, the same
@@ -54,7 +54,7 @@ from arcosim.fmu.flexchain.observer import (
 )
 from arcosim.identification.offline_observer import estimate_states, replay
 from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
-from benchmarks import chain_accuracy, load_accuracy
+from benchmarks import chain_accuracy, field_accuracy, load_accuracy
 from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
 #: Broadband lines (rad/s): the flexible scenario's plus 150 for the five-mass chain.
@@ -324,6 +324,15 @@ def run(
         "\nWhole-chain identification (`--method whole-chain --masses auto`, scenario "
         f"`identification`, {len(chain_seeds)} seeds; only the actuator known):\n\n"
         + chain_accuracy.markdown(whole)
+    )
+    names = list(field_accuracy.ROWS)[:1] if quick else list(field_accuracy.ROWS)
+    field_rows, _ = field_accuracy.score_rows(names, chain_seeds, progress)
+    summary["whole_chain_field"] = field_rows
+    text += (
+        "\nWhole-chain identification on drives the project never tuned on (logs from "
+        "`benchmarks/field_sim.py`, a simulator written apart from the plant; "
+        f"{len(chain_seeds)} seeds; `auto`; only k_t, J_m and the counts known, the friction "
+        "where the row says):\n\n" + field_accuracy.markdown(field_rows)
     )
     load_text, load_summary = _load_torque_table(chain_seeds, quick, progress)
     text += load_text

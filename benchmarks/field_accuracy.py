@@ -1,6 +1,6 @@
 """Whole-chain rows on drives the project never tuned on (part of the accuracy benchmark).
 
-Logs come from :mod:`cosim.field_sim`, a drive simulator written apart from the
+Logs come from :mod:`benchmarks.field_sim`, a drive simulator written apart from the
 project's plant; the chains are not the project's. Per row: a drive, an excitation and
 what the user gives (k_t, J_m, the encoder's counts; the friction or not; a load torque
 modelled or not); ``masses="auto"`` every time. Per seed (the seed changes the current
@@ -8,7 +8,7 @@ noise and the multi-sine's phases): the n chosen, the errors of every J_i, k_i, 
 (and D_m, f_c, the load torque when fitted) and their standard errors, the wall and CPU
 time of the identification.
 
-Run: ``python -m cosim.field_accuracy [--seeds 20] [--rows NAME ...] [--out FILE.json]``
+Run: ``python -m benchmarks.field_accuracy [--seeds 20] [--rows NAME ...] [--out FILE.json]``
 (prints the markdown table); ``--speed`` times the identification instead (five-mass and
 three-mass at 1 kHz, three-mass at 4 kHz, 20 s; five-mass 10 and 40 s for the growth
 with record length).
@@ -26,13 +26,11 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.errors import UserError
 from arcosim.fmu.flexchain.defaults import G_DIST
-from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
-from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.output_error import motor_record
-from arcosim.identification.whole_chain import identify, split
+from arcosim.identification.drive import identify_drive
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.whole_chain import split
 from benchmarks import field_sim
 
 #: The motor of most rows: the paper bench's EC motor class (kg·m², N·m/A, N·m·s/rad, N·m).
@@ -93,17 +91,17 @@ class Row:
     load: str = "none"
     note: str = ""
 
-    def log(self, seed: int) -> field_sim.Log:
-        """Simulate the row's record for ``seed``."""
+    def log(self, seed: int, duration: float = DURATION) -> field_sim.Log:
+        """Simulate the row's record (``duration`` s) for ``seed``."""
         drive = replace(self.drive)
         if self.speed_loop is None:
             current = field_sim.multisine(self.lines, self.amplitude, seed=seed)
-            return field_sim.simulate(drive, self.h, DURATION, current=current, seed=seed)
+            return field_sim.simulate(drive, self.h, duration, current=current, seed=seed)
         kp, ki = self.speed_loop
         # speed lines ∝ frequency: about equal torque per line, as an open-loop current
         reference = field_sim.multisine(self.lines, self.amplitude, seed=seed, slope=1.0)
         loop = field_sim.SpeedLoop(kp, ki, reference, limit=10.0)
-        return field_sim.simulate(drive, self.h, DURATION, speed_loop=loop, seed=seed)
+        return field_sim.simulate(drive, self.h, duration, speed_loop=loop, seed=seed)
 
 
 def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
@@ -170,27 +168,34 @@ ROWS: dict[str, Row] = {
 }
 
 
-def run_row(row: Row, seed: int) -> dict:
+def run_row(row: Row, seed: int, duration: float = DURATION) -> dict:
     """Identify one record of ``row``: errors (%) and standard errors (%) per parameter."""
-    log = row.log(seed)
+    log = row.log(seed, duration)
     d = row.drive
-    D_m, f_c = (d.D_m, d.f_c) if row.friction_given else (0.0, 0.0)
-    actuator = Actuator(d.J_m, d.k_t, 0.0, 0.0, D_m, f_c)
+    friction = {"D_m": d.D_m, "f_c": d.f_c} if row.friction_given else {}
     wall, cpu = time.perf_counter(), time.process_time()
-    record = motor_record(log.time, log.i_a, log.omega_m, log.theta_m, actuator, row.g_dist)
-    encoder = encoder_record(
-        log.time, log.i_a, log.theta_m, actuator, d.counts, row.friction_given, row.load
-    )
     out: dict = {"seed": seed, "stuck_fraction": log.stuck_fraction}
     try:
-        choice = identify(record, "auto", encoder)
-    except UserError as error:
+        result = identify_drive(
+            log.time,
+            log.i_a,
+            log.omega_m,
+            log.theta_m,
+            k_t=d.k_t,
+            J_m=d.J_m,
+            encoder_cpr=d.counts,
+            load=row.load,
+            g_dist=row.g_dist,
+            **friction,
+        )
+    except IdentificationError as error:
         out.update(n=0, error=str(error))
-        choice = None
+        result = None
     out["seconds"] = time.perf_counter() - wall
     out["cpu_seconds"] = time.process_time() - cpu
-    if choice is None:
+    if result is None:
         return out
+    choice = result.choice
     n = choice.n
     out.update(n=n, modes=choice.fit.extra["modes_rad_s"], weak=choice.fit.extra["weak_modes"])
     if n != d.n:
@@ -272,30 +277,58 @@ SPEED = (
 )
 
 
-def speed(repeats: int = 3) -> list[dict]:
+def speed(repeats: int = 3, quick: bool = False) -> list[dict]:
     """Wall and CPU seconds of the identification (log → result, simulation excluded),
-    median of ``repeats``; the three-mass 1 kHz row without its load model."""
-    global DURATION
+    median of ``repeats``; the three-mass 1 kHz row without its load model (``quick``:
+    that row only)."""
     out = []
-    for label, name, seconds in SPEED:
+    for label, name, seconds in SPEED[1:2] if quick else SPEED:
         row = ROWS[name]
         if row.load != "none":
             row = replace(row, load="none", drive=replace(row.drive, load_sine=(0.0, 0.0)))
-        saved, DURATION = DURATION, seconds
-        try:
-            runs = [run_row(row, seed) for seed in range(1, repeats + 1)]
-        finally:
-            DURATION = saved
+        runs = [run_row(row, seed, seconds) for seed in range(1, repeats + 1)]
         out.append(
             {
                 "what": label,
                 "n_right": sum(r.get("n") == row.drive.n for r in runs),
+                "runs": repeats,
                 "seconds": float(np.median([r["seconds"] for r in runs])),
                 "cpu_seconds": float(np.median([r["cpu_seconds"] for r in runs])),
                 "load_average": os.getloadavg()[0],
             }
         )
     return out
+
+
+def speed_markdown(rows: list[dict]) -> str:
+    """The speed table."""
+    lines = [
+        "| what | n right | s wall (median) | s CPU | load average |",
+        "|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['what']} | {r['n_right']} of {r['runs']} | {r['seconds']:.2f} "
+            f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def score_rows(
+    names: Sequence[str], seeds: Sequence[int], progress: Callable[[str], None] = print
+) -> tuple[dict[str, dict], dict[str, list[dict]]]:
+    """Every row of ``names`` over ``seeds``: the summaries, and every run's numbers."""
+    results: dict[str, list[dict]] = {}
+    summaries: dict[str, dict] = {}
+    for name in names:
+        row = ROWS[name]
+        results[name] = []
+        for seed in seeds:
+            r = run_row(row, seed)
+            results[name].append(r)
+            progress(f"{name}, seed {seed}: n = {r.get('n')}, {r['seconds']:.1f} s")
+        summaries[name] = summary(results[name], row)
+    return summaries, results
 
 
 def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = print) -> int:
@@ -306,27 +339,11 @@ def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = pr
     parser.add_argument("--speed", action="store_true", help="time the speed rows instead")
     args = parser.parse_args(argv)
     if args.speed:
-        rows = speed()
-        print("| what | n right | s wall (median of 3) | s CPU | load average |")
-        print("|---|---|---|---|---|")
-        for r in rows:
-            print(
-                f"| {r['what']} | {r['n_right']} of 3 | {r['seconds']:.2f} "
-                f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
-            )
+        print(speed_markdown(speed()))
         return 0
-    results: dict[str, list[dict]] = {}
-    summaries: dict[str, dict] = {}
-    for name in args.rows:
-        row = ROWS[name]
-        results[name] = []
-        for seed in range(1, args.seeds + 1):
-            r = run_row(row, seed)
-            results[name].append(r)
-            progress(f"{name}, seed {seed}: n = {r.get('n')}, {r['seconds']:.1f} s")
-        summaries[name] = summary(results[name], row)
-        if args.out:
-            args.out.write_text(json.dumps({"summary": summaries, "runs": results}, indent=1))
+    summaries, results = score_rows(args.rows, range(1, args.seeds + 1), progress)
+    if args.out:
+        args.out.write_text(json.dumps({"summary": summaries, "runs": results}, indent=1))
     print(markdown(summaries))
     return 0
 

@@ -41,6 +41,7 @@ from arcosim.experiments.scenarios import SCENARIOS
 from arcosim.fmu.flexchain.observer import STATE_ESTIMATION
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import MEASURED, cosimulate
+from benchmarks import field_accuracy
 
 H = 1e-3
 OBSERVER_SETTINGS = {"mode": 2}
@@ -223,6 +224,8 @@ def run(out: Path, runs: int, quick: bool, progress: Callable[[str], None] = pri
         d: repeat(f"{d:g} s record", lambda d=d: whole_loop(3, d) * d / H / 1e6) for d in lengths
     }
     oe = repeat("output-error identification", lambda: identification_seconds(10.0))
+    progress("whole-chain identification")
+    whole = field_accuracy.speed(repeats=1 if quick else max(runs, 3), quick=quick)
     results.update(
         {
             "bench_loop_us": vars(loop),
@@ -232,9 +235,15 @@ def run(out: Path, runs: int, quick: bool, progress: Callable[[str], None] = pri
             "loop_us_by_masses": {str(n): vars(f) for n, f in by_n.items()},
             "run_seconds_by_record": {f"{d:g}": vars(f) for d, f in by_length.items()},
             "output_error_10s_seconds": vars(oe),
+            "whole_chain_seconds": whole,
         }
     )
     text = markdown(loop, model_based, split, plain, by_n, by_length, oe, base, runs, quick)
+    text += (
+        "\nWhole-chain identification (log → result, the simulation excluded; drives of "
+        "`benchmarks/field_accuracy.py`; one BLAS thread):\n\n"
+        + field_accuracy.speed_markdown(whole)
+    )
     out.mkdir(parents=True, exist_ok=True)
     (out / "throughput.md").write_text(text, encoding="utf-8")
     (out / "throughput.json").write_text(json.dumps(results, indent=1), encoding="utf-8")

@@ -14,13 +14,18 @@ read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a Drive
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
 
-Identifying the chain from a log (numpy/scipy, no FMU needed)
+Identifying the drive from a log (numpy/scipy, no FMU needed)
 -------------------------------------------------------------
+identify_drive      -- every J_i, k_i, B_i (and n) from a log, k_t and J_m known
+DriveIdentification -- its result: the chain, standard errors, assumptions, evidence
+check_log           -- can a log support identification? (before any fit)
+design_excitation   -- the multi-sine to play on the drive for identification
 Actuator            -- the motor's terms: J_mo, k_to, Δk_t, ΔJ, D_m, f_c
 motor_record        -- a log as the reaction-torque record the fits use
 encoder_record      -- a log as the current → encoder record of the refinement
-identify_whole_chain -- every J_i, k_i, B_i (and n) from the motor side
+identify_whole_chain -- the whole-chain fit from those records (what identify_drive runs)
 uniform_chain       -- the paper's uniform chain: k and B by output error
+estimate_load_torque -- the torque on a load mass over a log (the observer's estimator)
 
 Scenarios and co-simulation
 ---------------------------
@@ -51,6 +56,7 @@ Errors
 ArcosimError        -- base of every error arcosim raises for a user to fix
 UserError           -- a bad argument, file or datum
 BuildError          -- an FMU could not be built
+IdentificationError -- a record or setting the identification cannot work with
 
 The paper's experiments and the report are the command ``arcosim reproduce``
 (:func:`arcosim.experiments.reproduce.reproduce`).
@@ -78,6 +84,11 @@ _API = {
     "read_log": "arcosim.logs",
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
+    "identify_drive": "arcosim.identification.drive",
+    "DriveIdentification": "arcosim.identification.drive",
+    "check_log": "arcosim.identification.log_check",
+    "design_excitation": "arcosim.identification.chain_excitation",
+    "estimate_load_torque": "arcosim.identification.load_torque",
     "Actuator": "arcosim.fmu.flexchain.dob",
     "motor_record": "arcosim.identification.output_error",
     "encoder_record": "arcosim.identification.encoder_fit",
@@ -101,9 +112,15 @@ _API = {
     "ArcosimError": "arcosim.errors",
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",
+    "IdentificationError": "arcosim.identification.errors",
 }
 #: Where the public name differs from the defining module's name.
-_ALIASES = {"identify_whole_chain": "identify"}
+_ALIASES = {
+    "identify_whole_chain": "identify",
+    "check_log": "check",
+    "design_excitation": "excite",
+    "estimate_load_torque": "estimate",
+}
 
 __all__ = ["__version__", *_API]
 

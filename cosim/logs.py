@@ -8,7 +8,9 @@ and the current that acted over the step ending at ``time``.
 
 from __future__ import annotations
 
+import codecs
 import csv
+import io
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -17,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.errors import UserError
+from arcosim.outputs import atomic_output
 
 LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
 
@@ -79,6 +82,9 @@ def parse_scales(texts: Iterable[str]) -> dict[str, float]:
 def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> DriveLog:
     """Read and check a drive log.
 
+    The file is UTF-8 text, with or without a byte-order mark; any other encoding is
+    refused, naming the first byte that is not UTF-8.
+
     Parameters
     ----------
     path : str or Path
@@ -98,7 +104,7 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     UserError
         Naming the row or column at fault: no such file, an empty file, a missing
         column, a cell that is not a finite number, time that does not increase,
-        fewer than two rows.
+        fewer than two rows, a file that is not UTF-8 text.
 
     Examples
     --------
@@ -111,10 +117,9 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     (2, 0.0005)
     """
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
-    with path.open(newline="", encoding="utf-8") as f:
-        reader = csv.reader(f)
+    text = read_text_file(path, "log")
+    reader = csv.reader(io.StringIO(text, newline=""))
+    try:
         header = next(reader, None)
         if header is None:
             raise UserError(
@@ -123,8 +128,9 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
         header = [h.strip() for h in header]
         missing = [c for c in LOG_COLUMNS if c not in header]
         if missing:
+            shown = ", ".join(repr(h) if not h.isprintable() else h for h in header[:20])
             raise UserError(
-                f"{path}: missing column {', '.join(missing)} (the header has: {', '.join(header)})"
+                f"{path}: missing column {', '.join(missing)} (the header has: {shown})"
             )
         index = {c: header.index(c) for c in LOG_COLUMNS}
         rows = []
@@ -139,21 +145,31 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
                     x = float(cell)
                 except ValueError:
                     raise UserError(
-                        f"{path}, row {line}, column {c}: {cell!r} is not a number"
+                        f"{path}, row {line}, column {c}: {cell[:40]!r} is not a number"
                     ) from None
                 if not math.isfinite(x):
                     raise UserError(
-                        f"{path}, row {line}, column {c}: {cell} is not a finite number"
+                        f"{path}, row {line}, column {c}: {cell[:40]} is not a finite number"
                     )
                 values.append(x)
             rows.append((line, values))
+    except csv.Error as error:
+        raise UserError(f"{path}, row {reader.line_num}: not CSV text ({error})") from None
     if len(rows) < 2:
         raise UserError(f"{path}: needs at least two data rows (has {len(rows)})")
     data = np.array([v for _, v in rows])
-    for c, factor in (scales or {}).items():
-        data[:, LOG_COLUMNS.index(c)] *= factor
-    steps = np.diff(data[:, 0])
-    bad = np.flatnonzero(~(steps > 0))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for c, factor in (scales or {}).items():
+            data[:, LOG_COLUMNS.index(c)] *= factor
+        steps = np.diff(data[:, 0])
+    overflow = np.argwhere(~np.isfinite(data))
+    if overflow.size:
+        r, j = overflow[0]
+        raise UserError(
+            f"{path}, row {rows[r][0]}, column {LOG_COLUMNS[j]}: not finite once scaled "
+            f"by --scale {LOG_COLUMNS[j]}={float((scales or {})[LOG_COLUMNS[j]])!r}"
+        )
+    bad = np.flatnonzero(~(steps > 0) | ~np.isfinite(steps))
     if bad.size:
         line = rows[bad[0] + 1][0]
         raise UserError(
@@ -163,15 +179,66 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     return DriveLog(path, {c: data[:, j] for j, c in enumerate(LOG_COLUMNS)})
 
 
-def write_csv(path: str | Path, columns: Mapping[str, np.ndarray]) -> Path:
+def read_text_file(path: Path, what: str = "file") -> str:
+    """The text of a UTF-8 file (a byte-order mark is dropped); refuse anything else.
+
+    Raises
+    ------
+    UserError
+        When the file is missing, a folder, unreadable, or not UTF-8 (naming the
+        encoding when a byte-order mark says which, else the first bad byte).
+    """
+    if path.is_dir():
+        raise UserError(f"{path}: is a folder, not a {what}")
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such file") from None
+    except OSError as error:
+        raise UserError(f"{path}: cannot read the {what} ({error.strerror or error})") from None
+    for bom, name in (
+        (codecs.BOM_UTF32_LE, "UTF-32"),
+        (codecs.BOM_UTF32_BE, "UTF-32"),
+        (codecs.BOM_UTF16_LE, "UTF-16"),
+        (codecs.BOM_UTF16_BE, "UTF-16"),
+    ):
+        if data.startswith(bom):
+            raise UserError(f"{path}: the {what} is {name} text; save it as UTF-8")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        byte = data[error.start]
+        raise UserError(
+            f"{path}, line {line}: byte 0x{byte:02x} is not UTF-8 (the {what} must be UTF-8 "
+            "text; Latin-1 or Windows-1252? save it as UTF-8)"
+        ) from None
+    if "\x00" in text:
+        line = text.count("\n", 0, text.index("\x00")) + 1
+        raise UserError(f"{path}, line {line}: a NUL byte: the {what} must be text, not binary")
+    return text
+
+
+def write_csv(
+    path: str | Path,
+    columns: Mapping[str, np.ndarray],
+    *,
+    force: bool = False,
+    option: str = "--out",
+) -> Path:
     """Write columns of equal length as a CSV file with a header, at full precision.
 
     Parameters
     ----------
     path : str or Path
-        The file to write (its folder is created if needed).
+        The file to write (its folder is created if needed). Written atomically
+        (:func:`arcosim.outputs.atomic_output`): never left half-written.
     columns : mapping of str to ndarray
         Column name → values (any unit; the name should say it), each of shape ``(N,)``.
+    force : bool
+        Whether an existing file may be replaced (else :class:`UserError`).
+    option : str
+        The option that named ``path``, for messages.
 
     Returns
     -------
@@ -188,8 +255,8 @@ def write_csv(path: str | Path, columns: Mapping[str, np.ndarray]) -> Path:
     'time,i_a'
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     names = list(columns)
     data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
-    np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+    with atomic_output(path, "w", force=force, option=option) as f:
+        np.savetxt(f, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
     return path

@@ -122,3 +122,32 @@ def test_fmus_built_from_other_sources_are_rebuilt_not_run(build_fmus, tmp_path:
     ensure_built(1, folder)
     assert plant.stat().st_mtime_ns != before
     assert (folder / DIGEST_FILE).read_text().strip() == source_digest(1)
+
+
+def test_excite_writes_the_multisine_and_warns_of_sticking(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "excitation.csv"
+    args = ["excite", "--band", "3", "150", "--current-limit", "1", "--out", str(out)]
+    assert main([*args, "--k-t", "0.0406", "--f-c", "2e-3"]) == 0
+    text = capsys.readouterr().out
+    assert "frequency_end = 150" in text and "lines = 40" in text
+    assert "the motor will stick often" in text  # 1 A on 40 lines: rms torque < 5 f_c
+    rows = out.read_text().splitlines()
+    assert rows[0] == "time,i_ref" and len(rows) == 20002
+    assert max(abs(float(r.split(",")[1])) for r in rows[1:]) <= 1.0
+    assert main(args) == 2  # never over an existing file without --force
+    assert "exists" in capsys.readouterr().err
+
+
+def test_check_says_whether_a_log_supports_identification(build_fmus, tmp_path, capsys) -> None:
+    good, poor = tmp_path / "identification.csv", tmp_path / "flexible.csv"
+    for scenario, path in (("identification", good), ("flexible", poor)):
+        assert main(["simulate", "--scenario", scenario, "--out", str(path)]) == 0
+    drive = ["--set", "k_to=0.0406", "--set", "J_mo=2.09e-5", "--set", "encoder_cpr=2000"]
+    capsys.readouterr()
+    assert main(["check", str(good), *drive]) == 0
+    text = capsys.readouterr().out
+    assert "ok: the log can support identification" in text and "assumption" not in text
+    assert main(["check", str(poor)]) == 1  # the lines stop at 120 rad/s: not ok
+    text = capsys.readouterr().out
+    assert "not ok" in text and "extend the lines" in text
+    assert "paper bench's value was used" in text  # nothing of the drive given

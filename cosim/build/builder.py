@@ -14,6 +14,7 @@ ships, whatever its host has imported.
 
 from __future__ import annotations
 
+import os
 import shutil
 import sys
 import tempfile
@@ -23,12 +24,14 @@ from arcosim.build.cache import (
     DIGEST_FILE,
     default_folder,
     fmu_package_dir,
+    fmu_problem,
     is_current,
     lock_folder,
     source_digest,
 )
 from arcosim.build.portable import make_portable
 from arcosim.build.recipes import RECIPES, SSP_NAME, FmuRecipe, check_masses
+from arcosim.errors import BuildError
 from arcosim.version import __version__
 
 
@@ -133,13 +136,34 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
 
 
 def build_locked(n: int, target: Path) -> list[Path]:
-    """:func:`build_all` into ``target`` for a caller that holds its lock."""
+    """:func:`build_all` into ``target`` for a caller that holds its lock.
+
+    The digest goes first (so a folder being rebuilt is never current) and comes back
+    last, written atomically, once every file is verified (:func:`fmu_problem`).
+
+    Raises
+    ------
+    BuildError
+        When a file cannot be written, or a built file is not a complete FMU.
+    """
     from arcosim.build.ssp import write_ssp
 
-    (target / DIGEST_FILE).unlink(missing_ok=True)
-    built = [build_fmu(recipe, n, target) for recipe in RECIPES]
-    built.append(write_ssp(target / SSP_NAME, target))
-    (target / DIGEST_FILE).write_text(source_digest(n) + "\n", encoding="utf-8")
+    stamp = target / DIGEST_FILE
+    try:
+        stamp.unlink(missing_ok=True)
+        built = [build_fmu(recipe, n, target) for recipe in RECIPES]
+        built.append(write_ssp(target / SSP_NAME, target))
+        problems = [p for p in map(fmu_problem, built) if p is not None]
+        if problems:
+            raise BuildError(f"the build into {target} left a broken file: {problems[0]}")
+        partial = target / f".{DIGEST_FILE}.{os.getpid()}.part"
+        partial.write_text(source_digest(n) + "\n", encoding="utf-8")
+        partial.replace(stamp)
+    except OSError as error:
+        raise BuildError(
+            f"cannot build into {target}: {error.strerror or error}"
+            + (f" ({error.filename})" if error.filename else "")
+        ) from None
     return built
 
 

@@ -20,11 +20,13 @@ import functools
 import hashlib
 import os
 import zipfile
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
 from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+from arcosim.errors import BuildError
 from arcosim.version import __version__
 
 #: Written beside the FMUs, last: the digest of the sources they were built from.
@@ -88,9 +90,23 @@ def source_digest(n: int) -> str:
 
 @contextlib.contextmanager
 def lock_folder(folder: Path) -> Iterator[None]:
-    """Hold the exclusive build lock of ``folder`` (waits while another process holds it)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    with open(folder / LOCK_FILE, "a+b") as handle:
+    """Hold the exclusive build lock of ``folder`` (waits while another process holds it).
+
+    The lock is an ``flock`` on :data:`LOCK_FILE` in the folder: the kernel drops it
+    when its holder exits, however it exits (``kill -9`` too), so it is never stale.
+
+    Raises
+    ------
+    BuildError
+        When the folder cannot be created or the lock file cannot be opened.
+    """
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / LOCK_FILE, "a+b")  # noqa: SIM115 (held across the yield)
+    except OSError as error:
+        what = "is a file, not a folder" if folder.is_file() else (error.strerror or str(error))
+        raise BuildError(f"cannot build into {folder}: {what}") from None
+    with handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
         try:
             yield
@@ -113,7 +129,15 @@ def fmu_problem(path: Path) -> str | None:
             ElementTree.fromstring(z.read(inner))
     except FileNotFoundError:
         return f"{path.name} is missing"
-    except (zipfile.BadZipFile, KeyError, ElementTree.ParseError, OSError, EOFError) as error:
+    except (
+        zipfile.BadZipFile,
+        KeyError,
+        ElementTree.ParseError,
+        OSError,
+        EOFError,
+        zlib.error,  # a corrupt deflate stream (testzip reads every member)
+        ValueError,
+    ) as error:
         return f"{path.name} is not a complete FMU ({error})"
     return None
 

@@ -1,27 +1,81 @@
 """The ``arcosim`` command line: one subcommand per module, dispatched through
-``set_defaults(execute=…)``."""
+``set_defaults(execute=…)``.
+
+Whatever goes wrong, a user sees one line on stderr, never a Python traceback:
+
+* a bad argument, file or value (:class:`~arcosim.errors.ArcosimError`, or an
+  argument argparse refuses): ``arcosim: error: …`` and exit status 2;
+* Python warnings (numpy's, a build's) are collected and printed after a command
+  that succeeds, each once, as ``arcosim: warning: …``; a refusal prints only its line;
+* Ctrl-C: ``arcosim: interrupted`` and exit status 130;
+* anything else (a bug): ``arcosim: internal error: …`` naming the file the
+  traceback was written to (in the temporary folder), and exit status 70
+  (``EX_SOFTWARE``).
+"""
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
 import sys
+import tempfile
+import traceback
+import warnings
 from collections.abc import Sequence
+from pathlib import Path
+from typing import NoReturn
 
-from arcosim.cli import bench, build, identify, reproduce, simulate, ssp, sweep, validate
+from arcosim.cli import (
+    bench,
+    build,
+    check,
+    excite,
+    identify,
+    reproduce,
+    simulate,
+    ssp,
+    sweep,
+    validate,
+)
 from arcosim.errors import ArcosimError
 from arcosim.version import __version__
+
+#: Exit status of a refused input, and of an internal error (sysexits' EX_SOFTWARE).
+EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 2, 70, 130
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose refusals are one line: ``arcosim: error: …``."""
+
+    def error(self, message: str) -> NoReturn:
+        print(f"arcosim: error: {message} (see `{self.prog} --help`)", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
 
 
 def make_parser() -> argparse.ArgumentParser:
     """The full ``arcosim`` parser."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="arcosim",
         description="Sensorless identification and state estimation of flexible drives "
         "with FMI co-simulation (action-reaction method).",
     )
     parser.add_argument("--version", action="version", version=f"arcosim {__version__}")
-    subparsers = parser.add_subparsers(title="commands", metavar="COMMAND")
-    for module in (build, simulate, identify, reproduce, sweep, ssp, validate, bench):
+    subparsers = parser.add_subparsers(
+        title="commands", metavar="COMMAND", parser_class=OneLineParser
+    )
+    for module in (
+        build,
+        simulate,
+        excite,
+        check,
+        identify,
+        reproduce,
+        sweep,
+        ssp,
+        validate,
+        bench,
+    ):
         module.add_parser(subparsers)
     return parser
 
@@ -29,15 +83,77 @@ def make_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``arcosim`` with ``argv`` (default: the process arguments); return the exit code."""
     parser = make_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as stop:  # a refused argument (one line printed), --help, --version
+        return stop.code if isinstance(stop.code, int) else EXIT_USAGE
     if not hasattr(args, "execute"):
         parser.print_help()
-        return 2
+        return EXIT_USAGE
+    caught: list[str] = []
     try:
-        return int(args.execute(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = lambda message, *_, **__: caught.append(one_line(str(message)))
+            code = int(args.execute(args) or 0)
+        for text in dict.fromkeys(caught):  # each once, after the command's own output
+            print(f"arcosim: warning: {text}", file=sys.stderr)
+        return code
     except ArcosimError as error:
-        print(f"arcosim: error: {error}", file=sys.stderr)
-        return 2
+        print(f"arcosim: error: {one_line(str(error))}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("arcosim: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as error:  # a bug: one line here, the traceback in a file
+        report = write_crash_report(argv if argv is not None else sys.argv[1:])
+        where = f"details in {report}" if report else "and the details could not be written"
+        print(
+            f"arcosim: internal error: {type(error).__name__}: {one_line(str(error))[:300]} "
+            f"({where}; please report it)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL
+
+
+def one_line(text: str) -> str:
+    r"""``text`` on one line: its lines joined by `` | `` (FMU logs come as several).
+
+    A Python traceback inside (an FMU's log of an internal error) keeps only its
+    last line, the exception.
+
+    Examples
+    --------
+    >>> one_line("step refused:\nTraceback (most recent call last):\n  File x\nValueError: no")
+    'step refused: | ValueError: no'
+    """
+    lines, in_traceback = [], False
+    for line in text.splitlines():
+        if line.strip().startswith("Traceback (most recent call last):"):
+            in_traceback = True
+            continue
+        if in_traceback and line[:1].isspace():
+            continue
+        in_traceback = False
+        if line.strip():
+            lines.append(line.strip())
+    return " | ".join(lines)
+
+
+def write_crash_report(argv: Sequence[str]) -> Path | None:
+    """Write the current exception's traceback, the command and versions to a new file
+    in the temporary folder; return its path (None if it cannot be written)."""
+    try:
+        fd, name = tempfile.mkstemp(prefix="arcosim-error-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(f"arcosim {__version__}, Python {sys.version.split()[0]}, {sys.platform}\n")
+            f.write(f"time: {datetime.datetime.now().isoformat(timespec='seconds')}\n")
+            f.write(f"command: arcosim {' '.join(argv)}\n")
+            f.write(f"folder: {os.getcwd()}\n\n")
+            f.write(traceback.format_exc())
+        return Path(name)
+    except OSError:
+        return None
 
 
 if __name__ == "__main__":

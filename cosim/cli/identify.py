@@ -13,7 +13,10 @@ Contract (scripts rely on it)::
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
-* ``--out FILE``: every output over time as CSV (``time`` first).
+* ``--out FILE``: every output over time as CSV (``time`` first); with
+  ``--method output-error`` or ``whole-chain``, the report ``--json`` prints, as a
+  JSON file (its name must end in ``.json``; the observer's CSV may not). An
+  existing file is replaced only with ``--force``; the log itself never.
 * ``--method output-error``: instead of replaying the observer FMU, fit the uniform
   chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
   from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
@@ -43,22 +46,24 @@ Contract (scripts rely on it)::
   ``tau_load_hat``, ``tau_reac_hat``, ``theta_hat[i]``, ``omega_hat[i]`` and the
   innovation; ``--json`` prints a summary. The step may vary.
 
-A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
-error naming the row or column, and exit status 2.
+A bad log (missing column, non-increasing time, NaN, empty file, not UTF-8) gives a
+one-line error naming the row or column, and exit status 2. So does a ``--start-k``
+outside the band the log can show (the first clamped mode between one period in the
+record and the Nyquist frequency π/h), and a fit that ends on non-finite numbers.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import OBSERVER, check_masses
-from arcosim.cli.options import add_fmus_option, fmu_folder
+from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
@@ -66,10 +71,19 @@ from arcosim.host.instance import FmuInstance
 from arcosim.host.overrides import parse_assignment
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
 from arcosim.identification import load_torque
-from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
-from arcosim.identification.whole_chain import identify as identify_chain
+from arcosim.identification.drive import identify_drive
+from arcosim.identification.output_error import (
+    Fit,
+    MotorRecord,
+    clamped_frequencies,
+    motor_record,
+    uniform_chain,
+)
 from arcosim.logs import DriveLog, parse_scales, read_log, write_csv
+from arcosim.outputs import check_output, write_text
+
+#: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
+OFFLINE = ("output-error", "whole-chain")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -104,7 +118,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="multiply a log column to get SI units, repeatable",
     )
     p.add_argument("--json", action="store_true", help="print the final outputs as one JSON object")
-    p.add_argument("--out", type=Path, help="write every output over time to this CSV file")
+    p.add_argument(
+        "--out",
+        type=Path,
+        help="observer, load-torque: every output over time as CSV; output-error, "
+        "whole-chain: the report as a .json file",
+    )
+    force_option(p)
     p.add_argument(
         "--method",
         choices=("observer", "output-error", "whole-chain", "load-torque"),
@@ -133,28 +153,39 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--start-k",
-        type=float,
-        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan",
+        type=number(0.0, low_open=True, unit="N.m/rad"),
+        help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
+        "it must put the chain's first mode in the band the log shows",
     )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
+    for given, option in (
+        (args.start_k is not None, "--start-k"),
+        (args.fit_inertia_scale, "--fit-inertia-scale"),
+    ):
+        if given and args.method != "output-error":
+            raise UserError(f"{option} is for --method output-error (not {args.method})")
+    if args.mode is not None and args.method != "observer":
+        raise UserError(f"--mode is for --method observer (not {args.method})")
+    _check_out(args, [])
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else _masses(args.masses)
-        return _whole_chain(args, log, fmu_folder(args, 3), masses)
+        return _whole_chain(args, log, masses)
     if args.method == "load-torque":
         chain = read_chain(args.chain) if args.chain else {}
-        n = int(chain.pop("masses")) if "masses" in chain else _masses(args.masses)
-        return _load_torque(args, log, fmu_folder(args, check_masses(n)), n, chain)
+        n = check_masses(int(chain.pop("masses")) if "masses" in chain else _masses(args.masses))
+        return _load_torque(args, log, n, chain)
     if args.chain:
         raise UserError("--chain is for --method load-torque")
     n = _masses(args.masses)
-    folder = fmu_folder(args, n)
     if args.method == "output-error":
-        return _output_error(args, log, folder, n)
+        return _output_error(args, log, n)
+    folder = fmu_folder(args, n)
+    _check_out(args, fmu_inputs(folder))
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
         recording = replay_log(observer, log, parameters)
@@ -162,12 +193,61 @@ def _execute(args: argparse.Namespace) -> int:
     if args.out:
         columns = {"time": recording.time}
         columns.update({k.split(".", 1)[1]: v for k, v in recording.signals.items()})
-        write_csv(args.out, columns)
+        write_csv(args.out, columns, force=args.force)
     if args.json:
         print(json.dumps(final, indent=2))
     else:
         _print_summary(final, len(log), args.out)
     return 0
+
+
+def _check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
+    """Refuse ``--out`` before any work: a name that does not fit the method's format,
+    an existing file without ``--force``, the log or an FMU."""
+    if args.out is None:
+        return
+    is_json = args.out.suffix.lower() == ".json"
+    if args.method in OFFLINE and not is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
+        )
+    if args.method not in OFFLINE and is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its outputs over time as CSV; "
+            "name a .csv file (--json prints a summary)"
+        )
+    chain = [args.chain] if args.chain else []
+    check_output(args.out, inputs=[args.log, *chain, *fmus], force=args.force)
+
+
+def _write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None:
+    """Refuse a report with a non-finite estimate; write it to ``--out`` if given."""
+    bad = [
+        key
+        for key, value in [*report.items(), *dict(report.get("std") or {}).items()]
+        if isinstance(value, float) and not math.isfinite(value)
+    ]
+    if bad:
+        raise UserError(
+            f"{args.log}: the fit ended on non-finite numbers ({', '.join(bad[:6])}): the log "
+            "does not determine them; check --set and the excitation"
+        )
+    if args.out:
+        write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
+
+
+def check_start_k(k: float, J: Sequence[float], record: MotorRecord) -> None:
+    """Refuse a ``--start-k`` whose uniform chain's first clamped mode lies outside the
+    band the record can show: from one period in its length to the Nyquist frequency."""
+    unit = float(clamped_frequencies([float(x) for x in J], [1.0] * len(J))[0])
+    low_w, high_w = 2.0 * math.pi / record.duration, math.pi / record.h
+    low, high = (low_w / unit) ** 2, (high_w / unit) ** 2
+    if not low <= k <= high:
+        raise UserError(
+            f"--start-k {k:g}: give a stiffness from {low:.3g} to {high:.3g} N.m/rad for this "
+            f"log and J (the chain's first mode between one period in {record.duration:g} s, "
+            f"{low_w:.3g} rad/s, and the Nyquist frequency, {high_w:.3g} rad/s)"
+        )
 
 
 def _print_summary(final: dict, samples: int, out: Path | None) -> None:
@@ -178,9 +258,12 @@ def _print_summary(final: dict, samples: int, out: Path | None) -> None:
         print(f"wrote {out}")
 
 
-def known_parameters(folder: Path, assignments: Sequence[str]) -> dict[str, float]:
-    """The observer FMU's parameter defaults with ``--set`` applied (offline methods)."""
-    variables = fmu_variables(folder)["observer"]
+def known_parameters(n: int, assignments: Sequence[str]) -> dict[str, float]:
+    """The observer's parameter defaults for ``n`` masses with ``--set`` applied, from the
+    observer FMU's own declaration (the offline methods need no built FMU)."""
+    from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
+
+    variables = ReactionTorqueObserver.interface(n)
     values: dict[str, float] = {
         name: float(v.start)
         for name, v in variables.items()
@@ -194,14 +277,14 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     """The actuator terms among the observer's parameters."""
     for name in ("J_mo", "k_to", "g_dist"):
         if not values[name] > 0:
-            raise UserError(f"{name} = {values[name]!r} must be > 0")
+            raise UserError(f"{name} = {float(values[name]):g} must be > 0")
     return Actuator(
         values["J_mo"], values["k_to"], values["dkt"], values["dJm"], values["D_m"], values["f_c"]
     )
 
 
-def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int) -> int:
-    values = known_parameters(folder, args.set)
+def _output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
+    values = known_parameters(n, args.set)
     J = [values[f"J[{i}]"] for i in range(1, n + 1)]
     if any(not x > 0 for x in J):
         raise UserError(f"the load inertias must be > 0, got J = {J}")
@@ -209,11 +292,14 @@ def _output_error(args: argparse.Namespace, log: DriveLog, folder: Path, n: int)
     record = motor_record(
         log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator_of(values), values["g_dist"]
     )
+    if args.start_k is not None:
+        check_start_k(args.start_k, J, record)
     result = uniform_chain(record, J, args.fit_inertia_scale, args.start_k)
     names = {"k": "k_hat", "B": "B_hat", "J_scale": "J_scale"}
     report = {names[k]: v for k, v in result.as_dict().items()}
     report["std"] = {names[k]: v for k, v in result.std_dict().items()}
     report.update(evidence(result, record))
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -235,77 +321,65 @@ def _masses(text: str) -> int:
     return check_masses(n)
 
 
-def _whole_chain(args: argparse.Namespace, log: DriveLog, folder: Path, masses: int | str) -> int:
-    values = known_parameters(folder, args.set)
+def _whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
+    values = known_parameters(masses if isinstance(masses, int) else 3, args.set)
     given = {parse_assignment(text)[0] for text in args.set}
-    friction_given = {"D_m", "f_c"} <= given
-    if not friction_given:  # fitted: the DOB's τ̂ (the modal start) is computed without
-        values["D_m"] = values["f_c"] = 0.0
+    friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
     actuator = actuator_of(values)
     c = log.columns
-    g_dist = values["g_dist"]
-    record = motor_record(log.time, c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
-    cpr = int(values["encoder_cpr"])
-    encoder = None
-    if cpr > 0:
-        encoder = encoder_record(
-            log.time, c["i_a"], c["theta_m"], actuator, cpr, friction_given, args.load
-        )
-    elif not friction_given or args.load != "none":
-        raise UserError(
-            "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
-            "(--set D_m=… --set f_c=…) and no load torque (--load none)"
-        )
-    choice = identify_chain(record, masses, encoder)
-    result = choice.fit
-    report: dict[str, object] = {"masses": choice.n, **result.as_dict()}
-    report["std"] = result.std_dict()
-    report.update(evidence(result, record), method="whole-chain")
-    report.update(
-        modes_rad_s=result.extra["modes_rad_s"],
-        damping_ratios=result.extra["damping_ratios"],
-        residue_t_values=result.extra["residue_t_values"],
-        weak_modes=result.extra["weak_modes"],
-        refused={str(n): why for n, why in choice.refused.items()},
-        assumptions=result.extra["assumptions"],
-        warnings=result.extra["warnings"],
-        criterion={str(n): v for n, v in choice.criterion.items()},
-        masses_seen=choice.seen,
+    result = identify_drive(
+        log.time,
+        c["i_a"],
+        c["omega_m"],
+        c["theta_m"],
+        k_t=actuator.k_to + actuator.dkt,
+        J_m=actuator.J_mo + actuator.dJm,
+        encoder_cpr=int(values["encoder_cpr"]),
+        masses=masses,
+        load=args.load,
+        g_dist=values["g_dist"],
+        **friction,
     )
     defaults = [name for name in ("J_mo", "k_to", "encoder_cpr") if name not in given]
     if defaults:
-        result.extra["assumptions"]["defaults"] = (
+        result.assumptions["defaults"] = (
             "not given, so the paper bench's value was used: "
             + ", ".join(f"{name} = {values[name]:g}" for name in defaults)
             + " (give your drive's with --set)"
         )
-    if choice.singular_values is not None:
-        report["singular_values"] = [float(x) for x in choice.singular_values[:16]]
-    if "load_torque_range" in result.extra:
-        report["load_torque_range"] = result.extra["load_torque_range"]
+    report = result.report()
+    _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
-    print(f"{len(log)} samples, whole-chain fit ({choice.n} masses):")
-    for key in result.names:
-        print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
+    print(f"{len(log)} samples, whole-chain fit ({result.masses} masses):")
+    for key, value in result.parameters.items():
+        print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
     for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
         print(f"  {key}: {report[key]}")
-    for key, text in result.extra["assumptions"].items():
+    for key, text in result.assumptions.items():
         print(f"  assumption, {key}: {text}")
-    for text in result.extra["warnings"]:
+    for text in result.warnings:
         print(f"  warning: {text}")
-    chain = {k: v for k, v in result.as_dict().items() if k[0] in "JkB" and "[" in k}
-    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in chain.items())
-    print(f"observer in mode 2 with this chain: --masses {choice.n} {settings}")
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.chain().items())
+    print(f"observer in mode 2 with this chain: --masses {result.masses} {settings}")
     return 0
 
 
 def read_chain(path: Path) -> dict[str, float]:
-    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report."""
+    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report.
+
+    Raises
+    ------
+    UserError
+        When the file is not UTF-8 JSON, or a value is missing, not a finite number,
+        or ``masses`` not a supported number of masses.
+    """
+    from arcosim.logs import read_text_file
+
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
+        data = json.loads(read_text_file(path, "chain"))
+    except ValueError as error:
         raise UserError(f"--chain {path}: cannot read it as JSON ({error})") from None
     if not isinstance(data, dict):
         raise UserError(f"--chain {path}: expected a JSON object with J[i], k[i], B[i]")
@@ -314,17 +388,23 @@ def read_chain(path: Path) -> dict[str, float]:
         for k, v in data.items()
         if (k.split("[")[0] in ("J", "k", "B") and k.endswith("]")) or k == "masses"
     }
-    n = int(chain.get("masses", sum(k.startswith("J[") for k in chain)))
+    for key, value in chain.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise UserError(f"--chain {path}: {key} = {value!r:.40} is not a number")
+        if not math.isfinite(value):
+            raise UserError(f"--chain {path}: {key} = {value} is not a finite number")
+    masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
+    if masses != int(masses):
+        raise UserError(f"--chain {path}: masses = {masses} is not a whole number")
+    n = check_masses(int(masses))
     missing = [f"{p}[{i}]" for p in "JkB" for i in range(1, n + 1) if f"{p}[{i}]" not in chain]
-    if n < 1 or missing:
-        raise UserError(f"--chain {path}: missing {', '.join(missing) or 'J[1]'}")
+    if missing:
+        raise UserError(f"--chain {path}: missing {', '.join(missing)}")
     return {**{k: float(v) for k, v in chain.items()}, "masses": n}
 
 
-def _load_torque(
-    args: argparse.Namespace, log: DriveLog, folder: Path, n: int, chain: dict[str, float]
-) -> int:
-    values = known_parameters(folder, args.set)
+def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[str, float]) -> int:
+    values = known_parameters(n, args.set)
     values.update({k: v for k, v in chain.items() if k not in _set_names(args.set)})
     load_mass = int(values["load_mass"])
     if not 1 <= load_mass <= n:
@@ -353,9 +433,15 @@ def _load_torque(
     if not settings.load_torque_bandwidth > 0:
         raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
     c = log.columns
-    result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+    try:
+        result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+    except (ValueError, ZeroDivisionError, OverflowError) as error:  # the Kalman design
+        raise UserError(
+            f"--method load-torque: no estimator for these settings ({error}); check "
+            "torque_noise_std, tau_noise_std, load_torque_bandwidth and the chain"
+        ) from None
     if args.out:
-        write_csv(args.out, result.columns())
+        write_csv(args.out, result.columns(), force=args.force)
     last = log.time >= log.time[-1] - 1.0
     report = {
         "method": "load-torque",

@@ -1,11 +1,124 @@
-"""Options several commands share."""
+"""Options several commands share, and the checks every CLI input gets where it enters.
+
+Numbers are parsed by :func:`number` / :func:`whole_number` (argparse ``type=``): a
+value that is not a finite number in its range is refused with one line naming the
+option and the range. :func:`check_steps` refuses a step and a length that give no
+sample or more than :data:`MAX_STEPS`. Outputs are checked by
+:mod:`arcosim.outputs` before any work starts.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 from pathlib import Path
 
 from arcosim.build.builder import ensure_built
+from arcosim.errors import UserError
+from arcosim.fmu.flexchain.defaults import STEP
+from arcosim.host.master import MAX_STEPS, MAX_TIME, MIN_STEP
+
+
+def number(
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = False,
+    unit: str = "",
+) -> Callable[[str], float]:
+    """An argparse ``type``: a finite float within [low, high] (``low_open``: > low).
+
+    Examples
+    --------
+    >>> number(0.0, 10.0, low_open=True, unit="s")("2.5")
+    2.5
+    """
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        below = low is not None and (value <= low if low_open else value < low)
+        above = high is not None and value > high
+        if not math.isfinite(value) or below or above:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not {describe_range(low, high, low_open, unit)}"
+            )
+        return value
+
+    return parse
+
+
+def whole_number(low: int, high: int) -> Callable[[str], int]:
+    """An argparse ``type``: an integer from ``low`` to ``high``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number from {low} to {high}")
+        return value
+
+    return parse
+
+
+def describe_range(
+    low: float | None, high: float | None, low_open: bool = False, unit: str = ""
+) -> str:
+    """``"a finite number > 0 and <= 86400 s"``: the words of a range, for messages."""
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if low_open else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"<= {high:g}")
+    text = "a finite number" + (" " + " and ".join(parts) if parts else "")
+    return text + (f" {unit}" if unit else "")
+
+
+def step_option(parser: argparse.ArgumentParser, default: float = STEP) -> None:
+    """``--step H``: a communication step in s."""
+    parser.add_argument(
+        "--step",
+        type=number(MIN_STEP, MAX_TIME, unit="s"),
+        default=default,
+        help=f"communication step in s, {MIN_STEP:g} to {MAX_TIME:g} (default {default:g})",
+    )
+
+
+def check_steps(option: str, length: float, step: float, length_option: str = "--duration") -> int:
+    """The number of steps of ``step`` s in ``length`` s; refuse none or too many.
+
+    Raises
+    ------
+    UserError
+        When ``length / step`` rounds to 0 or exceeds :data:`MAX_STEPS`.
+
+    Examples
+    --------
+    >>> check_steps("--step", 10.0, 1e-3)
+    10000
+    """
+    steps = round(length / step)
+    if steps < 1:
+        raise UserError(
+            f"{option} {step:g}: longer than the run ({length_option} {length:g} s), so not "
+            f"one step; use a step <= {length:g} s"
+        )
+    if steps > MAX_STEPS:
+        raise UserError(
+            f"{option} {step:g}: {steps:.3g} steps in {length:g} s, more than {MAX_STEPS:,}; "
+            f"use a step >= {length / MAX_STEPS:.3g} s or a shorter run"
+        )
+    return steps
+
+
+def force_option(parser: argparse.ArgumentParser) -> None:
+    """``--force``: replace an existing output file."""
+    parser.add_argument("--force", action="store_true", help="replace the output file if it exists")
 
 
 def add_fmus_option(parser: argparse.ArgumentParser) -> None:
@@ -22,4 +135,11 @@ def add_fmus_option(parser: argparse.ArgumentParser) -> None:
 
 def fmu_folder(args: argparse.Namespace, n: int) -> Path:
     """The folder of current FMUs for ``n`` masses that ``--fmus`` names (or the cache)."""
+    if args.fmus is not None and args.fmus.exists() and not args.fmus.is_dir():
+        raise UserError(f"--fmus {args.fmus}: is a file; name the folder of the FMUs")
     return ensure_built(n, args.fmus)
+
+
+def fmu_inputs(folder: Path) -> list[Path]:
+    """The files of a folder of FMUs a command reads (no output may be one of them)."""
+    return sorted(p for p in folder.glob("*") if p.suffix in (".fmu", ".ssp"))

@@ -17,7 +17,8 @@
    ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
 
 Writes ``report.md``, the CSV of every run and the PNG figures into ``--out``
-(default ``reports/``), and prints the tables. Realistic sensors (2000-count
+(default ``reports/``), and prints the tables. Refuses to start when one of those
+files exists there, unless ``--force`` (``make demo`` passes it). Realistic sensors (2000-count
 encoder, 5 mA current noise) unless ``--ideal``.
 """
 
@@ -59,13 +60,20 @@ def add_parser(
     )
     p.add_argument("--ideal", action="store_true", help="ideal sensors")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--force", action="store_true", help="replace the report's files if they exist")
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
     start = time.perf_counter()
-    results = reproduce(args.out, args.ideal, show_progress=not args.no_progress, fmu_dir=args.fmus)
+    results = reproduce(
+        args.out,
+        args.ideal,
+        show_progress=not args.no_progress,
+        fmu_dir=args.fmus,
+        force=args.force,
+    )
     print("\n1. Actuator self-identification (load detached)")
     print(text_table(["term", "identified", "true", "error"], actuator_rows(results)))
     print("\n2. Table II: five rigid maneuvers (ours) next to the paper's")

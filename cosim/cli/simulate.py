@@ -6,7 +6,14 @@
 
 The CSV holds ``time``, the measured ``i_a``, ``omega_m``, ``theta_m`` (so it is a
 log that ``arcosim identify`` accepts) and every recorded signal as
-``plant.<name>`` / ``observer.<name>``.
+``plant.<name>`` / ``observer.<name>``. An existing ``--out`` file is replaced only
+with ``--force``, and never with one of the FMUs the run reads.
+
+The run is refused (exit 2) when its step and duration give no step or more than
+10⁷, and its result when a recorded signal is not finite or the plant moves
+faster than a passive chain driven by its current can (:func:`check_passive`), the
+check behind the FMUs' own limits on their parameters (before them,
+``--set plant.k[1]=1e12`` gave such numbers at 1 ms).
 """
 
 from __future__ import annotations
@@ -14,17 +21,37 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import math
+from collections.abc import Mapping
 from pathlib import Path
 
+import numpy as np
+
 from arcosim.build.builder import fmu_variables
-from arcosim.build.recipes import check_masses
-from arcosim.cli.options import add_fmus_option, fmu_folder
+from arcosim.build.recipes import MAX_MASSES, MIN_MASSES, check_masses
+from arcosim.cli.options import (
+    MAX_TIME,
+    add_fmus_option,
+    check_steps,
+    fmu_folder,
+    fmu_inputs,
+    force_option,
+    number,
+    step_option,
+    whole_number,
+)
 from arcosim.errors import UserError
-from arcosim.experiments.scenarios import SCENARIOS, recording_columns, run_scenario
-from arcosim.fmu.flexchain.defaults import STEP
-from arcosim.host.master import ORDERINGS
+from arcosim.experiments.scenarios import (
+    IDEAL_SENSORS,
+    SCENARIOS,
+    Scenario,
+    recording_columns,
+    run_scenario,
+)
+from arcosim.host.master import ORDERINGS, Recording
 from arcosim.host.overrides import split_overrides
 from arcosim.logs import write_csv
+from arcosim.outputs import check_output
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -37,7 +64,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     names = ", ".join(f"{s.name} ({s.description})" for s in SCENARIOS.values())
     p.add_argument("--scenario", default="flexible", help=f"one of: {names}")
-    p.add_argument("--masses", type=int, default=3, help="number of load masses (default 3)")
+    p.add_argument(
+        "--masses",
+        type=whole_number(MIN_MASSES, MAX_MASSES),
+        default=3,
+        help=f"number of load masses, {MIN_MASSES} to {MAX_MASSES} (default 3)",
+    )
     p.add_argument(
         "--set",
         action="append",
@@ -49,11 +81,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--ideal", action="store_true", help="ideal sensors: exact angle, true velocity, no noise"
     )
     p.add_argument("--ordering", choices=ORDERINGS, default="gauss-seidel")
+    step_option(p)
     p.add_argument(
-        "--step", type=float, default=STEP, help=f"communication step in s (default {STEP:g})"
+        "--duration",
+        type=number(0.0, MAX_TIME, low_open=True, unit="s"),
+        help=f"length in s, up to {MAX_TIME:g} (default: the scenario's)",
     )
-    p.add_argument("--duration", type=float, help="length in s (default: the scenario's)")
     p.add_argument("--out", type=Path, help="CSV of every recorded signal (a log for identify)")
+    force_option(p)
     p.add_argument("--json", action="store_true", help="print the final observer outputs as JSON")
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
@@ -62,15 +97,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def _execute(args: argparse.Namespace) -> int:
     if args.scenario not in SCENARIOS:
         raise UserError(f"--scenario {args.scenario!r}: use one of {', '.join(SCENARIOS)}")
-    if not args.step > 0:
-        raise UserError(f"--step {args.step}: the step must be > 0 s")
     scenario = SCENARIOS[args.scenario]
     if args.duration is not None:
-        if not args.duration > 0:
-            raise UserError(f"--duration {args.duration}: the duration must be > 0 s")
         scenario = dataclasses.replace(scenario, duration=args.duration)
+    check_steps("--step", scenario.duration, args.step)
     n = check_masses(args.masses)
+    if args.out:
+        check_output(args.out, force=args.force, inputs=fmu_inputs(args.fmus) if args.fmus else ())
     folder = fmu_folder(args, n)
+    if args.out:
+        check_output(args.out, force=args.force, inputs=fmu_inputs(folder))
     variables = fmu_variables(folder)
     overrides = split_overrides(args.set, variables)
     recording = run_scenario(
@@ -83,8 +119,11 @@ def _execute(args: argparse.Namespace) -> int:
         ideal=args.ideal,
         fmu_dir=folder,
     )
+    plant = {name: v.start for name, v in variables["plant"].items() if v.causality == "parameter"}
+    plant.update({**scenario.plant, **(IDEAL_SENSORS if args.ideal else {}), **overrides["plant"]})
+    check_passive(recording, scenario, plant, n, args.step, args.set)
     if args.out:
-        write_csv(args.out, recording_columns(recording))
+        write_csv(args.out, recording_columns(recording), force=args.force)
     final = {
         key.split(".", 1)[1]: float(series[-1])
         for key, series in recording.signals.items()
@@ -94,7 +133,7 @@ def _execute(args: argparse.Namespace) -> int:
         print(json.dumps(final, indent=2))
     else:
         print(
-            f"{scenario.name}: {len(recording.time) - 1} steps of {args.step} s ({args.ordering})"
+            f"{scenario.name}: {len(recording.time) - 1} steps of {args.step:g} s ({args.ordering})"
         )
         for key, value in final.items():
             if value:
@@ -102,3 +141,57 @@ def _execute(args: argparse.Namespace) -> int:
         if args.out:
             print(f"wrote {args.out}")
     return 0
+
+
+def check_passive(
+    recording: Recording,
+    scenario: Scenario,
+    plant: Mapping[str, object],
+    n: int,
+    h: float,
+    settings: list[str],
+) -> None:
+    """Refuse a recording a passive chain cannot produce.
+
+    The chain stores and dissipates energy but makes none: with the motor torque
+    ``|k_t i| <= τ`` its energy obeys ``dE/dt <= τ |ω_m| <= τ sqrt(2 E / J_m)``, so from
+    rest ``E(T) <= (τ T)² / (2 J_m)`` and every velocity ``|ω_i| <= sqrt(2 E / J_i)``.
+    ``τ`` is taken with twice the largest current command (the current loop's
+    overshoot), so a plant that integrates correctly is orders of magnitude inside;
+    one whose numbers blow up (a chain too stiff for the step) is far outside.
+
+    Raises
+    ------
+    UserError
+        When a signal is not finite or a velocity exceeds the bound.
+    """
+    given = f" (settings: {' '.join(settings)})" if settings else ""
+    hint = (
+        f"{given}: the model cannot be integrated at --step {h:g} s with these "
+        "parameters; use other values or a smaller step"
+    )
+    for name, series in recording.signals.items():
+        bad = np.flatnonzero(~np.isfinite(series))
+        if bad.size:
+            t = float(recording.time[bad[0]])
+            raise UserError(f"{name} is not finite from t = {t:g} s{hint}")
+    steps = max(round(scenario.duration / h), 1)
+    i_max = float(np.max(np.abs(scenario.current(np.arange(steps) * h))))
+    torque = 2.0 * abs(float(plant["k_t"])) * i_max
+    J_m = float(plant["J_m"])
+    energy = (torque * scenario.duration) ** 2 / (2.0 * J_m)
+    checks = [("omega_m_true", J_m)]
+    checks += [(f"omega[{i}]", float(plant[f"J[{i}]"])) for i in range(1, n + 1)]
+    for name, inertia in checks:
+        series = recording.signals.get(f"plant.{name}")
+        if series is None or not inertia > 0:
+            continue
+        bound = math.sqrt(2.0 * energy / inertia)
+        fastest = int(np.argmax(np.abs(series)))
+        if abs(series[fastest]) > bound:
+            t = float(recording.time[fastest])
+            raise UserError(
+                f"plant.{name} reached {float(series[fastest]):.3g} rad/s at t = {t:g} s, more "
+                f"than a passive chain driven by at most {torque:.3g} N.m can reach in "
+                f"{scenario.duration:g} s ({bound:.3g} rad/s){hint}"
+            )

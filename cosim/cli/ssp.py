@@ -14,10 +14,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.defaults import STEP
+from arcosim.cli.options import MAX_TIME, force_option, number, step_option
 from arcosim.host.ssp import run_ssp
 from arcosim.logs import write_csv
+from arcosim.outputs import check_output
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -30,22 +30,23 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--parameter-set", default="bench", help="parameter set to apply (default bench)"
     )
     p.add_argument(
-        "--stop", type=float, help="stop time in s (default: the SSP's DefaultExperiment)"
+        "--stop",
+        type=number(0.0, MAX_TIME, low_open=True, unit="s"),
+        help=f"stop time in s, up to {MAX_TIME:g} (default: the SSP's DefaultExperiment)",
     )
-    p.add_argument(
-        "--step", type=float, default=STEP, help=f"communication step in s (default {STEP:g})"
-    )
+    step_option(p)
     p.add_argument("--out", type=Path, help="CSV of every output of every component")
+    force_option(p)
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
-    if not args.step > 0:
-        raise UserError(f"--step {args.step}: the step must be > 0 s")
+    if args.out:
+        check_output(args.out, inputs=[args.path], force=args.force)
     recording = run_ssp(args.path, args.parameter_set, args.stop, args.step)
     if args.out:
-        write_csv(args.out, {"time": recording.time, **recording.signals})
-    print(f"{args.path}: {len(recording.time) - 1} steps of {args.step} s (Jacobi)")
+        write_csv(args.out, {"time": recording.time, **recording.signals}, force=args.force)
+    print(f"{args.path}: {len(recording.time) - 1} steps of {args.step:g} s (Jacobi)")
     for key in ("observer.tau_reac_hat", "observer.theta_hat[1]", "plant.theta[1]"):
         if key in recording.signals:
             print(f"  final {key:24s} {recording[key][-1]:.6g}")

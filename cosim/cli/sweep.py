@@ -2,7 +2,7 @@
 
     arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
 
-The spec (format in :mod:`cosim.sweep_spec`) names the scenario, the parameters to
+The spec (format in :mod:`arcosim.sweeps.spec`) names the scenario, the parameters to
 vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of
 runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of
 ``--workers`` processes runs here; with it the same tasks go to that cluster. Each run
@@ -11,7 +11,8 @@ appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
 finished run and ``--resume`` runs only the others; a failed run records its error and
 the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
 parameter and the PNGs the error histograms and the errors against each parameter
-(:mod:`cosim.sweep_summary`).
+(:mod:`arcosim.sweeps.summary`). While it runs the sweep holds the folder's lock: a
+second sweep into it is refused, naming the pid and start time of the first.
 """
 
 from __future__ import annotations
@@ -20,9 +21,10 @@ import argparse
 import time
 from pathlib import Path
 
-from arcosim.cli.options import add_fmus_option
+from arcosim.cli.options import add_fmus_option, whole_number
 from arcosim.errors import UserError
-from arcosim.sweeps.runner import sweep
+from arcosim.outputs import same_file
+from arcosim.sweeps.runner import RESULTS, SUMMARY, sweep
 from arcosim.sweeps.spec import load_spec
 from arcosim.sweeps.summary import read_results
 
@@ -40,7 +42,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--scheduler", help="address of an existing Dask scheduler (default: a local cluster)"
     )
     p.add_argument(
-        "--workers", type=int, default=2, help="worker processes of the local cluster (default 2)"
+        "--workers",
+        type=whole_number(1, 1024),
+        default=2,
+        help="worker processes of the local cluster, 1 to 1024 (default 2)",
     )
     p.add_argument("--out", type=Path, help="output folder (default sweeps/<name>)")
     p.add_argument("--resume", action="store_true", help="finish an interrupted sweep in --out")
@@ -51,9 +56,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def _execute(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
-    if args.workers < 1:
-        raise UserError(f"--workers {args.workers}: at least one worker")
     out = args.out or Path("sweeps") / spec.name
+    for name in (RESULTS, SUMMARY):
+        if same_file(args.spec, out / name):
+            raise UserError(f"{args.spec}: the sweep writes {out / name}; keep the spec elsewhere")
     start = time.perf_counter()
     results = sweep(
         spec,

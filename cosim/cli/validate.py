@@ -8,7 +8,9 @@ start and 20 steps with a silent log, a refused NaN input, step size 0, a wrong
 communication point and a ``doStep`` before initialization (each fmi2Discard
 with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and
 its ``libtbb12`` are installed, a run in that C++ engine with a bare environment.
-Prints the problems and exits 1 if there are any.
+Prints the problems and exits 1 if there are any. A file that is not an FMU at all
+(text, empty, a zip without ``modelDescription.xml``, a truncated zip, an SSP) is
+refused with one line and exit status 2 before any FMU is run.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from pathlib import Path
 
 from arcosim.build.builder import ensure_built
 from arcosim.errors import UserError
-from arcosim.host.validate import validate
+from arcosim.host.validate import not_an_fmu, validate
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -37,10 +39,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def _execute(args: argparse.Namespace) -> int:
     fmus = args.fmus or sorted(ensure_built(3).glob("*.fmu"))
+    for fmu in fmus:  # every input checked before any is run
+        why = not_an_fmu(fmu)
+        if why is not None:
+            raise UserError(f"{fmu}: {why}")
     failed = 0
     for fmu in fmus:
-        if not fmu.is_file():
-            raise UserError(f"{fmu}: no such file")
         problems, notes = validate(fmu)
         print(f"{fmu}: {'OK' if not problems else f'{len(problems)} problem(s)'}")
         for line in problems:

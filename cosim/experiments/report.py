@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.host.master import Recording
+from arcosim.outputs import save_figure
 
 
 def _pyplot():
@@ -44,7 +45,7 @@ def figure_reaction_torque(
     ax.legend(loc="upper right", fontsize=8)
     fig.suptitle("Fig. 4 — reaction torque and its reconstruction from the identified k, B")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 
@@ -73,7 +74,7 @@ def figure_flexible_response(recording: Recording, n: int, path: Path) -> Path:
     ax.legend(loc="upper left", fontsize=8, ncol=n + 1)
     fig.suptitle("Fig. 5 — flexible response of the chain (plant truth)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 
@@ -124,7 +125,7 @@ def figure_state_estimates(
         ax.set_xlabel("time (s)")
     fig.suptitle("Fig. 6 — angle of each mass relative to the motor, estimated and true")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 
@@ -178,7 +179,7 @@ def figure_whole_chain(
     magnitude.legend(fontsize=8)
     fig.suptitle("Fig. 7 — the whole chain from the motor's current and encoder alone")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 
@@ -207,7 +208,7 @@ def figure_load_torque(
     ax.legend(loc="lower left", fontsize=8)
     fig.suptitle("Fig. 8 — load torque on mass 3 from the motor alone (model-based observer)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
 

@@ -61,6 +61,7 @@ from arcosim.identification.output_error import motor_record, through_g
 from arcosim.identification.whole_chain import Choice
 from arcosim.identification.whole_chain import identify as identify_chain
 from arcosim.logs import write_csv
+from arcosim.outputs import check_output_folder, refuse_existing, write_text
 from arcosim.version import __version__
 
 N_MASSES = 3
@@ -84,14 +85,42 @@ class Results:
     files: list[Path] = field(default_factory=list)
 
 
+#: The files :func:`reproduce` writes into its folder.
+OUTPUTS = (
+    "selfid.csv",
+    *(f"rigid_seed{seed}.csv" for seed in SEEDS),
+    "flexible.csv",
+    "identification.csv",
+    "whole_chain.csv",
+    "load_true_chain.csv",
+    "load_identified_chain.csv",
+    "fig4_reaction_torque.png",
+    "fig5_flexible_response.png",
+    "fig6_state_estimates.png",
+    "fig7_whole_chain.png",
+    "fig8_load_torque.png",
+    "report.md",
+)
+
+
 def reproduce(
-    out: Path, ideal: bool = False, show_progress: bool = True, fmu_dir: Path | None = None
+    out: Path,
+    ideal: bool = False,
+    show_progress: bool = True,
+    fmu_dir: Path | None = None,
+    force: bool = False,
 ) -> Results:
-    """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``."""
+    """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
+
+    Refuses to start (:class:`UserError`) when one of :data:`OUTPUTS` exists in
+    ``out`` unless ``force``; every file is written atomically.
+    """
     from tqdm import tqdm
 
+    check_output_folder(out)
+    if not force:
+        refuse_existing(out, OUTPUTS)
     folder = ensure_built(N_MASSES, fmu_dir)
-    out.mkdir(parents=True, exist_ok=True)
     steps = (
         round(SCENARIOS["selfid"].duration / STEP)
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
@@ -117,7 +146,7 @@ def reproduce(
             k: float(final[k])
             for k in ("dkt_hat", "dJm_hat", "D_m_hat", "f_c_hat", "self_id_rank_deficient")
         }
-        results.files.append(write_csv(out / "selfid.csv", recording_columns(selfid)))
+        results.files.append(write_csv(out / "selfid.csv", recording_columns(selfid), force=True))
         actuator = {
             "dkt": final["dkt_hat"],
             "dJm": final["dJm_hat"],
@@ -137,7 +166,9 @@ def reproduce(
                     "valid": bool(rec["observer.id_valid"][-1]),
                 }
             )
-            results.files.append(write_csv(out / f"rigid_seed{seed}.csv", recording_columns(rec)))
+            results.files.append(
+                write_csv(out / f"rigid_seed{seed}.csv", recording_columns(rec), force=True)
+            )
             first_rigid = first_rigid or rec
         k_mean = float(np.mean([r["k"] for r in results.rigid]))
         b_mean = float(np.mean([r["B"] for r in results.rigid]))
@@ -148,11 +179,13 @@ def reproduce(
             for p, v in (("k", k_mean), ("B", max(b_mean, 0.0)))
         }
         flexible = run("flexible", observer={**actuator, **chain})
-        results.files.append(write_csv(out / "flexible.csv", recording_columns(flexible)))
+        results.files.append(
+            write_csv(out / "flexible.csv", recording_columns(flexible), force=True)
+        )
 
         identification = run("identification", plant={"seed": 1}, observer=actuator)
         results.files.append(
-            write_csv(out / "identification.csv", recording_columns(identification))
+            write_csv(out / "identification.csv", recording_columns(identification), force=True)
         )
         bar.set_postfix_str("whole-chain fit")
         cpr = 0 if ideal else int(fmu_variables(folder)["plant"]["encoder_cpr"].start)
@@ -164,14 +197,18 @@ def reproduce(
         if choice.n == N_MASSES:  # the plant has three masses: n must match to co-simulate
             identified = {**actuator, **results.whole_chain, "estimator": MODEL_BASED}
             estimated = run("flexible", observer=identified)
-            results.files.append(write_csv(out / "whole_chain.csv", recording_columns(estimated)))
+            results.files.append(
+                write_csv(out / "whole_chain.csv", recording_columns(estimated), force=True)
+            )
             loaded = {}
             for label, chain, name in (
                 ("true chain", TRUE_CHAIN, "load_true_chain.csv"),
                 ("identified chain", results.whole_chain, "load_identified_chain.csv"),
             ):
                 loaded[label] = run(LOAD_PROFILE.scenario().name, observer={**actuator, **chain})
-                results.files.append(write_csv(out / name, recording_columns(loaded[label])))
+                results.files.append(
+                    write_csv(out / name, recording_columns(loaded[label]), force=True)
+                )
     motor = flexible["plant.theta_m_true"]
     results.scores = [
         flexible_score(flexible[f"observer.theta_hat[{i}]"], flexible[f"plant.theta[{i}]"], motor)
@@ -189,8 +226,7 @@ def reproduce(
     results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean, estimated)
     if estimated is not None:
         results.files.append(_whole_chain_figure(out, identification, results))
-    report = out / "report.md"
-    report.write_text(_report(results, ideal, k_mean, b_mean), encoding="utf-8")
+    report = write_text(out / "report.md", _report(results, ideal, k_mean, b_mean), force=True)
     results.files.append(report)
     return results
 

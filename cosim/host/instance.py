@@ -10,6 +10,8 @@ from __future__ import annotations
 import atexit
 import contextlib
 import shutil
+import zipfile
+import zlib
 from collections.abc import Iterable, Mapping, Sequence
 from ctypes import CFUNCTYPE, c_int, c_size_t, c_void_p, cast
 from pathlib import Path
@@ -47,7 +49,13 @@ def extracted(path: Path) -> str:
     key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     folder = _EXTRACTED.get(key)
     if folder is None or not Path(folder).is_dir():
-        folder = extract(str(path))
+        try:  # extracting checks every member's CRC-32: a truncated or corrupt zip fails
+            folder = extract(str(path))
+        except (OSError, zipfile.BadZipFile, EOFError, zlib.error, ValueError) as error:
+            raise UserError(
+                f"{path}: not a complete FMU ({error}); rebuild it (`arcosim build`) or "
+                "check the file"
+            ) from None
         _EXTRACTED[key] = folder
         atexit.register(shutil.rmtree, folder, True)
     return folder
@@ -139,11 +147,23 @@ class FmuInstance:
         if not path.is_file():
             raise UserError(f"FMU not found: {path} (run `arcosim build` first)")
         self.path = path
-        self.description = read_model_description(str(path))
+        self.slave = None
+        # The description is read from the unzipped copy whose binary is loaded, so the
+        # two always match, even if the file is replaced (a rebuild) in between.
+        self._unzipped = extracted(path)
+        try:
+            self.description = read_model_description(self._unzipped)
+        except Exception as error:  # fmpy raises whatever its XML reader meets
+            raise UserError(f"{path}: not a valid FMU ({error})") from None
+        if self.description.fmiVersion != "2.0":
+            raise UserError(
+                f"{path}: an FMI {self.description.fmiVersion} FMU; arcosim runs FMI 2.0"
+            )
+        if self.description.coSimulation is None:
+            raise UserError(f"{path}: not a co-simulation FMU (it has no <CoSimulation>)")
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.messages: list[str] = []
         self._echo = echo_log
-        self._unzipped = extracted(path)
         self._callbacks = self._make_callbacks()
         self.slave = FMU2Slave(
             guid=self.description.guid,
@@ -162,14 +182,17 @@ class FmuInstance:
     ) -> None:
         """Set parameters by name, then run initialization mode at ``start_time`` (s).
 
-        Raises:
-            UserError: the FMU refused its parameters (its log lines are the message).
+        Raises
+        ------
+        UserError
+            When the FMU refuses a value or its initialization; its log lines (they
+            name the parameters at fault) are the message.
         """
-        self.slave.setupExperiment(startTime=start_time)
-        self.set(parameters or {})
-        self.slave.enterInitializationMode()
         before = len(self.messages)
         try:
+            self.slave.setupExperiment(startTime=start_time)
+            self.set(parameters or {})
+            self.slave.enterInitializationMode()
             self.slave.exitInitializationMode()
         except FMICallException as error:
             said = [m.split(": ", 1)[-1] for m in self.messages[before:]]
@@ -190,7 +213,7 @@ class FmuInstance:
 
     def close(self) -> None:
         """Terminate and free the instance (the unzipped FMU stays for the next one)."""
-        if self.slave is None:
+        if getattr(self, "slave", None) is None:
             return
         with contextlib.suppress(FMICallException):
             self.slave.terminate()

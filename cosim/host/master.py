@@ -22,10 +22,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.errors import UserError
+from arcosim.fmu.fmukit.checks import SMALLEST_STEP
 from arcosim.host.instance import FmuInstance
 
 MEASURED = ("i_a", "omega_m", "theta_m")
 ORDERINGS = ("gauss-seidel", "jacobi")
+#: Most communication steps a run of the command line (or a sweep) may take: 10⁷,
+#: 10⁴ s at 1 ms. Every recorded signal is kept in memory, 8 bytes a step: 10⁷ steps of
+#: the ~50 signals ``arcosim simulate`` records are 4 GB.
+MAX_STEPS = 10_000_000
+#: Largest time or length (s) the command line accepts: a day.
+MAX_TIME = 86_400.0
+#: Smallest communication step (s): the FMUs' own limit.
+MIN_STEP = SMALLEST_STEP
 
 
 @dataclass
@@ -128,7 +137,7 @@ def cosimulate(
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
     if not (h > 0.0 and np.isfinite(h)):
-        raise UserError(f"step size {h!r} s: it must be a finite number > 0")
+        raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
     if record_every < 1:
         raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
     currents = [float(x) for x in i_ref]
@@ -228,4 +237,4 @@ def _check(status: int, fmu: FmuInstance, doing: str, t: float) -> None:
     if status > 1:
         log = "\n  ".join(fmu.messages[-5:])
         refused = "refused the step" if doing == "stepping" else f"failed {doing}"
-        raise UserError(f"{fmu.path.name} {refused} at t = {t!r} s:\n  {log}")
+        raise UserError(f"{fmu.path.name} {refused} at t = {float(t):.10g} s:\n  {log}")

@@ -13,19 +13,32 @@ from collections.abc import Iterable, Mapping
 from arcosim.errors import UserError
 
 Value = float | int | bool | str
+#: The range of an FMI 2.0 Integer (32-bit).
+INT_MIN, INT_MAX = -(2**31), 2**31 - 1
 
 
 def parse_assignment(text: str) -> tuple[str, str]:
     """``"NAME=VALUE"`` → ``(NAME, VALUE)``; refuses text without ``=``."""
     name, sep, value = text.partition("=")
     if not sep or not name.strip() or not value.strip():
-        raise UserError(f"--set {text!r}: write NAME=VALUE, e.g. observer.g_dist=200")
+        raise UserError(f"--set {_shown(text)!r}: write NAME=VALUE, e.g. observer.g_dist=200")
     return name.strip(), value.strip()
 
 
 def typed_value(name: str, text: str, vtype: str) -> Value:
-    """Convert ``text`` to the FMI type ``vtype`` of variable ``name``."""
+    """Convert ``text`` to the FMI type ``vtype`` of variable ``name``.
+
+    Reals must be finite, Integers fit FMI's 32 bits, Strings are UTF-8 text without
+    NUL; anything else is a :class:`UserError` naming the variable and what it takes.
+    """
+    shown = _shown(text)
     if vtype == "String":
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            raise UserError(f"{name}={shown}: {name} takes UTF-8 text") from None
+        if "\x00" in text:
+            raise UserError(f"{name}={shown}: {name} takes text without a NUL character")
         return text
     try:
         if vtype == "Boolean":
@@ -36,14 +49,26 @@ def typed_value(name: str, text: str, vtype: str) -> Value:
                 return False
             raise ValueError
         if vtype == "Integer":
-            return int(text)
+            value = int(text)
+            if not INT_MIN <= value <= INT_MAX:
+                raise UserError(
+                    f"{name}={shown}: {name} takes a whole number from {INT_MIN} to {INT_MAX}"
+                )
+            return value
         value = float(text)
     except ValueError:
         kind = {"Boolean": "true or false", "Integer": "a whole number"}.get(vtype, "a number")
-        raise UserError(f"{name}={text}: {name} takes {kind}") from None
+        raise UserError(f"{name}={shown}: {name} takes {kind}") from None
     if not math.isfinite(value):
-        raise UserError(f"{name}={text}: {name} must be a finite number")
+        raise UserError(f"{name}={shown}: {name} must be a finite number")
     return value
+
+
+def _shown(text: str) -> str:
+    """``text`` for a message: control characters escaped, at most 60 characters."""
+    if not text.isprintable():
+        text = text.encode("unicode_escape", "backslashreplace").decode("ascii")
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def check_name(name: str, variables: Mapping[str, object], fmu: str) -> None:

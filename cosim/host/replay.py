@@ -109,7 +109,7 @@ def replay_log(
         status = observer.do_step(float(t[k - 1]), float(t[k] - t[k - 1]))
         if status > 1:
             raise UserError(
-                f"{log.path}, sample at t = {t[k]!r} s: the observer refused it: "
+                f"{log.path}, sample at t = {float(t[k]):.10g} s: the observer refused it: "
                 + (observer.messages[-1] if observer.messages else f"status {status}")
             )
         samples[k] = read()

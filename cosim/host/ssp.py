@@ -11,8 +11,10 @@ connected). ``arcosim ssp FILE`` is the command line.
 
 from __future__ import annotations
 
+import math
 import tempfile
 import zipfile
+import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +25,7 @@ import numpy as np
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
-from arcosim.host.master import Recording
+from arcosim.host.master import MAX_STEPS, Recording
 
 
 @dataclass
@@ -47,11 +49,22 @@ def read_ssp(path: Path) -> SspSystem:
         with zipfile.ZipFile(path) as z:
             z.extractall(folder.name)
         root = ElementTree.parse(Path(folder.name) / "SystemStructure.ssd").getroot()
-    except (zipfile.BadZipFile, FileNotFoundError, ElementTree.ParseError) as error:
+    except (zipfile.BadZipFile, ElementTree.ParseError, OSError, EOFError, zlib.error) as error:
         folder.cleanup()
         raise UserError(f"{path}: not a readable SSP ({error})") from None
+    try:
+        return _structure(path, root, folder)
+    except (ValueError, TypeError, IndexError) as error:
+        folder.cleanup()
+        raise UserError(f"{path}: not a readable SSP ({error})") from None
+
+
+def _structure(path: Path, root: ElementTree.Element, folder: tempfile.TemporaryDirectory):
+    """The :class:`SspSystem` of a parsed ``SystemStructure.ssd``."""
     components, sets = {}, {}
     for c in root.iterfind("{*}System/{*}Elements/{*}Component"):
+        if not c.get("name") or not c.get("source"):
+            raise ValueError("a Component without name or source")
         components[c.get("name")] = Path(folder.name) / c.get("source")
         for pset in c.iterfind(
             "{*}ParameterBindings/{*}ParameterBinding/{*}ParameterValues/{*}ParameterSet"
@@ -64,11 +77,17 @@ def read_ssp(path: Path) -> SspSystem:
         (x.get("startElement"), x.get("startConnector"), x.get("endElement"), x.get("endConnector"))
         for x in root.iterfind("{*}System/{*}Connections/{*}Connection")
     ]
+    for a, _, b, _ in connections:
+        for end in (a, b):
+            if end not in components:
+                raise ValueError(f"a Connection names the unknown component {end!r}")
     experiment = root.find("{*}DefaultExperiment")
     system = SspSystem(components, connections, sets, folder=folder)
     if experiment is not None:
         system.start = float(experiment.get("startTime", 0.0))
         system.stop = float(experiment.get("stopTime", 10.0))
+    if not (math.isfinite(system.start) and math.isfinite(system.stop)):
+        raise ValueError(f"DefaultExperiment {system.start} … {system.stop} s is not finite")
     return system
 
 
@@ -122,9 +141,28 @@ def run_ssp(
         raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
     chosen = system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
     stop = system.stop if stop is None else stop
-    steps = round((stop - system.start) / h)
-    instances = {name: FmuInstance(fmu, name) for name, fmu in system.components.items()}
+    if not (math.isfinite(stop) and stop > system.start):
+        system.folder.cleanup()
+        raise UserError(
+            f"stop time {stop:g} s: it must be finite and after the start, {system.start:g} s"
+        )
+    steps = round((stop - system.start) / h) if h > 0 and math.isfinite(h) else 0
+    if not 1 <= steps <= MAX_STEPS:
+        system.folder.cleanup()
+        raise UserError(
+            f"step {h:g} s from {system.start:g} to {stop:g} s gives {steps:.3g} steps; "
+            f"a run takes 1 to {MAX_STEPS:,} steps"
+        )
+    instances: dict[str, FmuInstance] = {}
     try:
+        for name, fmu in system.components.items():
+            if not fmu.is_file():
+                raise UserError(f"{path}: component {name}: no file {fmu.name} in the SSP")
+            try:
+                instances[name] = FmuInstance(fmu, name)
+            except UserError as error:
+                said = str(error).split(": ", 1)[-1]
+                raise UserError(f"{path}: component {name} ({fmu.name}): {said}") from None
         for name, fmu in instances.items():
             fmu.initialize({**chosen.get(name, {}), **(extra or {}).get(name, {})}, system.start)
         links = [
@@ -151,7 +189,9 @@ def run_ssp(
                 write(read())
             for name, fmu in instances.items():
                 if fmu.do_step(t, h) > 1:
-                    raise UserError(f"{name} refused the step at t = {t!r} s: {fmu.messages[-1:]}")
+                    raise UserError(
+                        f"{name} refused the step at t = {float(t):.10g} s: {fmu.messages[-1:]}"
+                    )
             for name, (read, _) in readers.items():
                 logs[name][k + 1] = read()
     finally:

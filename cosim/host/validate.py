@@ -16,12 +16,14 @@ from __future__ import annotations
 import math
 import tempfile
 import zipfile
+import zlib
 from pathlib import Path
 from xml.etree import ElementTree
 
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
+from arcosim.errors import UserError
 from arcosim.host.ecos import ecos_binary, run_ecos
 from arcosim.host.instance import FmuInstance
 from arcosim.portability import portability_problems
@@ -127,6 +129,30 @@ def check_ecos(fmu: Path) -> tuple[list[str], str | None]:
     return [], None
 
 
+def not_an_fmu(path: Path) -> str | None:
+    """Why ``path`` cannot be validated at all (not a file, not a complete FMU zip,
+    an SSP), or None."""
+    if not path.exists():
+        return "no such file"
+    if not path.is_file():
+        return "not a file"
+    if path.suffix.lower() == ".ssp":
+        return "an SSP system, not an FMU (run it with `arcosim ssp`; validate its FMUs)"
+    if not zipfile.is_zipfile(path):
+        size = path.stat().st_size
+        return "an empty file, not an FMU" if size == 0 else "not an FMU (not a zip file)"
+    try:
+        with zipfile.ZipFile(path) as z:
+            if "modelDescription.xml" not in z.namelist():
+                return "a zip file without modelDescription.xml, not an FMU"
+            bad = z.testzip()
+            if bad is not None:
+                return f"a corrupt FMU (member {bad} fails its CRC-32)"
+    except (OSError, zipfile.BadZipFile, EOFError, zlib.error) as error:
+        return f"a truncated or corrupt FMU ({error})"
+    return None
+
+
 def validate(fmu: Path) -> tuple[list[str], list[str]]:
     """Check one FMU the way a strict FMI host would.
 
@@ -159,10 +185,17 @@ def validate(fmu: Path) -> tuple[list[str], list[str]]:
     >>> problems
     []
     """
-    problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
+    try:
+        problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
+    except Exception as error:  # fmpy's reader raises whatever the file makes it meet
+        return [f"fmpy cannot read the model description ({type(error).__name__}: {error})"], []
     problems += [f"portability: {p}" for p in portability_problems(fmu)]
     problems += check_model_description(fmu)
-    problems += check_runtime(fmu)
+    try:
+        problems += check_runtime(fmu)
+    except (UserError, FMICallException) as error:
+        problems.append(f"the FMU does not run in fmpy: {error}")
+        return problems, ["the ecos run was skipped: the FMU does not run in fmpy"]
     ecos_problems, skipped = check_ecos(fmu)
     problems += ecos_problems
     return problems, [f"ecos run skipped: {skipped}"] if skipped else []

@@ -29,6 +29,7 @@ import numpy as np
 
 from arcosim.fmu.flexchain import excitation
 from arcosim.fmu.flexchain.defaults import STEP
+from arcosim.identification.errors import IdentificationError
 
 #: Lines of the multi-sine (log-spaced over the band).
 LINES = 40
@@ -42,7 +43,7 @@ LINE_T = 5.0
 MULTISINE = 1
 
 
-class ExcitationError(ValueError):
+class ExcitationError(IdentificationError):
     """A band or limit no excitation can meet; the message says what to change."""
 
 
@@ -91,25 +92,66 @@ def excite(
     g_dist: float | None = None,
     speed_gain: float | None = None,
 ) -> Excitation:
-    """Design the identification multi-sine.
+    """Design the multi-sine to play on a drive for whole-chain identification.
 
-    Args:
-        band: lowest and highest line (rad/s).
-        current_limit: the drive's peak current (A): a current multi-sine's lines add up
-            to it, so the command never exceeds it.
-        h: sample step (s).
-        duration: record length (s).
-        lines: number of log-spaced lines.
-        kind: ``"current"`` (open loop) or ``"speed"`` (reference of a PI speed loop with
-            proportional gain ``speed_gain``, A·s/rad: lines ∝ frequency, whose currents
-            through the gain add up to ``current_limit``).
-        seed: phases (the ExcitationSource's seed).
-        k_t, f_c, J_total, counts, g_dist: when given, the design is checked against the
-            friction (sticking), the encoder (motion at the top line) and the DOB band.
+    Log-spaced lines over the band whose amplitudes add up to the current limit (a
+    current command), or grow with frequency (a speed loop's reference); checked,
+    when the drive's figures are given, against the friction (sticking), the encoder
+    (motion at the top line) and the DOB's band — each shortfall a warning with what
+    to change.
 
-    Raises:
-        ExcitationError: for a band that is empty or above what the sample rate leaves,
-            a non-positive limit, or a speed design without ``speed_gain``.
+    Parameters
+    ----------
+    band : tuple of float
+        Lowest and highest line (rad/s).
+    current_limit : float
+        The drive's peak current (A): a current multi-sine's lines add up to it, so the
+        command never exceeds it.
+    h : float
+        Sample step (s).
+    duration : float
+        Record length (s).
+    lines : int
+        Number of log-spaced lines (a count).
+    kind : {"current", "speed"}
+        ``"current"`` (open loop) or ``"speed"`` (the reference of a PI speed loop with
+        proportional gain ``speed_gain``: lines ∝ frequency, whose currents through the
+        gain add up to ``current_limit``).
+    seed : int
+        Seed of the phases (the ExcitationSource FMU's ``seed``); an index.
+    k_t : float, optional
+        Torque constant (N·m/A), for the friction check.
+    f_c : float, optional
+        Coulomb friction (N·m), for the friction check.
+    J_total : float, optional
+        Motor and load inertia (kg·m²), for the encoder check.
+    counts : int, optional
+        Encoder counts per revolution (a count), for the encoder check.
+    g_dist : float, optional
+        DOB bandwidth (rad/s), for the band check.
+    speed_gain : float, optional
+        The speed loop's proportional gain (A·s/rad), for ``kind="speed"``.
+
+    Returns
+    -------
+    Excitation
+        Time (s) and command (A or rad/s), shape ``(N,)``; the lines (rad/s), their
+        amplitudes and phases, shape ``(L,)``; ExcitationSource parameters that play
+        the same current; the warnings.
+
+    Raises
+    ------
+    ExcitationError
+        For a band that is empty or above what the sample rate leaves, a non-positive
+        limit, or a speed design without ``speed_gain``.
+
+    Examples
+    --------
+    >>> design = arcosim.design_excitation((3.0, 150.0), 3.0, k_t=0.0406, f_c=2e-3)
+    >>> design.signal.shape, bool(np.abs(design.signal).max() <= 3.0)
+    ((20001,), True)
+    >>> design.source_parameters["lines"], design.warnings
+    (40, [])
     """
     low, high = (float(x) for x in band)
     if not 0.0 < low < high:

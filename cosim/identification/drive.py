@@ -164,29 +164,17 @@ def identify_drive(
 
     Examples
     --------
-    A two-mass chain simulated here (the project's own simulator of the plant's
-    physics), identified from the motor's current and encoder:
+    A two-mass chain the plant FMU simulates under the ``identification`` excitation
+    (40 lines, 3–150 rad/s, 3 A, 20 s), identified from the motor's signals alone
+    (its friction fitted):
 
-    >>> from arcosim.plant.motorchain.physics import PlantPhysics
-    >>> from arcosim.fmu.flexchain import excitation
-    >>> h, J, k, B = 1e-3, [4e-4, 8e-4], [0.3, 0.2], [2e-5, 1.5e-5]
-    >>> plant = PlantPhysics(J_m=2.09e-5, k_t=0.0406, D_m=0.0, f_c=0.0, J=J, k=k, B=B)
-    >>> lines = excitation.log_spaced(3.0, 150.0, 40)
-    >>> phases = excitation.multisine_phases(40, 1)
-    >>> t = np.arange(20001) * h
-    >>> current = [excitation.multisine(x, 3.0, lines, phases) for x in t]
-    >>> angle = [0.0]
-    >>> for i in current[1:]:
-    ...     angle.append(plant.step(h, i)[0])
-    >>> counts = 2.0 * np.pi / 16384
-    >>> theta = np.floor(np.array(angle) / counts) * counts
-    >>> omega = np.concatenate([[0.0], np.diff(theta) / h])
-    >>> result = arcosim.identify_drive(
-    ...     t, current, omega, theta, k_t=0.0406, J_m=2.09e-5, encoder_cpr=16384,
-    ...     D_m=0.0, f_c=0.0)
+    >>> chain = {"J[1]": 4e-4, "J[2]": 8e-4, "k[1]": 0.3, "k[2]": 0.2}
+    >>> run = arcosim.run_scenario(arcosim.SCENARIOS["identification"], 2, plant=chain)
+    >>> log = [run.time] + [run[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
+    >>> result = arcosim.identify_drive(*log, k_t=0.0406, J_m=2.09e-5, encoder_cpr=2000)
     >>> result.masses
     2
-    >>> [round(result.parameters[f"k[{i}]"], 3) for i in (1, 2)]
+    >>> [round(result.parameters[name], 2) for name in ("k[1]", "k[2]")]  # N·m/rad
     [0.3, 0.2]
     """
     if not (k_t > 0 and J_m > 0):

@@ -124,17 +124,54 @@ def encoder_record(
     load: str = "none",
     g_dist: float = G_DIST,
 ) -> EncoderRecord:
-    """Build the record from a log (``theta_m`` as the encoder gives it: whole counts);
-    the friction's sign from the angle's derivative smoothed without lag at
-    ``VELOCITY_SMOOTHING · g_dist``, as the motor record's DOB velocity (the second pass
-    of :func:`refine` replaces it).
+    """The record of the prediction-error fit: the current in, the encoder's counts out.
 
-    With ``friction_given=False`` the actuator's D_m, f_c are ignored and the fit
-    starts from a rigid-body estimate (:func:`rigid_friction`).
+    The friction's sign comes from the angle's derivative smoothed without lag at
+    ``VELOCITY_SMOOTHING · g_dist``, as the motor record's DOB velocity (the second
+    pass of :func:`refine` replaces it). With ``friction_given=False`` the actuator's
+    D_m, f_c are ignored and the fit starts from a rigid-body estimate
+    (:func:`rigid_friction`).
 
-    Raises:
-        IdentificationError: for an encoder without counts (``cpr`` ≤ 0), a varying step or an
-            unknown ``load``.
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``, a constant step.
+    i_a : ndarray
+        Current (A), shape ``(N,)``, the current that acted over each step.
+    theta_m : ndarray
+        Motor angle as the encoder gives it (rad, whole counts), shape ``(N,)``.
+    actuator : Actuator
+        The motor's terms (J_mo kg·m², k_to N·m/A, D_m N·m·s/rad, f_c N·m).
+    cpr : int
+        The encoder's counts per revolution (a count), > 0.
+    friction_given : bool
+        Whether the actuator's D_m and f_c are known (else they are fitted).
+    load : {"none", "constant", "slow"}
+        The load torque the model carries on the last mass.
+    g_dist : float
+        The DOB's bandwidth (rad/s), for the friction sign's smoothing.
+
+    Returns
+    -------
+    EncoderRecord
+        The drive torque (N·m), the counts' angle (rad) and their resolution (rad),
+        the friction model and its start, each array of shape ``(N,)``.
+
+    Raises
+    ------
+    IdentificationError
+        For an encoder without counts (``cpr`` ≤ 0), a varying step or an unknown
+        ``load``.
+
+    Examples
+    --------
+    >>> t = np.arange(1000) * 1e-3
+    >>> counts = 2.0 * np.pi / 2000
+    >>> theta = np.floor(np.sin(3.0 * t) / counts) * counts
+    >>> motor = arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406)
+    >>> record = arcosim.encoder_record(t, 0.1 * np.sin(3.0 * t), theta, motor, 2000)
+    >>> record.h, float(record.count) == counts
+    (0.001, True)
     """
     if cpr <= 0:
         raise IdentificationError(

@@ -61,15 +61,50 @@ def estimate(
     omega_m: np.ndarray,
     theta_m: np.ndarray,
 ) -> LoadEstimate:
-    """Run the load torque estimator over a log (timing contract of shared/METHOD.md).
+    """The torque on a load mass over a recorded log, from the motor's signals alone.
 
-    Args:
-        settings: mode 2, estimator 1, ``load_mass`` ≥ 1, and the chain and actuator.
-        time: sample times (s), strictly increasing, shape (N,).
-        i_a, omega_m, theta_m: the log's current (A), velocity (rad/s), angle (rad).
+    The observer FMU's own estimator (mode 2, estimator 1 with ``load_mass``), run
+    offline one sample at a time with the step each row takes.
 
-    Raises:
-        IdentificationError: for settings that do not estimate a load torque.
+    Parameters
+    ----------
+    settings : ObserverSettings
+        Mode 2, estimator 1, ``load_mass`` ≥ 1, the chain (J_i kg·m², k_i N·m/rad,
+        B_i N·m·s/rad) and the actuator, as the observer FMU's parameters would say.
+    time : ndarray
+        Sample times (s), strictly increasing, shape ``(N,)``.
+    i_a : ndarray
+        Current (A), shape ``(N,)``.
+    omega_m : ndarray
+        Motor velocity (rad/s), shape ``(N,)``.
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+
+    Returns
+    -------
+    LoadEstimate
+        The estimated torque on the load mass (N·m, the plant's ``tau_ext`` sign),
+        τ̂_reac (N·m), the load angles (rad) and velocities (rad/s), the innovation.
+
+    Raises
+    ------
+    IdentificationError
+        For settings that do not estimate a load torque.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from arcosim.fmu.flexchain import defaults
+    >>> from arcosim.fmu.flexchain.observer import ObserverSettings
+    >>> run = arcosim.run_scenario(dataclasses.replace(arcosim.SCENARIOS["flexible"], duration=2.0))
+    >>> settings = ObserverSettings(
+    ...     mode=2, actuator=arcosim.Actuator(defaults.J_M, defaults.K_T, D_m=2e-5, f_c=2e-3),
+    ...     g_dist=100.0, g_lpf=100.0, J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3,
+    ...     estimator=1, encoder_cpr=2000, load_mass=3)
+    >>> signals = [run[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
+    >>> estimate = arcosim.estimate_load_torque(settings, run.time, *signals)
+    >>> estimate.tau_load.shape, bool(abs(estimate.tau_load[-1]) < 1e-3)  # no load: ≈ 0 N·m
+    ((2001,), True)
     """
     if not (
         settings.mode == STATE_ESTIMATION

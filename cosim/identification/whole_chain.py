@@ -140,19 +140,51 @@ def identify(
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
     The record's modes come from a stabilization diagram of the subspace step
-    (:func:`~cosim.modal_start.detect_modes`): a mode counts when it comes back at
-    several model orders and its residue stands above its standard error; ``auto``
-    takes n = the number that count. An n the record cannot support is refused, naming
-    the modes it shows, the ones too weakly excited, and what would fix the record.
+    (:func:`~arcosim.identification.modal_start.detect_modes`): a mode counts when it
+    comes back at several model orders and its residue stands above its standard
+    error; ``auto`` takes n = the number that count, confirmed by the data's
+    information criterion one weak mode at a time. An n the record cannot support is
+    refused, naming the modes it shows, the ones too weakly excited, and what would
+    fix the record. :func:`arcosim.identify_drive` runs this from a log.
 
     With ``encoder`` (the same log's current and encoder counts) the chain is fitted by
-    the prediction-error fit from the current to the encoder (:mod:`cosim.encoder_fit`:
-    with the motor's friction and a load torque when the record asks for them) straight
-    from the modal start; without it, by the output-error fit to τ̂_reac.
+    the prediction-error fit from the current to the encoder
+    (:mod:`arcosim.identification.encoder_fit`: with the motor's friction and a load
+    torque when the record asks for them) straight from the modal start; without it,
+    by the output-error fit to τ̂_reac.
 
-    Raises:
-        IdentificationError: when ``masses`` is neither a positive integer nor ``"auto"``, or the
-            record cannot support the chain asked for.
+    Parameters
+    ----------
+    record : MotorRecord
+        The log's reaction-torque record (:func:`~arcosim.motor_record`).
+    masses : int or "auto"
+        Number of load masses (a count), or ``"auto"``.
+    encoder : EncoderRecord, optional
+        The same log's current → encoder record (:func:`~arcosim.encoder_record`).
+
+    Returns
+    -------
+    Choice
+        ``n``, the fit (``J[i]`` kg·m², ``k[i]`` N·m/rad, ``B[i]`` N·m·s/rad with
+        standard errors, and the evidence), the criterion per n tried, refusals.
+
+    Raises
+    ------
+    IdentificationError
+        When ``masses`` is neither a positive integer nor ``"auto"``, or the record
+        cannot support the chain asked for.
+
+    Examples
+    --------
+    >>> run = arcosim.run_scenario(arcosim.SCENARIOS["identification"], 2,
+    ...                            plant={"J[1]": 4e-4, "J[2]": 8e-4, "k[1]": 0.3, "k[2]": 0.2})
+    >>> i_a, omega, theta = (run[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m"))
+    >>> motor = arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406, D_m=2e-5, f_c=2e-3)
+    >>> record = arcosim.motor_record(run.time, i_a, omega, theta, motor, 100.0)
+    >>> encoder = arcosim.encoder_record(run.time, i_a, theta, motor, 2000)
+    >>> choice = arcosim.identify_whole_chain(record, "auto", encoder)
+    >>> choice.n, round(choice.fit.as_dict()["k[1]"], 2)
+    (2, 0.3)
     """
     auto = masses == "auto"
     n_asked = None if auto else _masses(masses)

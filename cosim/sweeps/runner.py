@@ -2,7 +2,7 @@
 
     arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
 
-The spec (format in :mod:`cosim.sweep_spec`) names the scenario, the parameters to
+The spec (format in :mod:`arcosim.sweeps.spec`) names the scenario, the parameters to
 vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of
 runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of
 ``--workers`` processes runs here; with it the same tasks go to that cluster. Each run
@@ -11,18 +11,29 @@ appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
 finished run and ``--resume`` runs only the others; a failed run records its error and
 the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
 parameter and the PNGs the error histograms and the errors against each parameter
-(:mod:`cosim.sweep_summary`).
+(:mod:`arcosim.sweeps.summary`).
+
+A sweep holds its folder's lock (:func:`lock_sweep`) from the check of
+``results.csv`` to the summary, so a second sweep into the same folder (fresh or
+``--resume``) is refused, naming the one that runs: no run is duplicated, and two
+fresh starts cannot both begin.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
+import datetime
+import fcntl
 import hashlib
+import os
+import socket
+import sys
 import tempfile
 import time
 import traceback
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 
 from arcosim.build.builder import ensure_built, fmu_variables
@@ -30,10 +41,60 @@ from arcosim.build.recipes import OBSERVER, PLANT
 from arcosim.errors import UserError
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.host.overrides import typed_value
+from arcosim.outputs import check_output_folder
 from arcosim.sweeps.spec import SweepSpec, check_names, draw_runs, load_spec, metric_columns
 from arcosim.sweeps.summary import complete, read_results, write_summary
 
-__all__ = ["draw_runs", "load_spec", "read_results", "run_one", "sweep"]
+__all__ = ["draw_runs", "load_spec", "lock_sweep", "read_results", "run_one", "sweep"]
+
+#: The lock file of a sweep folder; while locked it says who holds it.
+LOCK_FILE = ".arcosim-sweep.lock"
+#: The files a sweep writes into its folder (besides the PNG plots).
+RESULTS, SUMMARY = "results.csv", "summary.md"
+
+
+@contextlib.contextmanager
+def lock_sweep(out: Path) -> Iterator[None]:
+    """Hold the lock of the sweep folder ``out``, or refuse naming the sweep that does.
+
+    An ``flock`` on :data:`LOCK_FILE`, taken without waiting; the kernel releases it
+    when the holder exits, however it exits, so it is never stale. The holder writes
+    its pid, host, start time and command into the file for the message.
+
+    Raises
+    ------
+    UserError
+        When another process holds the lock, or the folder cannot be used.
+    """
+    check_output_folder(out)
+    try:
+        handle = open(out / LOCK_FILE, "a+", encoding="utf-8")  # noqa: SIM115 (held across the yield)
+    except OSError as error:
+        raise UserError(f"--out {out}: cannot lock the folder ({error.strerror})") from None
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = " ".join(handle.read().split())[:300] or "one that is starting"
+            raise UserError(
+                f"--out {out}: another sweep is writing there ({holder}); wait for it to "
+                "finish or choose another --out"
+            ) from None
+        try:
+            handle.seek(0)
+            handle.truncate()
+            started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
+            command = " ".join(["arcosim", *sys.argv[1:]])[:200]
+            handle.write(
+                f"pid {os.getpid()} on {socket.gethostname()}, started {started}: {command}\n"
+            )
+            handle.flush()
+            yield
+        finally:
+            handle.seek(0)
+            handle.truncate()
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def run_one(
@@ -141,26 +202,26 @@ def sweep(
     check_names(spec, variables)
     runs = draw_runs(spec)
     columns = ["run", *spec.vary, *metric_columns(spec), "error"]
-    out.mkdir(parents=True, exist_ok=True)
-    results = out / "results.csv"
-    done = _finished_runs(results, columns) if resume else set()
-    if results.exists() and not resume:
-        raise UserError(
-            f"{results} exists: add --resume to finish that sweep, or choose another --out"
-        )
-    pending = [(i, v) for i, v in enumerate(runs) if i not in done]
-    blobs = {name: path.read_bytes() for name, path in fmus.items()}
-    if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
-        with open(results, "a", encoding="utf-8") as f:
-            f.write("\n")  # an interrupted write: keep its partial line apart
-    with open(results, "a", newline="", encoding="utf-8") as f:
-        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        if not done:
-            writer.writeheader()
-            f.flush()
-        if pending:
-            _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress)
-    write_summary(spec, results, out)
+    results = out / RESULTS
+    with lock_sweep(out):
+        done = _finished_runs(results, columns) if resume else set()
+        if results.exists() and not resume:
+            raise UserError(
+                f"{results} exists: add --resume to finish that sweep, or choose another --out"
+            )
+        pending = [(i, v) for i, v in enumerate(runs) if i not in done]
+        blobs = {name: path.read_bytes() for name, path in fmus.items()}
+        if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
+            with open(results, "a", encoding="utf-8") as f:
+                f.write("\n")  # an interrupted write: keep its partial line apart
+        with open(results, "a", newline="", encoding="utf-8") as f:
+            writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+            if not results.stat().st_size:
+                writer.writeheader()
+                f.flush()
+            if pending:
+                _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress)
+        write_summary(spec, results, out)
     return results
 
 
@@ -196,10 +257,15 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
 def _finished_runs(results: Path, columns: Sequence[str]) -> set[int]:
     if not results.exists():
         return set()
-    with open(results, newline="", encoding="utf-8") as f:
-        reader = csv.DictReader(f)
-        if reader.fieldnames != list(columns):
-            raise UserError(
-                f"{results} was written by another spec (columns differ); choose another --out"
-            )
-        return {int(row["run"]) for row in reader if complete(row)}
+    try:
+        with open(results, newline="", encoding="utf-8") as f:
+            reader = csv.DictReader(f)
+            if reader.fieldnames != list(columns):
+                raise UserError(
+                    f"{results} was written by another spec (columns differ); choose another --out"
+                )
+            return {int(row["run"]) for row in reader if complete(row)}
+    except (UnicodeDecodeError, csv.Error) as error:
+        raise UserError(
+            f"{results}: not a sweep's results ({error}); choose another --out"
+        ) from None

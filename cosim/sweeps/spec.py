@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -40,8 +41,9 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.recipes import check_masses
+from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.errors import UserError
+from arcosim.host.master import MAX_STEPS, MAX_TIME, MIN_STEP
 from arcosim.host.overrides import check_name, typed_value
 
 if sys.version_info >= (3, 11):
@@ -71,6 +73,10 @@ DISTRIBUTIONS = {
     "grid": ("values",),
 }
 METRICS = ("k_error", "B_error", "D_m_error", "f_c_error", "theta_error", "runtime")
+#: Most runs one sweep may ask for.
+MAX_RUNS = 1_000_000
+#: A sweep's name: it names the folder ``sweeps/<name>``, so one plain folder name.
+NAME = re.compile(r"[A-Za-z0-9._-]{1,100}")
 
 
 @dataclass(frozen=True)
@@ -91,80 +97,203 @@ class SweepSpec:
 
 
 def load_spec(path: Path) -> SweepSpec:
-    """Read and check a spec; every mistake is a :class:`UserError` naming it."""
+    """Read and check a spec; every mistake is a :class:`UserError` naming it.
+
+    Every field is checked for its type and range: whole numbers are TOML integers
+    (``runs = 2.5`` and ``runs = "ten"`` are refused), numbers are finite, the name is
+    a plain folder name (it names ``sweeps/<name>``: no ``/``, no ``..``), and a spec
+    asks for 1 to :data:`MAX_RUNS` runs of 1 to :data:`MAX_STEPS` steps each.
+    """
     from arcosim.experiments.scenarios import SCENARIOS
+    from arcosim.logs import read_text_file
 
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
+    text = read_text_file(path, "sweep spec")
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise UserError(f"{path}: not valid TOML ({error})") from None
+        raise UserError(f"{path}: not valid TOML ({_one_line(str(error))})") from None
+    where = f"{path}:"
     unknown = set(raw) - KEYS
     if unknown:
         raise UserError(
-            f"{path}: unknown key {', '.join(sorted(unknown))} (known: {', '.join(sorted(KEYS))})"
+            f"{where} unknown key {', '.join(sorted(_key(k) for k in unknown))} "
+            f"(known: {', '.join(sorted(KEYS))})"
         )
-    scenario = raw.get("scenario", "rigid")
+    name = _text(where, "name", raw.get("name", path.stem))
+    if not NAME.fullmatch(name) or name in (".", ".."):
+        raise UserError(
+            f"{where} name = {_shown(name)}: use letters, digits, '.', '_' and '-' only (it "
+            "names the folder sweeps/<name>), at most 100 characters, not '.' or '..'"
+        )
+    scenario = _text(where, "scenario", raw.get("scenario", "rigid"))
     if scenario not in SCENARIOS:
-        raise UserError(f"{path}: scenario {scenario!r} is not one of {', '.join(SCENARIOS)}")
-    metrics = tuple(raw.get("metrics", ["k_error", "B_error", "runtime"]))
+        raise UserError(f"{where} scenario {_shown(scenario)} is not one of {', '.join(SCENARIOS)}")
+    metrics = raw.get("metrics", ["k_error", "B_error", "runtime"])
+    if not isinstance(metrics, list) or not metrics:
+        raise UserError(f'{where} metrics: write a list, e.g. metrics = ["k_error", "runtime"]')
     for metric in metrics:
-        if metric not in METRICS:
-            raise UserError(f"{path}: metric {metric!r} is not one of {', '.join(METRICS)}")
-    vary = raw.get("vary", {})
-    for name, dist in vary.items():
-        _check_distribution(path, name, dist)
+        if not isinstance(metric, str) or metric not in METRICS:
+            raise UserError(f"{where} metric {_shown(metric)} is not one of {', '.join(METRICS)}")
+    metrics = tuple(dict.fromkeys(metrics))
+    fixed = _table(where, "fixed", raw.get("fixed", {}))
+    vary = _table(where, "vary", raw.get("vary", {}))
+    for qualified in [*vary, *fixed]:
+        if qualified.split(".", 1)[0] not in ("plant", "observer") or "." not in qualified:
+            raise UserError(
+                f"{where} {_key(qualified)!r}: name the FMU first (plant.NAME or observer.NAME)"
+            )
+    both = sorted(set(vary) & set(fixed))
+    if both:
+        raise UserError(f"{where} {both[0]} is both fixed and varied; keep one")
+    for qualified, value in fixed.items():
+        _scalar(where, qualified, value)
+    for qualified, dist in vary.items():
+        _check_distribution(path, qualified, dist)
     grids = [n for n, d in vary.items() if d["distribution"] == "grid"]
     if grids and len(grids) != len(vary):
         raise UserError(
-            f"{path}: a grid cannot be mixed with random distributions "
+            f"{where} a grid cannot be mixed with random distributions "
             f"({', '.join(grids)} are grids)"
         )
-    runs = int(raw.get("runs", 0 if grids else 1))
-    if not grids and runs < 1:
-        raise UserError(f"{path}: runs = {runs}: at least one run")
-    for name in [*vary, *raw.get("fixed", {})]:
-        if name.split(".", 1)[0] not in ("plant", "observer") or "." not in name:
-            raise UserError(f"{path}: {name!r}: name the FMU first (plant.NAME or observer.NAME)")
+    if grids:
+        runs = math.prod(len(vary[n]["values"]) for n in grids)
+        if runs > MAX_RUNS:
+            raise UserError(f"{where} the grid has {runs:,} runs, more than {MAX_RUNS:,}")
+        if "runs" in raw:  # a grid's size comes from the grid; runs is checked, not used
+            _integer(where, "runs", raw["runs"], 1, MAX_RUNS)
+    else:
+        runs = _integer(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
+    masses = _integer(where, "masses", raw.get("masses", 3), MIN_MASSES, MAX_MASSES)
+    seed = _integer(where, "seed", raw.get("seed", 0), 0, 2**63 - 1)
+    step = _real(where, "step", raw.get("step", 1e-3), MIN_STEP, MAX_TIME)
     duration = raw.get("duration")
-    if duration is not None and not duration > 0:
-        raise UserError(f"{path}: duration = {duration}: it must be > 0 s")
+    length = SCENARIOS[scenario].duration
+    if duration is not None:
+        duration = length = _real(where, "duration", duration, 0.0, MAX_TIME, low_open=True)
+    steps = round(length / step)
+    if not 1 <= steps <= MAX_STEPS:
+        raise UserError(
+            f"{where} step = {step:g} s gives {steps:.3g} steps in {length:g} s; "
+            f"a run takes 1 to {MAX_STEPS:,} steps"
+        )
+    ideal = raw.get("ideal", False)
+    if not isinstance(ideal, bool):
+        raise UserError(f"{where} ideal = {_shown(ideal)}: write true or false")
     return SweepSpec(
-        name=str(raw.get("name", path.stem)),
+        name=name,
         scenario=scenario,
-        masses=check_masses(int(raw.get("masses", 3))),
+        masses=masses,
         runs=runs,
-        seed=int(raw.get("seed", 0)),
+        seed=seed,
         metrics=metrics,
-        fixed=dict(raw.get("fixed", {})),
+        fixed=dict(fixed),
         vary=dict(vary),
         duration=duration,
-        step=float(raw.get("step", 1e-3)),
-        ideal=bool(raw.get("ideal", False)),
+        step=step,
+        ideal=ideal,
     )
 
 
 def _check_distribution(path: Path, name: str, dist: object) -> None:
+    where = f"{path}: {name}:"
     if not isinstance(dist, dict) or "distribution" not in dist:
-        raise UserError(f'{path}: {name}: write {{ distribution = "uniform", low = …, high = … }}')
+        raise UserError(f'{where} write {{ distribution = "uniform", low = …, high = … }}')
     kind = dist["distribution"]
-    if kind not in DISTRIBUTIONS:
+    if not isinstance(kind, str) or kind not in DISTRIBUTIONS:
         raise UserError(
-            f"{path}: {name}: unknown distribution {kind!r} (use {', '.join(DISTRIBUTIONS)})"
+            f"{where} unknown distribution {_shown(kind)} (use {', '.join(DISTRIBUTIONS)})"
         )
     missing = [k for k in DISTRIBUTIONS[kind] if k not in dist]
     if missing:
-        raise UserError(f"{path}: {name}: a {kind} distribution needs {', '.join(missing)}")
-    if kind in ("choice", "grid") and (not isinstance(dist["values"], list) or not dist["values"]):
-        raise UserError(f"{path}: {name}: values must be a non-empty list")
+        raise UserError(f"{where} a {kind} distribution needs {', '.join(missing)}")
+    extra = sorted(_key(k) for k in set(dist) - {"distribution", *DISTRIBUTIONS[kind]})
+    if extra:
+        raise UserError(f"{where} a {kind} distribution takes no {', '.join(extra)}")
+    if kind in ("choice", "grid"):
+        values = dist["values"]
+        if not isinstance(values, list) or not values:
+            raise UserError(f"{where} values must be a non-empty list")
+        if len(values) > MAX_RUNS:
+            raise UserError(f"{where} at most {MAX_RUNS:,} values")
+        for value in values:
+            _scalar(f"{path}:", f"{name} value", value)
+        return
+    for key in DISTRIBUTIONS[kind]:
+        if kind == "randint":
+            _integer(f"{path}: {name}:", key, dist[key], -(2**63), 2**63 - 1)
+        else:
+            _real(f"{path}: {name}:", key, dist[key], -1e300, 1e300)
     if kind in ("uniform", "loguniform", "randint") and not dist["low"] < dist["high"]:
-        raise UserError(f"{path}: {name}: low = {dist['low']} must be below high = {dist['high']}")
+        raise UserError(f"{where} low = {dist['low']} must be below high = {dist['high']}")
     if kind == "loguniform" and not dist["low"] > 0:
-        raise UserError(f"{path}: {name}: a loguniform distribution needs low > 0")
+        raise UserError(f"{where} a loguniform distribution needs low > 0")
     if kind == "normal" and not dist["std"] > 0:
-        raise UserError(f"{path}: {name}: std = {dist['std']} must be > 0")
+        raise UserError(f"{where} std = {dist['std']} must be > 0")
+
+
+def _text(where: str, key: str, value: object) -> str:
+    if not isinstance(value, str):
+        raise UserError(f'{where} {key} = {_shown(value)}: write a text in quotes ({key} = "…")')
+    return value
+
+
+def _table(where: str, key: str, value: object) -> dict:
+    if not isinstance(value, dict):
+        raise UserError(f"{where} {key}: write a table ([{key}], then NAME = VALUE lines)")
+    return value
+
+
+def _integer(where: str, key: str, value: object, low: int, high: int) -> int:
+    """A TOML integer from ``low`` to ``high`` (a float, Boolean or text is refused)."""
+    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+        raise UserError(f"{where} {key} = {_shown(value)}: a whole number from {low} to {high}")
+    return value
+
+
+def _real(
+    where: str, key: str, value: object, low: float, high: float, low_open: bool = False
+) -> float:
+    """A finite TOML number in its range (an integer counts as a number)."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if ok:
+        x = float(value)
+        ok = math.isfinite(x) and (x > low if low_open else x >= low) and x <= high
+    if not ok:
+        bound = ">" if low_open else ">="
+        raise UserError(
+            f"{where} {key} = {_shown(value)}: a finite number {bound} {low:g} and <= {high:g}"
+        )
+    return float(value)
+
+
+def _scalar(where: str, key: str, value: object) -> None:
+    """A parameter value: a finite number, a Boolean or a text."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise UserError(f"{where} {key} = {_shown(value)}: a finite number")
+    if not isinstance(value, (int, float, str, bool)):
+        raise UserError(f"{where} {key} = {_shown(value)}: a number, true/false or a text")
+
+
+def _shown(value: object) -> str:
+    """A value as a spec writes it, cut to a readable length, control characters escaped."""
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    elif isinstance(value, str):
+        text = repr(value)
+    else:
+        text = str(value)
+    text = text.encode("unicode_escape").decode("ascii") if not text.isprintable() else text
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _key(key: str) -> str:
+    """A TOML key for a message: control characters escaped, at most 60 characters."""
+    return _shown(key)[1:-1] if _shown(key).startswith(("'", '"')) else _shown(key)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 def check_names(spec: SweepSpec, variables: Mapping[str, Mapping[str, object]]) -> None:

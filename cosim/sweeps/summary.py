@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arcosim.outputs import save_figure, write_text
 from arcosim.sweeps.spec import SweepSpec, metric_columns
 
 
@@ -67,7 +68,7 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
         *(f"![{m}]({_plot(spec, ok, m, out).name})" for m in metrics if any(r.get(m) for r in ok)),
     ]
     summary = out / "summary.md"
-    summary.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    write_text(summary, "\n".join(lines) + "\n", force=True)
     return summary
 
 
@@ -104,6 +105,6 @@ def _plot(spec: SweepSpec, rows: list[dict[str, str]], metric: str, out: Path) -
     fig.suptitle(f"{spec.name}: {metric} ({len(y)} runs)")
     fig.tight_layout()
     path = out / f"{metric.replace('[', '_').replace(']', '')}.png"
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100, force=True)
     plt.close(fig)
     return path

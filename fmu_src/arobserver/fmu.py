@@ -40,6 +40,15 @@ MODES = {
     2: "state estimation",
 }
 ESTIMATORS = {0: "the paper's recursion", 1: "model-based observer"}
+#: Noise levels (N.m) the model-based observer's Kalman design is known to solve:
+#: torque_noise_std and tau_noise_std each in this range, neither more than
+#: NOISE_RATIO times the other. Checked over n = 1, 3, 8 masses, encoders of 0 (none),
+#: 64, 2000 and 2^20 counts, steps 1e-5 … 1e-2 s and g_dist 10 … 1000 rad/s: 3312
+#: designs, none failed (``python -m benchmarks.noise_envelope``); outside it (a noise
+#: of 0, or one 1e10 times the other) the Riccati iteration fails to converge or meets
+#: a singular matrix. The load-torque state (load_mass > 0) was not part of that check.
+NOISE_RANGE = (1e-9, 1e4)
+NOISE_RATIO = 1e8
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
 IDENTIFICATION_OUTPUTS = (
     "dkt_hat",
@@ -259,6 +268,20 @@ class ReactionTorqueObserver(FmuSlave):
         ):
             if problem is not None:
                 problems.append(problem)
+        model_based = (
+            self.value("mode") == STATE_ESTIMATION and self.value("estimator") == MODEL_BASED
+        )
+        if model_based and not problems:
+            torque, tau = self.value("torque_noise_std"), self.value("tau_noise_std")
+            low, high = NOISE_RANGE
+            inside = low <= torque <= high and low <= tau <= high
+            if not inside or max(torque / tau, tau / torque) > NOISE_RATIO:
+                problems.append(
+                    f"parameters torque_noise_std = {torque!r} and tau_noise_std = {tau!r} N.m: "
+                    "the model-based observer (mode 2, estimator 1) designs its Kalman gain "
+                    f"for noise on both; give each from {low:g} to {high:g} N.m, neither more "
+                    f"than {NOISE_RATIO:g} times the other (defaults 1e-4 and 1.5e-3)"
+                )
         return problems + self.load_mass_problems()
 
     def load_mass_problems(self) -> list[str]:

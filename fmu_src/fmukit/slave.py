@@ -82,6 +82,13 @@ class FmuSlave(Fmi2Slave):
         """Every variable of the FMU, in value-reference order."""
         raise NotImplementedError
 
+    @classmethod
+    def interface(cls, n: int) -> dict[str, Variable]:
+        """The FMU's variables for ``n`` load masses by name, as built (start values are
+        the parameters' defaults): its interface without building it."""
+        built = type(cls.__name__, (cls,), {"n_masses": n})
+        return {v.name: v for v in (*built.declare(), TRACE_FILE)}
+
     def check_parameters(self) -> list[str]:
         """Problems with the parameter values, one sentence each (empty if none)."""
         return []
