@@ -47,6 +47,11 @@ def source_dir() -> Path:
     return plant_package_dir() / "motorchain_c"
 
 
+def envelope_header() -> Path:
+    """The state envelope every arcosim FMU shares (shipped in the plant's sources/)."""
+    return Path(__file__).parent / "native" / "fmu_envelope.h"
+
+
 def compiler() -> str:
     """The C compiler: ``$CC``, else ``cc`` or ``gcc`` on PATH."""
     for name in (os.environ.get("CC"), "cc", "gcc"):
@@ -112,6 +117,7 @@ def sources_digest(n: int) -> str:
     digest = hashlib.sha256(f"n={n}".encode())
     for name in (*SOURCES, *HEADERS):
         digest.update((source_dir() / name).read_bytes())
+    digest.update(envelope_header().read_bytes())
     return digest.hexdigest()[:10]
 
 
@@ -176,6 +182,7 @@ def build_c_plant(n: int, destination: Path) -> Path:
             *CFLAGS,
             f"-I{folder}",
             f"-I{source_dir()}",
+            f"-I{envelope_header().parent}",
             f"-I{fmi_headers()}",
             *(str(source_dir() / s) for s in SOURCES),
             "-lm",
@@ -194,6 +201,7 @@ def build_c_plant(n: int, destination: Path) -> Path:
             z.write(binary, f"binaries/linux64/{identifier}.so")
             for name in (*SOURCES, *HEADERS):
                 z.write(source_dir() / name, f"sources/{name}")
+            z.write(envelope_header(), f"sources/{envelope_header().name}")
             for name, text in generated.items():
                 z.writestr(f"sources/{name}", text)
         partial.replace(destination)

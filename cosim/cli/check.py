@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from arcosim.cli.identify import known_parameters
+from arcosim.cli.options import log_options
 from arcosim.host.overrides import parse_assignment
 from arcosim.identification.log_check import check
 from arcosim.logs import parse_scales, read_log
@@ -34,21 +34,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("log", type=Path, help="CSV log with time, i_a, omega_m, theta_m")
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="k_to (N.m/A), J_mo (kg.m2), encoder_cpr, g_dist (rad/s); repeatable",
-    )
-    p.add_argument(
-        "--scale",
-        action="append",
-        default=[],
-        metavar="COLUMN=FACTOR",
-        help="multiply a log column to get SI units, repeatable",
-    )
+    log_options(p, "k_to (N.m/A), J_mo (kg.m2), encoder_cpr, g_dist (rad/s); repeatable")
     p.add_argument("--json", action="store_true", help="print the report as one JSON object")
     p.set_defaults(execute=_execute)
 

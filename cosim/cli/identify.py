@@ -63,7 +63,14 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.recipes import OBSERVER, check_masses
-from arcosim.cli.options import add_fmus_option, fmu_folder, fmu_inputs, force_option, number
+from arcosim.cli.options import (
+    add_fmus_option,
+    fmu_folder,
+    fmu_inputs,
+    force_option,
+    log_options,
+    number,
+)
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
@@ -94,7 +101,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("log", type=Path, help="CSV log with time, i_a, omega_m, theta_m")
+    log_options(p, "observer parameter, repeatable")
     p.add_argument(
         "--masses",
         default="3",
@@ -102,20 +109,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--mode", type=int, choices=(0, 1, 2), help="observer mode (default: the FMU's, 2)"
-    )
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="observer parameter, repeatable",
-    )
-    p.add_argument(
-        "--scale",
-        action="append",
-        default=[],
-        metavar="COLUMN=FACTOR",
-        help="multiply a log column to get SI units, repeatable",
     )
     p.add_argument("--json", action="store_true", help="print the final outputs as one JSON object")
     p.add_argument(

@@ -116,6 +116,20 @@ def check_steps(option: str, length: float, step: float, length_option: str = "-
     return steps
 
 
+def log_options(parser: argparse.ArgumentParser, set_help: str) -> None:
+    """A drive log and what is known of the drive: ``LOG``, ``--set NAME=VALUE`` (the
+    observer's parameters, as ``set_help`` says), ``--scale COLUMN=FACTOR``."""
+    parser.add_argument("log", type=Path, help="CSV log with time, i_a, omega_m, theta_m")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=set_help)
+    parser.add_argument(
+        "--scale",
+        action="append",
+        default=[],
+        metavar="COLUMN=FACTOR",
+        help="multiply a log column to get SI units (i_a=0.001 for mA), repeatable",
+    )
+
+
 def force_option(parser: argparse.ArgumentParser) -> None:
     """``--force``: replace an existing output file."""
     parser.add_argument("--force", action="store_true", help="replace the output file if it exists")

@@ -1,20 +1,5 @@
-"""The paper's three experiments on the bench, and three beyond it (``arcosim reproduce``).
-
-1. actuator self-identification with the load detached (mode 0);
-2. five rigid maneuvers with different noise seeds (mode 1), with the actuator terms
-   of experiment 1 → Table II next to the paper's own rows, and Fig. 4;
-3. a flexible maneuver with energy at all three modes (mode 2), with the mean k̂, B̂
-   of experiment 2 → Fig. 5 (the flexible response) and Fig. 6 (estimated against
-   true angle of every mass, the model-based observer of experiment 4 beside it);
-4. beyond the paper: the whole bench chain (every J_i, k_i, B_i, and n) identified
-   from one identification record with only the actuator terms of experiment 1
-   known (:mod:`arcosim.identification.whole_chain`), then every mass's angle
-   estimated in mode 2 (model-based observer) with those parameters alone → Fig. 7;
-5. beyond the paper: a load torque on mass 3 (a step of a tenth of the drive's peak
-   torque, then a 2 rad/s sine) during the broadband maneuver, estimated from the motor
-   alone (model-based observer with ``load_mass = 3``), with the true chain and with
-   experiment 4's chain: settling time, settled error, lag of the sine (scenario
-   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
+"""``arcosim reproduce [--out DIR] [--ideal] [--fmus DIR] [--force]``: the paper's
+experiments and three beyond them (:mod:`arcosim.experiments.reproduce`).
 
 Writes ``report.md``, the CSV of every run and the PNG figures into ``--out``
 (default ``reports/``), and prints the tables. Refuses to start when one of those
@@ -29,6 +14,7 @@ import time
 from pathlib import Path
 
 from arcosim.cli.options import add_fmus_option
+from arcosim.experiments import reproduce as experiments
 from arcosim.experiments.report import text_table
 from arcosim.experiments.reproduce import (
     LOAD_HEADER,
@@ -52,7 +38,7 @@ def add_parser(
     p = subparsers.add_parser(
         "reproduce",
         help="run the paper's three experiments and three more, write the report",
-        description=__doc__,
+        description=(__doc__ or "") + "\n" + (experiments.__doc__ or ""),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

@@ -1,12 +1,5 @@
-"""The SSP 1.0 system source → plant → observer: ``dist/ActionReaction.ssp``.
-
-:func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
-connectors, connections, a DefaultExperiment, and parameter sets bound inline per
-component, as ecos reads them). :func:`run_ssp` runs such a file with a fixed-step
-Jacobi master on fmpy, honouring its connections, a named parameter set and its
-DefaultExperiment — which ``fmpy.ssp.simulate_ssp`` does not (it ignores parameter
-bindings, LinearTransformation and DefaultExperiment, and needs every input
-connected). ``arcosim ssp FILE`` is the command line.
+"""``arcosim ssp FILE.ssp [--parameter-set NAME] [--stop S] [--step H] [--out FILE.csv]``:
+run an SSP system (:func:`arcosim.host.ssp.run_ssp`) and write every output over time.
 """
 
 from __future__ import annotations

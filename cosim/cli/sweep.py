@@ -1,18 +1,12 @@
-"""``arcosim sweep SPEC.toml``: Monte Carlo and grid sweeps of co-simulations on Dask.
+"""``arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]``:
+Monte Carlo and grid sweeps of co-simulations on Dask (:mod:`arcosim.sweeps.runner`;
+the spec's format: :mod:`arcosim.sweeps.spec`).
 
-    arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
-
-The spec (format in :mod:`arcosim.sweeps.spec`) names the scenario, the parameters to
-vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of
-runs and the metrics. Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of
-``--workers`` processes runs here; with it the same tasks go to that cluster. Each run
-is a task that builds nothing: the FMUs are built once and shipped as bytes. Rows are
-appended to ``results.csv`` as runs finish, so an interrupted sweep keeps every
-finished run and ``--resume`` runs only the others; a failed run records its error and
-the sweep goes on. At the end ``summary.md`` holds metric quantiles per varied
-parameter and the PNGs the error histograms and the errors against each parameter
-(:mod:`arcosim.sweeps.summary`). While it runs the sweep holds the folder's lock: a
-second sweep into it is refused, naming the pid and start time of the first.
+Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of ``--workers`` processes
+runs here; with it the same tasks go to that cluster. Rows are appended to
+``results.csv`` as runs finish; ``--resume`` runs only the missing ones. While it
+runs the sweep holds the folder's lock: a second sweep into it is refused, naming the
+pid and start time of the first.
 """
 
 from __future__ import annotations

@@ -1,13 +1,6 @@
-"""``arcosim validate [FMU ...]``: check built FMUs the way a strict FMI host would.
+"""``arcosim validate [FMU ...]``: check FMUs the way a strict FMI host would
+(:mod:`arcosim.host.validate`; default: the FMUs for 3 masses in the per-user cache).
 
-For each FMU (default: every ``.fmu`` in ``dist/``) it runs fmpy's validation and
-then checks what fmpy does not: a unit from ``<UnitDefinitions>`` on every Real, a
-description on every variable, the project as ``generationTool``, a
-DefaultExperiment, state save/restore declared; then it runs the FMU: a clean
-start and 20 steps with a silent log, a refused NaN input, step size 0, a wrong
-communication point and a ``doStep`` before initialization (each fmi2Discard
-with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and
-its ``libtbb12`` are installed, a run in that C++ engine with a bare environment.
 Prints the problems and exits 1 if there are any. A file that is not an FMU at all
 (text, empty, a zip without ``modelDescription.xml``, a truncated zip, an SSP) is
 refused with one line and exit status 2 before any FMU is run.

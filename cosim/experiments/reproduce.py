@@ -16,9 +16,8 @@
    experiment 4's chain: settling time, settled error, lag of the sine (scenario
    ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
 
-Writes ``report.md``, the CSV of every run and the PNG figures into ``--out``
-(default ``reports/``), and prints the tables. Realistic sensors (2000-count
-encoder, 5 mA current noise) unless ``--ideal``.
+:func:`reproduce` writes ``report.md``, the CSV of every run and the PNG figures into
+a folder; ``arcosim reproduce`` is the command line.
 """
 
 from __future__ import annotations

@@ -1,38 +1,10 @@
-"""``arcosim identify LOG.csv``: drive the observer FMU with a recorded log.
+"""Feed a recorded drive log to the observer FMU, sample by sample.
 
-Contract (scripts rely on it)::
-
-    arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
-                             [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
-                             [--method observer|output-error|whole-chain]
-                             [--fit-inertia-scale] [--start-k K]
-
-* the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
-  converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
-  of shared/METHOD.md); the step may vary, and the observer gets the step taken;
-* ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
-* ``--json``: one JSON object, the final value of every observer output keyed by its
-  FMU name (Booleans as true/false);
-* ``--out FILE``: every output over time as CSV (``time`` first).
-* ``--method output-error``: instead of replaying the observer FMU, fit the uniform
-  chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
-  from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
-  observer's parameters (``--set``: J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, J[i]) say
-  what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
-  standard errors under ``std``, and the evidence (start, residual, velocity used).
-  Needs a constant sample step.
-* ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
-  damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
-  J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, encoder_cpr: with counts, the fit is refined
-  from the current to the encoder). ``--masses auto`` reads the number of
-  masses from the record. ``--json`` prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's
-  own parameter names: pass them back with ``--set`` in mode 2), their standard errors
-  under ``std``, and the evidence (modes seen, singular values, criterion per n).
-  Needs a constant sample step and an excitation that rings every mode (``arcosim
-  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
-
-A bad log (missing column, non-increasing time, NaN, empty file) gives a one-line
-error naming the row or column, and exit status 2.
+:func:`replay_log` drives a ReactionTorqueObserver instance with a log's rows as a
+Gauss–Seidel master would (the timing contract: row k ends the step from row k − 1,
+and the step may vary); :func:`parameter_sets` and :func:`observer_parameters` type
+``NAME=VALUE`` texts against the observer's variables. ``arcosim identify`` is the
+command line.
 """
 
 from __future__ import annotations

@@ -1,12 +1,11 @@
-"""The SSP 1.0 system source → plant → observer: ``dist/ActionReaction.ssp``.
+"""Read and run an SSP 1.0 system, such as ``ActionReaction.ssp`` (source → plant →
+observer, written beside the FMUs by :mod:`arcosim.build.ssp`).
 
-:func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
-connectors, connections, a DefaultExperiment, and parameter sets bound inline per
-component, as ecos reads them). :func:`run_ssp` runs such a file with a fixed-step
-Jacobi master on fmpy, honouring its connections, a named parameter set and its
-DefaultExperiment — which ``fmpy.ssp.simulate_ssp`` does not (it ignores parameter
-bindings, LinearTransformation and DefaultExperiment, and needs every input
-connected). ``arcosim ssp FILE`` is the command line.
+:func:`run_ssp` runs it with a fixed-step Jacobi master on fmpy, honouring its
+connections, a named parameter set and its DefaultExperiment — which
+``fmpy.ssp.simulate_ssp`` does not (it ignores parameter bindings,
+LinearTransformation and DefaultExperiment, and needs every input connected).
+``arcosim ssp FILE`` is the command line.
 """
 
 from __future__ import annotations

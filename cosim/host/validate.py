@@ -1,14 +1,13 @@
-"""``arcosim validate [FMU ...]``: check built FMUs the way a strict FMI host would.
+"""The checks a strict FMI host would run on an FMU (``arcosim validate``).
 
-For each FMU (default: every ``.fmu`` in ``dist/``) it runs fmpy's validation and
-then checks what fmpy does not: a unit from ``<UnitDefinitions>`` on every Real, a
-description on every variable, the project as ``generationTool``, a
-DefaultExperiment, state save/restore declared; then it runs the FMU: a clean
-start and 20 steps with a silent log, a refused NaN input, step size 0, a wrong
-communication point and a ``doStep`` before initialization (each fmi2Discard
-with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and
-its ``libtbb12`` are installed, a run in that C++ engine with a bare environment.
-Prints the problems and exits 1 if there are any.
+:func:`validate` runs fmpy's validation, the portability checks of
+:mod:`arcosim.portability`, then what fmpy does not check: a unit from
+``<UnitDefinitions>`` on every Real, a description on every variable, the project as
+``generationTool``, a DefaultExperiment, state save/restore declared; then it runs the
+FMU: a clean start and 20 steps with a silent log, a refused NaN input, step size 0, a
+wrong communication point and a ``doStep`` before initialization (each fmi2Discard
+with a log line, none fatal), a state round trip, and, where ecos (``ecospy``) and its
+``libtbb12`` are installed, a run in that C++ engine with a bare environment.
 """
 
 from __future__ import annotations

@@ -1,6 +1,4 @@
-"""``arcosim sweep SPEC.toml``: Monte Carlo and grid sweeps of co-simulations on Dask.
-
-    arcosim sweep SPEC.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--resume]
+"""Monte Carlo and grid sweeps of co-simulations on Dask (``arcosim sweep``).
 
 The spec (format in :mod:`arcosim.sweeps.spec`) names the scenario, the parameters to
 vary by FMU and variable (as in ``arcosim simulate``), how to draw them, the number of

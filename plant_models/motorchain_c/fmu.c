@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fmu_envelope.h"
 #include "physics.h"
 #include "plant_variables.h"
 
@@ -656,42 +657,11 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
     return fmi2OK;
 }
 
-/* A serialized state is the Core in the envelope every arcosim FMU uses (the Python
- * FMUs' is written by cosim/native/fmu_trampoline.c), all integers little-endian:
- *   0  8  "ARCOSIMS"                 magic
- *   8  4  format version (1)
- *  12  4  flags (unused here: 0)
- *  16  8  the FMU's time (IEEE 754 double)
- *  24  4  n, the number of load masses
- *  28  4  L, length of the identity text
- *  32  L  identity: "<modelIdentifier> <GUID> <build>"
- *  32+L    8  P, length of the payload (sizeof(Core))
- *  40+L    P  the Core
- *  40+L+P  4  CRC-32 (IEEE 802.3) of every byte before it */
-#define ENVELOPE_VERSION 1u
-static const char ENVELOPE_MAGIC[8] = {'A', 'R', 'C', 'O', 'S', 'I', 'M', 'S'};
+/* A serialized state is the Core in the envelope every arcosim FMU uses
+ * (fmu_envelope.h); this FMU's flags are 0. */
 static const char IDENTITY[] = MODEL_IDENTIFIER " " MODEL_GUID " " PLANT_BUILD;
 #define IDENTITY_LENGTH (sizeof IDENTITY - 1)
-#define SERIALIZED (40 + IDENTITY_LENGTH + sizeof(Core) + 4)
-
-static uint32_t crc32(const unsigned char *p, size_t n) {
-    uint32_t crc = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) {
-        crc ^= p[i];
-        for (int k = 0; k < 8; k++) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
-
-static void put_le(unsigned char *p, uint64_t v, int bytes) {
-    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static uint64_t get_le(const unsigned char *p, int bytes) {
-    uint64_t v = 0;
-    for (int i = 0; i < bytes; i++) v |= (uint64_t)p[i] << (8 * i);
-    return v;
-}
+#define SERIALIZED (ENVELOPE_OVERHEAD(IDENTITY_LENGTH) + sizeof(Core))
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
     (void)c;
@@ -710,18 +680,9 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte b
     }
     const Core *core = state;
     unsigned char *out = (unsigned char *)bytes;
-    uint64_t time_bits;
-    memcpy(&time_bits, &core->time, sizeof time_bits);
-    memcpy(out, ENVELOPE_MAGIC, 8);
-    put_le(out + 8, ENVELOPE_VERSION, 4);
-    put_le(out + 12, 0, 4);
-    put_le(out + 16, time_bits, 8);
-    put_le(out + 24, (uint64_t)N_MASSES, 4);
-    put_le(out + 28, IDENTITY_LENGTH, 4);
-    memcpy(out + 32, IDENTITY, IDENTITY_LENGTH);
-    put_le(out + 32 + IDENTITY_LENGTH, sizeof(Core), 8);
-    memcpy(out + 40 + IDENTITY_LENGTH, core, sizeof(Core));
-    put_le(out + SERIALIZED - 4, crc32(out, SERIALIZED - 4), 4);
+    envelope_open(out, 0, core->time, N_MASSES, IDENTITY, IDENTITY_LENGTH, sizeof(Core));
+    memcpy(envelope_payload(out, IDENTITY_LENGTH), core, sizeof(Core));
+    envelope_seal(out, SERIALIZED);
     return fmi2OK;
 }
 
@@ -733,46 +694,22 @@ static fmi2Status refuse(Plant *p, const char *why) {
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
                                    fmi2FMUstate *state) {
     Plant *p = c;
-    const unsigned char *in = (const unsigned char *)bytes;
     char why[TEXT];
-    if (!bytes || size < 32) {
-        snprintf(why, sizeof why, "%zu bytes are too few to be a serialized state of this FMU",
-                 size);
+    const unsigned char *payload;
+    uint64_t payload_length;
+    uint32_t flags;
+    double time;
+    if (envelope_check((const unsigned char *)bytes, size, IDENTITY, IDENTITY_LENGTH, N_MASSES,
+                       why, sizeof why, &payload, &payload_length, &flags, &time))
+        return refuse(p, why);
+    if (payload_length != sizeof(Core)) {
+        snprintf(why, sizeof why, "its payload has %llu bytes, a state of this FMU %zu",
+                 (unsigned long long)payload_length, sizeof(Core));
         return refuse(p, why);
     }
-    if (memcmp(in, ENVELOPE_MAGIC, 8) != 0)
-        return refuse(p, "the bytes are not an FMU state serialized by an arcosim FMU");
-    if (get_le(in + 8, 4) != ENVELOPE_VERSION) {
-        snprintf(why, sizeof why, "state format version %u; this FMU reads version %u",
-                 (unsigned)get_le(in + 8, 4), ENVELOPE_VERSION);
-        return refuse(p, why);
-    }
-    uint64_t length = get_le(in + 28, 4);
-    unsigned n = (unsigned)get_le(in + 24, 4);
-    if (length > size - 32 || size - 32 - length < 12) {
-        snprintf(why, sizeof why, "the identity field runs past the %zu bytes given", size);
-        return refuse(p, why);
-    }
-    if (length != IDENTITY_LENGTH || memcmp(in + 32, IDENTITY, IDENTITY_LENGTH) != 0 ||
-        n != N_MASSES) {
-        char theirs[512];
-        size_t shown = length < sizeof theirs - 1 ? (size_t)length : sizeof theirs - 1;
-        memcpy(theirs, in + 32, shown);
-        theirs[shown] = '\0';
-        snprintf(why, sizeof why, "it is a state of '%s' with n = %u, not of this FMU '%s' "
-                 "with n = %d", theirs, n, IDENTITY, N_MASSES);
-        return refuse(p, why);
-    }
-    if (size != SERIALIZED || get_le(in + 32 + IDENTITY_LENGTH, 8) != sizeof(Core)) {
-        snprintf(why, sizeof why, "%zu bytes arrived, a state of this FMU has %zu (truncated or "
-                 "padded)", size, (size_t)SERIALIZED);
-        return refuse(p, why);
-    }
-    if (crc32(in, size - 4) != (uint32_t)get_le(in + size - 4, 4))
-        return refuse(p, "checksum mismatch: the bytes were altered after serialization");
     Core *copy = *state ? (Core *)*state : malloc(sizeof(Core));
     if (!copy) return fmi2Error;
-    memcpy(copy, in + 40 + IDENTITY_LENGTH, sizeof(Core));
+    memcpy(copy, payload, sizeof(Core));
     *state = copy;
     return fmi2OK;
 }

@@ -66,6 +66,7 @@
 #include <wchar.h>
 
 #include "fmi2Functions.h"
+#include "fmu_envelope.h"
 
 #if !defined(ARCOSIM_IDENTIFIER) || !defined(ARCOSIM_GUID) || !defined(ARCOSIM_BUILD) || \
     !defined(ARCOSIM_N) || !defined(ARCOSIM_CORE)
@@ -985,41 +986,11 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
     return s;
 }
 
-/* The envelope of a serialized state, all integers little-endian:
- *   0  8  "ARCOSIMS"                    magic
- *   8  4  format version (1)
- *  12  4  flags: 1 = parameters refused at initialization, 2 = time known
- *  16  8  last successful time (IEEE 754 double)
- *  24  4  n, the number of load masses
- *  28  4  L, length of the identity text
- *  32  L  identity: "<modelIdentifier> <GUID> <build package>"
- *  32+L    8  P, length of the core's payload
- *  40+L    P  the core's bytes
- *  40+L+P  4  CRC-32 (IEEE 802.3) of every byte before it */
-#define ENVELOPE_VERSION 1u
-static const char ENVELOPE_MAGIC[8] = {'A', 'R', 'C', 'O', 'S', 'I', 'M', 'S'};
+/* Serialized states travel in the envelope of fmu_envelope.h; this FMU's flags: 1 =
+ * parameters refused at initialization, 2 = time known. */
 static const char IDENTITY[] = ARCOSIM_IDENTIFIER " " ARCOSIM_GUID " " ARCOSIM_BUILD;
 #define IDENTITY_LENGTH (sizeof IDENTITY - 1)
-#define OVERHEAD (40 + IDENTITY_LENGTH + 4)
-
-static uint32_t crc32(const unsigned char *p, size_t n) {
-    uint32_t crc = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) {
-        crc ^= p[i];
-        for (int k = 0; k < 8; k++) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
-
-static void put_le(unsigned char *p, uint64_t v, int bytes) {
-    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static uint64_t get_le(const unsigned char *p, int bytes) {
-    uint64_t v = 0;
-    for (int i = 0; i < bytes; i++) v |= (uint64_t)p[i] << (8 * i);
-    return v;
-}
+#define OVERHEAD ENVELOPE_OVERHEAD(IDENTITY_LENGTH)
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
     BEGIN(c);
@@ -1045,21 +1016,13 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte b
         return fmi2Error;
     }
     unsigned char *out = (unsigned char *)bytes;
-    double time = st->time;
-    uint64_t time_bits;
-    memcpy(&time_bits, &time, sizeof time_bits);
-    memcpy(out, ENVELOPE_MAGIC, 8);
-    put_le(out + 8, ENVELOPE_VERSION, 4);
-    put_le(out + 12, (uint64_t)(st->init_failed ? 1 : 0) | (st->time_known ? 2u : 0u), 4);
-    put_le(out + 16, time_bits, 8);
-    put_le(out + 24, (uint64_t)ARCOSIM_N, 4);
-    put_le(out + 28, IDENTITY_LENGTH, 4);
-    memcpy(out + 32, IDENTITY, IDENTITY_LENGTH);
-    put_le(out + 32 + IDENTITY_LENGTH, payload, 8);
+    uint32_t flags = (st->init_failed ? 1u : 0u) | (st->time_known ? 2u : 0u);
+    envelope_open(out, flags, st->time, (uint32_t)ARCOSIM_N, IDENTITY, IDENTITY_LENGTH, payload);
     s = finish(in, core.SerializeFMUstate(in->core, st->core,
-                                          (fmi2Byte *)(out + 40 + IDENTITY_LENGTH), payload));
+                                          (fmi2Byte *)envelope_payload(out, IDENTITY_LENGTH),
+                                          payload));
     if (s > fmi2Warning) return s;
-    put_le(out + 40 + IDENTITY_LENGTH + payload, crc32(out, 40 + IDENTITY_LENGTH + payload), 4);
+    envelope_seal(out, size);
     return s;
 }
 
@@ -1078,40 +1041,18 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size
     BEGIN(c);
     if (!state) return fmi2Error;
     if (*state && !state_of(in, *state, "fmi2DeSerializeFMUstate")) return fmi2Error;
-    const unsigned char *p = (const unsigned char *)bytes;
-    if (!bytes || size < 32)
-        return refuse(in, "%zu bytes are too few to be a serialized state of this FMU", size);
-    if (memcmp(p, ENVELOPE_MAGIC, 8) != 0)
-        return refuse(in, "the bytes are not an FMU state serialized by an arcosim Python FMU");
-    uint32_t version = (uint32_t)get_le(p + 8, 4);
-    if (version != ENVELOPE_VERSION)
-        return refuse(in, "state format version %u; this FMU reads version %u", version,
-                      ENVELOPE_VERSION);
-    uint64_t length = get_le(p + 28, 4);
-    uint32_t n = (uint32_t)get_le(p + 24, 4);
-    if (length > size - 32 || size - 32 - length < 12)
-        return refuse(in, "the identity field runs past the %zu bytes given (truncated?)", size);
-    if (length != IDENTITY_LENGTH || memcmp(p + 32, IDENTITY, IDENTITY_LENGTH) != 0 ||
-        n != (uint32_t)ARCOSIM_N) {
-        char theirs[512];
-        size_t shown = length < sizeof theirs - 1 ? (size_t)length : sizeof theirs - 1;
-        memcpy(theirs, p + 32, shown);
-        theirs[shown] = '\0';
-        return refuse(in, "it is a state of '%s' with n = %u, not of this FMU '%s' with n = %d",
-                      theirs, n, IDENTITY, ARCOSIM_N);
-    }
-    uint64_t payload = get_le(p + 32 + IDENTITY_LENGTH, 8);
-    if (payload != size - OVERHEAD)
-        return refuse(in, "its length field says %llu payload bytes, %zu arrived (truncated or "
-                      "padded)", (unsigned long long)payload,
-                      size >= OVERHEAD ? size - OVERHEAD : 0);
-    uint32_t stored = (uint32_t)get_le(p + size - 4, 4);
-    if (crc32(p, size - 4) != stored)
-        return refuse(in, "checksum mismatch: the bytes were altered after serialization");
+    char why[TEXT];
+    const unsigned char *payload;
+    uint64_t payload_length;
+    uint32_t flags;
+    double time;
+    if (envelope_check((const unsigned char *)bytes, size, IDENTITY, IDENTITY_LENGTH,
+                       (uint32_t)ARCOSIM_N, why, sizeof why, &payload, &payload_length, &flags,
+                       &time))
+        return refuse(in, "%s", why);
     fmi2FMUstate taken = NULL;
-    fmi2Status s = finish(in, core.DeSerializeFMUstate(
-                                  in->core, (const fmi2Byte *)(p + 40 + IDENTITY_LENGTH),
-                                  (size_t)payload, &taken));
+    fmi2Status s = finish(in, core.DeSerializeFMUstate(in->core, (const fmi2Byte *)payload,
+                                                       (size_t)payload_length, &taken));
     if (s > fmi2Warning) return s;
     State *st = *state;
     if (!st) {
@@ -1120,13 +1061,11 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size
     } else if (st->core && !in->dead) {
         core.FreeFMUstate(in->core, &st->core);
     }
-    uint32_t flags = (uint32_t)get_le(p + 12, 4);
-    uint64_t time_bits = get_le(p + 16, 8);
     st->magic = STATE_MAGIC;
     st->core = taken;
     st->init_failed = (flags & 1u) != 0;
     st->time_known = (flags & 2u) != 0;
-    memcpy(&st->time, &time_bits, sizeof st->time);
+    st->time = time;
     *state = st;
     return s;
 }
