@@ -15,7 +15,7 @@ then run again on the recorded logs, offline, in every configuration (the same
   (the mean of the springs for the non-uniform case);
 * state estimation on the broadband run: the paper's recursion (eq. 22–26), the
   model-based observer, and the naive ``θ̂_i = θ_m``; score per mass
-  rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (METHOD.md). The estimators use the output-error
+  rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (docs/method.md). The estimators use the output-error
   k̂, B̂ of the same run and the known J_i; the actuator terms are the plant's (what
   mode 0 returns to within 0.1 %).
 

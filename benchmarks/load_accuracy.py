@@ -1,10 +1,11 @@
 """Accuracy rows of the load torque estimate (part of ``arcosim bench accuracy``).
 
 The accuracy benchmark's two- and five-mass chains, realistic sensors, the
-``load-torque`` scenario's profile (:class:`cosim.scenarios.LoadProfile`: the broadband
+``load-torque`` scenario's profile (:class:`arcosim.experiments.scenarios.LoadProfile`: the
+broadband
 multi-sine at 1 A, a step of a tenth of the drive's peak torque, then a 2 rad/s sine)
 on the last mass and on a middle one, one run per seed. The estimate is the observer
-FMU's own code run offline on the recorded log (:func:`cosim.load_torque.estimate`)
+FMU's own code run offline on the recorded log (:func:`arcosim.identification.load_torque.estimate`)
 with the true chain and the plant's actuator terms, and once more with every spring
 of the model 5 % stiff (the model is wrong). Per row: the step's settled error (mean
 over seeds, and the worst |error| of any seed in the settled window), the settling

@@ -1,18 +1,20 @@
 """Speed of the co-simulation, of each FMU's step and of identification:
-``arcosim bench speed [--quick] [--runs R] [--out DIR]`` (or ``benchmarks/throughput.py``).
+``arcosim bench speed [--quick] [--runs R] [--out DIR]`` (or ``python -m benchmarks.speed``).
 
 Every figure is the median over R runs (spread: min–max) on this machine:
 
 * the bench co-simulation (C plant + pythonfmu observer, 1 kHz, 10 s, realistic
   sensors, the ``flexible`` scenario, mode 2, default estimator) through
-  :func:`cosim.master.cosimulate`: µs per 1 ms step of the whole loop;
+  :func:`arcosim.host.master.cosimulate`: µs per 1 ms step of the whole loop;
 * the same loop instrumented call by call: each FMU's ``fmi2DoStep`` and its set/get
   traffic, through the same raw ctypes calls as the master, plus the observer's
   estimates read every step as a controller would (the timer's own overhead, shown
   in its row, is included in every row);
 * the observer's algorithms stepped in plain Python (no FMI), over the same signals;
 * the whole loop for n = 1, 3, 10, 20 masses and for 1, 10, 100 s records;
-* output-error identification (:mod:`cosim.output_error`) of a 10 s bench record.
+* output-error identification (:mod:`arcosim.identification.output_error`) of a 10 s
+  bench record, and whole-chain identification of the field drives
+  (:mod:`benchmarks.field_accuracy`).
 
 Writes ``throughput.md`` and ``throughput.json`` into ``--out`` (default reports/).
 ``--quick`` proves the benchmark runs (one run, short records, n = 1 and 3); its

@@ -2,7 +2,7 @@
 
 A log is a CSV file with a header row and at least the columns ``time`` (s),
 ``i_a`` (A), ``omega_m`` (rad/s) and ``theta_m`` (rad), one row per sample as the
-timing contract of shared/METHOD.md defines it: the angle and velocity at ``time``
+timing contract of docs/method.md defines it: the angle and velocity at ``time``
 and the current that acted over the step ending at ``time``.
 """
 

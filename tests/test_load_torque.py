@@ -29,7 +29,7 @@ D = 2.6e-3  # N·m, on mass 3
 
 def test_ideal_sensors_follow_the_filters_own_prediction(build_fmus) -> None:
     """Ideal sensors, the true chain, no Coulomb friction: the DOB gives G[τ̄_1] exactly
-    (shared/METHOD.md), so the only model error left is the motor angle taken linear
+    (docs/method.md), so the only model error left is the motor angle taken linear
     between samples, off by at most |θ̈_m| h²/8 in angle and |θ̈_m| h/2 in speed: a
     torque error of at most k_1 |θ̈_m| h²/8 + B_1 |θ̈_m| h/2 in τ̂_reac, which reaches the
     estimate with a gain of at most 1 (the filter's DC gain; it only falls with

@@ -48,7 +48,7 @@ def through_g(x: np.ndarray, g: float = 100.0, h: float = 1e-3) -> np.ndarray:
 
 
 def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -> float:
-    """METHOD.md's state score: rms(θ̂_i − θ_i) / rms(θ_i − θ_m)."""
+    """docs/method.md's state score: rms(θ̂_i − θ_i) / rms(θ_i − θ_m)."""
     return float(np.sqrt(np.mean((estimate - truth) ** 2) / np.mean((truth - motor) ** 2)))
 
 
@@ -59,7 +59,7 @@ def test_observer_validates_without_problems(build_fmus, n: int) -> None:
 
 def test_dob_matches_the_step_averaged_reaction_torque(fmus) -> None:
     """Ideal sensors, 1 ms: τ̂_reac = G[mean τ_reac over each step] to 0.5 % (issue 3);
-    the pairing of METHOD.md makes it exact up to rounding."""
+    the pairing of docs/method.md makes it exact up to rounding."""
     t = np.arange(3000) * 1e-3
     current = 0.3 * np.sin(20 * t) + 0.1 * np.sin(95 * t) + 0.1 * np.sin(31 * t)
     r = run(
@@ -152,7 +152,7 @@ def test_rigid_maneuver_identifies_k_with_kappa(fmus) -> None:
 
 def test_literal_eq21_underestimates_k_by_kappa(fmus) -> None:
     k_literal = rigid_run(fmus, False)["observer.k_hat"][-1]
-    assert k_literal == pytest.approx(K_TRUE / 1.614, rel=0.03)  # ~38 % low, as METHOD.md says
+    assert k_literal == pytest.approx(K_TRUE / 1.614, rel=0.03)  # ~38 % low, as docs/method.md says
 
 
 def test_state_estimation_by_recursion(fmus, tmp_path_factory) -> None:

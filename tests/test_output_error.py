@@ -71,7 +71,7 @@ def test_a_variable_step_is_refused() -> None:
 
 def test_prediction_matches_the_observer_on_an_ideal_co_simulation(build_fmus) -> None:
     """The chain model, driven by the plant's motor angle, predicts the DOB's τ̂_reac:
-    what is left is the DOB's own error (METHOD.md: 0.07 %) and friction at reversals."""
+    what is left is the DOB's own error (docs/method.md: 0.07 %) and friction at reversals."""
     recording = run_scenario(
         SCENARIOS["flexible"],
         plant={"seed": 1},

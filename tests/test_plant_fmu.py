@@ -91,7 +91,7 @@ def test_natural_frequencies_match_chain_eigenvalues(plant_fmu: Path) -> None:
         stiffness[i - 1 : i + 1, i - 1 : i + 1] += K * np.array([[1, -1], [-1, 1]])
     w2 = np.sort(eig(stiffness, inertia, right=False).real)
     expected = np.sqrt(w2[w2 > 1e-9])
-    assert expected == pytest.approx([16.8, 30.2, 90.1], abs=0.05)  # METHOD.md's figures
+    assert expected == pytest.approx([16.8, 30.2, 90.1], abs=0.05)  # docs/method.md's figures
     np.testing.assert_allclose(measured, expected, rtol=1e-3)
 
 

@@ -1,6 +1,6 @@
 """The plant's equations and exact step, checked against independent solutions.
 
-These tests use :class:`motorchain.physics.PlantPhysics` directly (no FMU); the
+These tests use :class:`arcosim.plant.motorchain.physics.PlantPhysics` directly (no FMU); the
 FMU tests check that the built FMU carries the same physics.
 """
 

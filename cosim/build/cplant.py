@@ -1,9 +1,9 @@
 """Build the plant FMU from C: ``plant_models/motorchain_c/`` compiled with the system
 C compiler against the FMI 2.0 headers fmpy ships.
 
-The interface is the Python plant's (:class:`motorchain.fmu.MotorChainPlant`, kept as
+The interface is the Python plant's (:class:`arcosim.plant.motorchain.fmu.MotorChainPlant`, kept as
 the reference): its variable list generates the model description (through
-:mod:`fmukit.model_description`, as every FMU of the project) and a C header of
+:mod:`arcosim.fmu.fmukit.model_description`, as every FMU of the project) and a C header of
 names, types, causalities, start values and value references, so both cannot
 drift apart. The FMU has no Python in it: it runs in any FMI host with nothing
 installed, and a step costs about a microsecond instead of a hundred.

@@ -28,7 +28,6 @@ no host and no other build can have imported a module of that name.
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import tempfile
 import zipfile
@@ -36,6 +35,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from xml.etree import ElementTree
 
+from arcosim.build.cplant import compiler as c_compiler
 from arcosim.build.exit_fix import remove_exit_bug
 from arcosim.errors import BuildError
 from arcosim.portability import bundle_name, import_problems
@@ -130,13 +130,9 @@ def make_portable(
 
 
 def compile_trampoline(*, identifier: str, guid: str, bundle: str, n: int, headers: Path) -> bytes:
-    """The trampoline for one build, compiled with the system C compiler."""
-    compiler = shutil.which("cc") or shutil.which("gcc")
-    if compiler is None:
-        raise BuildError(
-            "no C compiler (cc or gcc) on PATH to build the FMU's binary: install one "
-            "(Debian: `apt-get install gcc`)"
-        )
+    """The trampoline for one build, compiled with the plant's C compiler (``$CC``, else
+    ``cc`` or ``gcc``: :func:`arcosim.build.cplant.compiler`)."""
+    compiler = c_compiler()
     with tempfile.TemporaryDirectory(prefix="arcosim_trampoline_") as tmp:
         out = Path(tmp) / f"{identifier}.so"
         command = [

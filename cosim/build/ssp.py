@@ -35,7 +35,7 @@ CONNECTIONS = (
     ("plant", "omega_m", "observer", "omega_m"),
     ("plant", "theta_m", "observer", "theta_m"),
 )
-#: The bench parameter set: the flexible maneuver (multi-sine, 0.3 A peak) and the
+#: The bench parameter set: the flexible maneuver (multi-sine, 0.48 A) and the
 #: observer estimating the load angles with the bench's actuator terms.
 BENCH = {
     "source": {

@@ -43,6 +43,8 @@ from arcosim.version import __version__
 
 #: Exit status of a refused input, and of an internal error (sysexits' EX_SOFTWARE).
 EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 2, 70, 130
+#: Exit status when the output's reader went away, as a tool killed by SIGPIPE.
+EXIT_BROKEN_PIPE = 141
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -105,6 +107,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("arcosim: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader went away (`arcosim … | head`): stop quietly
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except Exception as error:  # a bug: one line here, the traceback in a file
         report = write_crash_report(argv if argv is not None else sys.argv[1:])
         where = f"details in {report}" if report else "and the details could not be written"

@@ -9,7 +9,7 @@ Contract (scripts rely on it)::
 
 * the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
-  of shared/METHOD.md); the step may vary, and the observer gets the step taken;
+  of docs/method.md); the step may vary, and the observer gets the step taken;
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);

@@ -1,5 +1,5 @@
 """``arcosim reproduce [--out DIR] [--ideal] [--fmus DIR] [--force]``: the paper's
-experiments and three beyond them (:mod:`arcosim.experiments.reproduce`).
+experiments and two beyond them (:mod:`arcosim.experiments.reproduce`).
 
 Writes ``report.md``, the CSV of every run and the PNG figures into ``--out``
 (default ``reports/``), and prints the tables. Refuses to start when one of those
@@ -37,7 +37,7 @@ def add_parser(
     """Register ``arcosim reproduce``."""
     p = subparsers.add_parser(
         "reproduce",
-        help="run the paper's three experiments and three more, write the report",
+        help="run the paper's three experiments and two beyond them, write the report",
         description=(__doc__ or "") + "\n" + (experiments.__doc__ or ""),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

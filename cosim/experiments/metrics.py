@@ -1,4 +1,4 @@
-"""How estimates are scored against the plant's truth (shared/METHOD.md)."""
+"""How estimates are scored against the plant's truth (docs/method.md)."""
 
 from __future__ import annotations
 

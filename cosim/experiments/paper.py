@@ -1,6 +1,6 @@
 """The paper's own results (Khalil & Sabanovic, Table II), in the project's SI units.
 
-The bench's springs are linear (kN/m, N·s/m); METHOD.md maps them to rotary values
+The bench's springs are linear (kN/m, N·s/m); docs/method.md maps them to rotary values
 at a 10 mm lever: ``k_rot = k_lin · r²``, ``B_rot = B_lin · r²``.
 """
 

@@ -85,7 +85,7 @@ def _self_identification_current(t: np.ndarray) -> np.ndarray:
 
 
 def _flexible_current(t: np.ndarray) -> np.ndarray:
-    """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s, peak 0.3 A."""
+    """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s, 0.48 A."""
     return excitation.multisine(t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1)
 
 
@@ -203,7 +203,7 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "rigid",
-            "rigid maneuver: 2 A at 2.1 rad/s under raised-cosine ramps, no drift (mode 1)",
+            "rigid maneuver: 3 A at 2.1 rad/s under raised-cosine ramps, no drift (mode 1)",
             lambda t: excitation.rigid_maneuver(t),
             RIGID_DURATION,
             {},

@@ -3,7 +3,7 @@
 Connections: the plant's measured ``i_a``, ``omega_m``, ``theta_m`` feed the
 observer's inputs of the same names. Time is ``t0 + k h``, never accumulated.
 
-Orderings (both honour the timing contract of shared/METHOD.md):
+Orderings (both honour the timing contract of docs/method.md):
 
 * ``"gauss-seidel"`` (default): the plant steps first, and the observer's
   ``doStep(t_k, h)`` receives the sample at ``t_k + h``; after step k every output

@@ -2,7 +2,7 @@
 
 :func:`excite` turns a band and a current limit into a multi-sine: as arrays, and (for a
 current) as the ExcitationSource FMU's parameters, which play the same signal (the same
-``flexchain.excitation`` functions). What the design rests on, measured on the
+``arcosim.fmu.flexchain.excitation`` functions). What the design rests on, measured on the
 whole-chain rows (README):
 
 * many lines across the band (40 log-spaced lines; 11 let the subspace step take lines

@@ -1,9 +1,9 @@
 """Sensorless load torque offline: the observer FMU's estimator run over a log, and the
 scores of an estimate against a known torque.
 
-:func:`estimate` runs :class:`flexchain.observer.Observer` (the same standard-library
+:func:`estimate` runs :class:`arcosim.fmu.flexchain.observer.Observer` (the same standard-library
 code the observer FMU bundles: DOB, reaction torque observer and the load torque
-observer of :mod:`flexchain.load_observer`) over a drive log, one sample at a time,
+observer of :mod:`arcosim.fmu.flexchain.load_observer`) over a drive log, one sample at a time,
 with the step each row takes. ``arcosim identify LOG.csv --method load-torque`` is its
 command line; ``arcosim reproduce`` (experiment 5) and ``arcosim bench accuracy`` score
 it with :func:`score`.
@@ -172,7 +172,7 @@ def score(
     settled_from: float,
     sine_settled_from: float,
 ) -> LoadScore:
-    """Score an estimate of a step then a sine (:class:`cosim.scenarios.LoadProfile`).
+    """Score an estimate of a step then a sine (:class:`arcosim.experiments.scenarios.LoadProfile`).
 
     Args:
         time: sample times (s), (N,).
@@ -211,7 +211,8 @@ def score(
 
 
 def score_profile(time: np.ndarray, estimate: np.ndarray, profile) -> LoadScore:
-    """:func:`score` for a run of ``profile`` (a :class:`cosim.scenarios.LoadProfile`)."""
+    """:func:`score` for a run of ``profile`` (a
+    :class:`arcosim.experiments.scenarios.LoadProfile`)."""
     truth = step_truth(time, profile.torque(time))
     return score(
         time,

@@ -4,7 +4,8 @@
 (k_t, J_m, the encoder's counts, the DOB bandwidth) and reports, each with what would
 fix it: the step's regularity, the motion (encoder range, how often the motor stands
 still), the excitation's band (its lines against the band 0.3/h and 3·g_dist leave),
-and the modes the record shows (:func:`cosim.modal_start.detect_modes`: stable, with
+and the modes the record shows (:func:`arcosim.identification.modal_start.detect_modes`: stable,
+with
 residues above their standard errors; the weak ones named).
 """
 

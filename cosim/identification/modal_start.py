@@ -10,7 +10,8 @@ with no search:
    are the clamped modes p_i and their damping ratios;
 2. the residues r_i of ``τ/θ_m = k_1 − Σ r_i / (s² + 2ζ_i p_i s + p_i²)`` by
    non-negative least squares on the record, the p_i held;
-3. the chain (J_i, k_i) with those modes (:func:`cosim.chain_modes.chain_from_modes`).
+3. the chain (J_i, k_i) with those modes
+(:func:`arcosim.identification.chain_modes.chain_from_modes`).
 
 What the record must have (measured on the accuracy benchmark's chains, README):
 a broadband excitation with many lines (a multi-sine of 40 log-spaced lines 3–150

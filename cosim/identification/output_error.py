@@ -3,8 +3,8 @@
 The load chain, driven by the measured motor angle (linear between samples), predicts
 the reaction torque; the prediction goes through the DOB's own ``G(s)`` and is fitted to
 the reaction torque observer's estimate τ̂_reac computed from the same log
-(:class:`flexchain.dob.ReactionObserver`, the code the observer FMU runs). The chain
-model is :mod:`flexchain.driven_chain`, shared with the model-based observer; here it is
+(:class:`arcosim.fmu.flexchain.dob.ReactionObserver`, the code the observer FMU runs). The chain
+model is :mod:`arcosim.fmu.flexchain.driven_chain`, shared with the model-based observer; here it is
 simulated in modal coordinates with ``scipy.signal.lfilter`` (no Python loop per sample).
 
 Two parameterizations share one fit (:func:`fit`):

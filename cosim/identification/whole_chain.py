@@ -1,20 +1,22 @@
-"""Identify the whole chain from the motor alone: every J_i, k_i and B_i (offline).
+"""Identify the whole chain from the motor alone: every J_i, k_i and B_i, and n (offline).
 
 A chain of masses and springs is fixed by its driving-point response (motor angle in,
-reaction torque out; :mod:`cosim.chain_modes`), so a motor-side record carries every
-inertia, stiffness and damping. The fit is the output-error fit of
-:mod:`cosim.output_error` with all 3n parameters free, started from the chain whose
-clamped modes and residues the record shows (:mod:`cosim.modal_start`: subspace
-identification, no search), on longer and longer openings of the record
-(:func:`~cosim.output_error.continued_fit`); given the log's current and encoder
-counts, a prediction-error fit from the current to the encoder refines it
-(:mod:`cosim.encoder_fit`: the counts bias the output-error B_i).
+reaction torque out; :mod:`arcosim.identification.chain_modes`), so a motor-side
+record carries every inertia, stiffness and damping. :func:`identify` reads the
+record's modes from a stabilization diagram of the subspace step
+(:func:`arcosim.identification.modal_start.detect_modes`: a mode counts when it comes
+back at several model orders and its residue stands above its standard error), starts
+the chain from those modes and residues with no search (the Lanczos inverse), and fits
+every parameter: by the prediction-error fit from the current to the encoder
+(:mod:`arcosim.identification.encoder_fit`, with the motor's friction and a load
+torque when asked for) when the encoder's counts are known, else by the output-error
+fit to τ̂_reac (:mod:`arcosim.identification.output_error`).
 
-``masses="auto"`` reads n from the record's modes (the subspace singular values) and
-checks it with the Bayesian information criterion of the n − 1, n, n + 1 fits,
-computed with the effective number of independent samples (the record over the
-Newey–West bandwidth: the residuals are low-passed and coloured, so counting every
-sample would favour too many masses).
+``masses="auto"`` takes n = the modes that count, confirmed by the data: the fits
+without the weakest modes are compared by their information criterion, one weak mode
+at a time. An n the record cannot support is refused, naming the modes it shows, the
+ones too weakly excited, and what would fix the record.
+:func:`arcosim.identification.drive.identify_drive` runs it from a log.
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ varied parameters must then be grids, and the runs are their product). Every run
 values are drawn up front from ``seed``, so a spec gives the same runs every time.
 
 Metrics: ``k_error``, ``B_error`` (mode 1, % against the plant's k[1], B[1]),
-``D_m_error``, ``f_c_error`` (mode 0, %), ``theta_error`` (mode 2, METHOD.md's score
+``D_m_error``, ``f_c_error`` (mode 0, %), ``theta_error`` (mode 2, docs/method.md's score
 per mass), ``runtime`` (s per run).
 """
 

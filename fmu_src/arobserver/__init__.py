@@ -1,1 +1,1 @@
-"""The observer FMU class (a thin FMI wrapper around :mod:`flexchain.observer`)."""
+"""The observer FMU class (a thin FMI wrapper around :mod:`arcosim.fmu.flexchain.observer`)."""

@@ -1,7 +1,7 @@
 """``ReactionTorqueObserver``: the action-reaction observer as an FMI 2.0 co-simulation FMU.
 
 Inputs are the motor's measured current, velocity and angle (timing contract of
-shared/METHOD.md: the sample at ``t + h`` when the master steps the plant first,
+docs/method.md: the sample at ``t + h`` when the master steps the plant first,
 the sample at ``t`` with Jacobi ordering). All algorithms live in
 :mod:`flexchain`; this class maps FMU variables to them.
 """
@@ -130,7 +130,7 @@ class ReactionTorqueObserver(FmuSlave):
                 "kappa_correction",
                 True,
                 "",
-                "Mode 1: multi-mass correction kappa (shared/METHOD.md); false gives the "
+                "Mode 1: multi-mass correction kappa (docs/method.md); false gives the "
                 "paper's literal eq. 21",
             ),
             par(
@@ -180,7 +180,7 @@ class ReactionTorqueObserver(FmuSlave):
                 5.0,
                 "rad/s",
                 "Mode 0: speed below which the motor counts as stopped; such samples and the "
-                "5/g_dist s after them are left out of the fit",
+                "5/g_dist + 5/g_id s after them are left out of the fit",
             ),
             par(
                 "g_id",

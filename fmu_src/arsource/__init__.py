@@ -1,1 +1,2 @@
-"""The excitation source FMU class (a thin FMI wrapper around :mod:`flexchain.excitation`)."""
+"""The excitation source FMU class (a thin FMI wrapper around
+:mod:`arcosim.fmu.flexchain.excitation`)."""

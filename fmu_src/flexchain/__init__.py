@@ -3,6 +3,6 @@
 Pure Python (standard library only): the package is bundled into the FMUs and runs
 in any host that has a Python 3. Modules:
 
-* :mod:`flexchain.linalg` — small dense matrices as lists of lists, matrix exponential.
-* :mod:`flexchain.chain` — the motor–spring–mass chain as a linear model.
+* :mod:`arcosim.fmu.flexchain.linalg` — small dense matrices as lists of lists, matrix exponential.
+* :mod:`arcosim.fmu.flexchain.chain` — the motor–spring–mass chain as a linear model.
 """

@@ -2,7 +2,7 @@
 
 Bodies 0 … n: body 0 is the motor (inertia ``J_m``), bodies 1 … n the load masses.
 Spring i (1-based) joins body i−1 and body i with stiffness ``k[i-1]`` (N·m/rad)
-and damping ``B[i-1]`` (N·m·s/rad). Sign convention of shared/METHOD.md: the
+and damping ``B[i-1]`` (N·m·s/rad). Sign convention of docs/method.md: the
 torque of spring i is ``τ_i = k_i (θ_{i−1} − θ_i) + B_i (θ̇_{i−1} − θ̇_i)``.
 """
 

@@ -1,8 +1,8 @@
 """Disturbance observer (eq. 8–9) and reaction torque observer (eq. 16).
 
-Sign convention of shared/METHOD.md. The nominal motor model is
+Sign convention of docs/method.md. The nominal motor model is
 ``J_mo θ̈_m = k_to i_a − d``; the discrete form pairs the velocity change over a
-step with the current that acted over that same step (METHOD.md: low-passing
+step with the current that acted over that same step (docs/method.md: low-passing
 ``k_to i + g J_mo θ̇`` and subtracting ``g J_mo θ̇`` leaves ~10 % error):
 
     α_k = (ω_k − ω_{k−1}) / h                      (rad/s²)

@@ -1,5 +1,5 @@
 """The load chain driven by the motor angle: the one chain model the model-based
-observer (:mod:`flexchain.model_observer`) and the offline output-error
+observer (:mod:`arcosim.fmu.flexchain.model_observer`) and the offline output-error
 identification (``cosim/output_error.py``) share.
 
 The motor angle is taken as linear between two samples, so over the step that ends at
@@ -14,7 +14,7 @@ on the loads in the model):
 
     τ̄_k = Σ_i J_i (ω_i,k − ω_i,k−1) / h,
 
-which is what the DOB's paired step torque measures (shared/METHOD.md), before its
+which is what the DOB's paired step torque measures (docs/method.md), before its
 low-pass ``G(s)``.
 
 Standard library only; ``expm`` may be swapped for a faster one (scipy offline).

@@ -1,7 +1,7 @@
 """Current commands (A) as functions of time: the scenarios' excitations.
 
 Standard library only: the ExcitationSource FMU bundles this module, and
-``cosim.excitation`` evaluates the same functions over arrays, so an FMU run and
+``arcosim.experiments.excitation`` evaluates the same functions over arrays, so an FMU run and
 an offline run see the same signal.
 """
 
@@ -45,7 +45,7 @@ def rigid_maneuver(
     current's first and second integrals vanish too and the chain swings about its
     start and comes back to rest there (a windowed cosine current would leave it
     several radians away). The smooth window keeps energy away from the resonances
-    (shared/METHOD.md); ω defaults to about an eighth of the bench's first mode.
+    (docs/method.md); ω defaults to about an eighth of the bench's first mode.
 
     The amplitude must be well above the current that overcomes the motor's
     Coulomb friction (f_c / k_t ≈ 0.05 A on the bench): the motor sticks at every

@@ -1,7 +1,7 @@
 """First-order low-pass filters discretized exactly for the step actually taken.
 
 ``G(s) = g / (s + g)`` with its input held over each step (the timing contract of
-shared/METHOD.md: a sample carries what acted over the step that ends there):
+docs/method.md: a sample carries what acted over the step that ends there):
 
     y_k = e^{−g h} y_{k−1} + (1 − e^{−g h}) u_k
 

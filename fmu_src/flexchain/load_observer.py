@@ -1,7 +1,7 @@
 """Sensorless load torque: the model-based observer with the external torque on one load
 mass as a state (``load_mass``; beyond the paper).
 
-The chain model of :mod:`flexchain.model_observer`, driven by the measured motor angle
+The chain model of :mod:`arcosim.fmu.flexchain.model_observer`, driven by the measured motor angle
 (linear between samples), augmented with the unknown torque ``d`` on load mass L
 (sign of the plant's ``tau_ext[L]``: positive accelerates mass L), held over each
 step. State ``s = [θ_1…θ_n, ω_1…ω_n, d, y]`` (y: the model's τ̂_reac), per step of h:
@@ -15,7 +15,7 @@ step. State ``s = [θ_1…θ_n, ω_1…ω_n, d, y]`` (y: the model's τ̂_reac),
 (``Ad``, ``Bd``, ``b_d``: one matrix exponential of the chain augmented with θ_m, v and
 d, all exact for a motor angle linear and a torque constant over the step.)
 
-Noise model behind K: that of :mod:`flexchain.model_observer`, plus the random walk's
+Noise model behind K: that of :mod:`arcosim.fmu.flexchain.model_observer`, plus the random walk's
 increments, white with standard deviation ``ω_L σ_τ h`` per step (ω_L the
 ``bandwidth``, σ_τ the noise on τ̂_reac): a torque seen directly through that noise
 would then be estimated with a first-order bandwidth of ω_L, since the steady-state
@@ -31,7 +31,7 @@ low-pass at ``SMOOTHING_RATIO · ω_L`` (exact for the step taken). A Kalman fil
 passes white measurement noise to its estimates with a first-order roll-off (d̂ is the
 sum of its corrections), and the reaction torque observer's largest error is far above
 ω_L: with the encoder's backward-difference velocity the DOB pairs the current with the
-acceleration half a step late (shared/METHOD.md), an error of J_m Δα/2 per step that
+acceleration half a step late (docs/method.md), an error of J_m Δα/2 per step that
 rings at the drive's resonances (on the bench, 0.015 N·m at its 90 rad/s mode under a
 2 A multi-sine: an rms error of 9 % of a 5 mN·m load step through the first-order
 roll-off, 0.2 % after the low-pass). The chain model uses the unsmoothed d.
@@ -113,7 +113,7 @@ def load_column(
 
 @dataclass(frozen=True)
 class LoadStepModel(StepModel):
-    """:class:`~flexchain.model_observer.StepModel` plus the output low-pass over the
+    """:class:`~arcosim.fmu.flexchain.model_observer.StepModel` plus the output low-pass over the
     step: ``z ← Φ z + φ d̂`` (z = [value, rate]), the output is ``z[0]``."""
 
     Phi: Matrix
@@ -148,7 +148,7 @@ def load_step_model(
     Args:
         J, k, B: load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad).
         g_dist: DOB bandwidth (rad/s).
-        noise: the chain's noise model (:class:`~flexchain.model_observer.NoiseModel`).
+        noise: the chain's noise model (:class:`~arcosim.fmu.flexchain.model_observer.NoiseModel`).
         h: step (s).
         load_mass: the mass the torque acts on, 1 … n.
         bandwidth: ω_L (rad/s), > 0: sets the random walk's increments (module doc).
@@ -198,7 +198,8 @@ class LoadTorqueObserver(ModelObserver):
     """Load angles and velocities, and the external torque on one load mass.
 
     Args:
-        J, k, B, g_dist, noise, theta0: as :class:`~flexchain.model_observer.ModelObserver`.
+        J, k, B, g_dist, noise, theta0: as
+        :class:`~arcosim.fmu.flexchain.model_observer.ModelObserver`.
         load_mass: the mass the torque acts on (1 … n).
         bandwidth: ω_L (rad/s), > 0 (module doc).
 

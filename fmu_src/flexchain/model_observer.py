@@ -1,6 +1,6 @@
 """Model-based state observer of the load chain (``estimator = 1``; beyond the paper).
 
-The chain model of :mod:`flexchain.driven_chain`, driven by the measured motor angle,
+The chain model of :mod:`arcosim.fmu.flexchain.driven_chain`, driven by the measured motor angle,
 predicts every load angle and velocity without lag and without differentiating along
 the chain; a steady-state Kalman gain corrects it with the reaction torque observer's
 τ̂_reac, which the model predicts through the same ``G(s)``. State

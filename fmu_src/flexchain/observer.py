@@ -1,10 +1,12 @@
 """The action-reaction observer: DOB and reaction torque observer, plus one of
 three modes, advanced one sample at a time.
 
-* mode 0 — actuator self-identification, load detached (:mod:`flexchain.self_identification`)
-* mode 1 — chain identification from a rigid maneuver (:mod:`flexchain.rigid_identification`)
-* mode 2 — state estimation: the paper's recursion (:mod:`flexchain.recursion`) or the
-  model-based observer (:mod:`flexchain.model_observer`)
+* mode 0 — actuator self-identification, load detached
+  (:mod:`~arcosim.fmu.flexchain.self_identification`)
+* mode 1 — chain identification from a rigid maneuver
+  (:mod:`~arcosim.fmu.flexchain.rigid_identification`)
+* mode 2 — state estimation: the paper's recursion (:mod:`~arcosim.fmu.flexchain.recursion`)
+  or the model-based observer (:mod:`~arcosim.fmu.flexchain.model_observer`)
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ class ObserverSettings:
         torque_noise_std: model-based observer: unmodelled torque on each mass (N·m).
         tau_noise_std: model-based observer: noise on τ̂_reac (N·m).
         load_mass: model-based observer: 0, or the load mass (1 … n) whose external
-            torque is estimated too (:mod:`flexchain.load_observer`).
+            torque is estimated too (:mod:`arcosim.fmu.flexchain.load_observer`).
         load_torque_bandwidth: bandwidth of that estimate (rad/s), > 0.
     """
 

@@ -8,7 +8,7 @@ spring carries ``τ_{i+1} = τ_i − J_i θ̈_i``. Start: ``τ_1 = τ̂_reac`` a
 carry the same lag). Each later stage passes its torque and angle through one
 more ``G_lpf(s) = g_lpf / (s + g_lpf)``, as the paper filters θ̈.
 
-Expect stage 1 to work and later stages to amplify errors (METHOD.md: J_i ω²/k ≫ 1
+Expect stage 1 to work and later stages to amplify errors (docs/method.md: J_i ω²/k ≫ 1
 above the first mode).
 """
 

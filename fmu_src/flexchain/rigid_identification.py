@@ -1,4 +1,4 @@
-"""Chain identification from a rigid maneuver (eq. 17–21), with METHOD.md's κ.
+"""Chain identification from a rigid maneuver (eq. 17–21), with docs/method.md's κ.
 
 The rigid motion is the double integral of the reaction torque over ΣJ plus
 ``c_4 t + c_5`` (eq. 20). Substituting it into eq. 21 makes the fit linear in

@@ -1,7 +1,7 @@
 """Actuator self-identification with the load detached (eq. 13–15).
 
 With τ_reac = 0 the disturbance is ``d = D θ̇ + f_c sgn θ̇ − Δk_t i + ΔJ θ̈``.
-Every regressor is low-passed by the same ``G(s)`` as ``d̂`` (METHOD.md) and
+Every regressor is low-passed by the same ``G(s)`` as ``d̂`` (docs/method.md) and
 paired as the DOB pairs them (mean velocity and velocity change over the step):
 
     d̂ ≈ β_0 G[i] + β_1 G[v] + β_2 G[α] + β_3 G[sgn v],

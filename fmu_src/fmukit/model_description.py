@@ -1,7 +1,7 @@
 """Write a compliant FMI 2.0 co-simulation modelDescription.xml.
 
 pythonfmu's own ``to_xml`` writes no units, no ``<InitialUnknowns>`` and no output
-dependencies (see shared/FMI-NOTES.md); every FMU of the project writes its model
+dependencies (see docs/development.md); every FMU of the project writes its model
 description through :func:`model_description` instead.
 """
 

@@ -12,8 +12,8 @@ Conventions it settles (see README, "FMU conventions"):
   and leaves the state untouched.
 * Algorithm state is kept in plain data (floats, ints, lists, small classes), so
   FMU state get/set and serialization cover every filter and accumulator
-  (:mod:`fmukit.state`).
-* Timing contract (shared/METHOD.md): after ``doStep(t, h)`` the outputs are the
+  (:mod:`arcosim.fmu.fmukit.state`).
+* Timing contract (docs/method.md): after ``doStep(t, h)`` the outputs are the
   sample at ``t + h``.
 """
 

@@ -1,7 +1,7 @@
 """Declarations of FMU variables: name, type, causality, unit, description, start.
 
-A :class:`Variable` is a plain description; :class:`fmukit.slave.FmuSlave` stores
-the values and :func:`fmukit.model_description.model_description` writes the XML.
+A :class:`Variable` is a plain description; :class:`arcosim.fmu.fmukit.slave.FmuSlave` stores
+the values and :func:`arcosim.fmu.fmukit.model_description.model_description` writes the XML.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ class Variable:
         causality: ``"parameter"`` (fixed after initialization), ``"input"`` or
             ``"output"`` (computed by ``doStep``, depending on no input directly).
         description: one line for the user, with what the value means.
-        unit: unit name from :data:`fmukit.units.UNITS` (Real only; ``"1"`` when
+        unit: unit name from :data:`arcosim.fmu.fmukit.units.UNITS` (Real only; ``"1"`` when
             dimensionless).
         start: start value (parameters and inputs); outputs start at ``start`` or 0
             until the first step.
