@@ -41,7 +41,7 @@ def main() -> None:
     print(f"1. {LOG.name}: {len(log)} samples, {log.time[-1]:.1f} s")
 
     # 2. Before any fit: can this log support identification?
-    report = arcosim.check_log(log.time, *signals, k_t=K_T, J_m=J_M, counts=COUNTS)
+    report = arcosim.check_log(log.time, *signals, k_t=K_T, J_m=J_M, encoder_cpr=COUNTS)
     print("2. check:\n   " + report.text().replace("\n", "\n   "))
     if not report.ok:
         raise SystemExit("the log cannot support identification: see the problems above")
@@ -60,18 +60,12 @@ def main() -> None:
     # 4. Estimate every load angle from the motor alone: the observer FMU in mode 2,
     #    model-based estimator, with the chain just identified.
     folder = arcosim.ensure_built(result.masses)
-    parameters = {
-        "mode": 2,
-        "estimator": 1,
-        "encoder_cpr": COUNTS,
-        "J_mo": J_M,
-        "k_to": K_T,
-        "D_m": result.parameters["D_m"],
-        "f_c": result.parameters["f_c"],
-        **result.chain(),
-    }
+    #    (observer_parameters: the chain, the friction and estimator = 1.)
+    parameters = {"mode": 2, "encoder_cpr": COUNTS, "J_mo": J_M, "k_to": K_T}
+    parameters.update(result.observer_parameters())
     with arcosim.FmuInstance(folder / "ReactionTorqueObserver.fmu", "observer") as observer:
         estimate = arcosim.replay_log(observer, log, parameters)
+    print(f"4. the observer FMU replayed the log with {len(parameters)} parameters set")
 
     # 5. The sample log also holds the truth the drive could not measure: score the
     #    estimate as rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (0 is perfect, θ̂_i = θ_m scores 1).

@@ -92,20 +92,25 @@ def test_offline_tool_gives_the_fmus_estimate(build_fmus, tmp_path: Path) -> Non
     chain.update(
         {f"{p}[{i}]": v for i in (1, 2, 3) for p, v in (("k", defaults.K), ("B", defaults.B))}
     )
-    (tmp_path / "chain.json").write_text(json.dumps(chain))
+    (tmp_path / "bare.json").write_text(json.dumps(chain))
+    (tmp_path / "chain.json").write_text(json.dumps({**chain, **observer}))  # as fitted
     command = [sys.executable, "-m", "arcosim", "identify", str(log), "--method", "load-torque"]
     command += ["--chain", "chain.json", "--set", "load_mass=3", "--out", "est.csv", "--json"]
-    command += ["--set", f"D_m={defaults.D_M}", "--set", f"f_c={defaults.F_C}"]
     result = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)
     assert report["load_mass"] == 3 and report["samples"] == len(recording.time)
+    assert "D_m" not in report.get("assumptions", {}).get("defaults", "")
     offline = np.genfromtxt(tmp_path / "est.csv", delimiter=",", names=True)["tau_load_hat"]
     fmu = recording["observer.tau_load_hat"]
     assert np.max(np.abs(offline - fmu)) <= 1e-9 * np.max(np.abs(fmu))
     assert report["final"] == pytest.approx(fmu[-1], rel=1e-9)
     missing = subprocess.run(command[:7], capture_output=True, text=True, cwd=tmp_path)
     assert missing.returncode == 2 and "--set load_mass=I" in missing.stderr
+    bare = [*command[:8], "bare.json", "--set", "load_mass=3"]
+    text = subprocess.run(bare, capture_output=True, text=True, cwd=tmp_path)
+    assert text.returncode == 0, text.stderr
+    assert "assumption, defaults: not given" in text.stdout and "D_m = 0" in text.stdout
 
 
 def test_score_of_a_known_estimate() -> None:

@@ -1,4 +1,5 @@
-"""``arcosim identify LOG.csv``: drive the observer FMU with a recorded log.
+"""``arcosim identify LOG.csv``: a drive from its log — the observer FMU replayed, the
+chain fitted offline (output error, whole chain), or the torque on a load mass.
 
 Contract (scripts rely on it)::
 
@@ -19,32 +20,37 @@ Contract (scripts rely on it)::
   existing file is replaced only with ``--force``; the log itself never.
 * ``--method output-error``: instead of replaying the observer FMU, fit the uniform
   chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
-  from any excitation rich enough to ring the chain (``cosim/output_error.py``). The
+  from any excitation rich enough to ring the chain (``arcosim.identification.output_error``). The
   observer's parameters (``--set``: J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, J[i]) say
   what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
   standard errors under ``std``, and the evidence (start, residual, velocity used).
   Needs a constant sample step.
 * ``--method whole-chain [--masses N|auto]``: fit every load inertia, stiffness and
-  damping (``cosim/whole_chain.py``); only the actuator terms are known (``--set``:
+  damping (``arcosim.identification.whole_chain``); only the actuator terms are known (``--set``:
   J_mo, k_to, dkt, dJm, g_dist, encoder_cpr; D_m and f_c when known, else they are
   fitted with the chain; with counts the fit is the prediction-error fit from the
   current to the encoder). ``--load constant|slow``: a load torque on the last mass is
   part of the model (fitted, reported as ``tau_load``). ``--masses auto`` reads the
   number of masses from the record. The report's ``assumptions`` say what the result
   is conditional on (and any drive parameter left at the bench's default). ``--json``
-  prints ``J[i]``, ``k[i]``, ``B[i]`` (the observer's own parameter names: pass them
-  back with ``--set`` in mode 2), their standard errors under ``std``, and the evidence
+  prints ``J[i]``, ``k[i]``, ``B[i]``, ``D_m``, ``f_c`` (the observer's own parameter
+  names; the text output ends with the ``--set`` line, ``estimator=1`` included, that
+  estimates every load angle with them), their standard errors under ``std``, the evidence
   (modes seen and their residue t values, weak modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
-  time, from the motor alone (``cosim/load_torque.py``: the observer FMU's estimator 1
-  with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) comes from
-  ``--chain`` (the JSON that ``--method whole-chain --json`` prints; it sets
-  ``--masses`` too) and ``--set``, the actuator terms, ``load_mass`` (required) and
+  time, from the motor alone (``arcosim.identification.load_torque``: the observer FMU's estimator 1
+  with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) and the
+  friction (``D_m``, ``f_c``) come from ``--chain`` (the JSON that ``--method
+  whole-chain --json`` prints; it sets ``--masses`` too) and ``--set`` (which wins), the
+  actuator terms, ``load_mass`` (required) and
   ``load_torque_bandwidth`` from ``--set``; ``--out`` writes ``time``,
   ``tau_load_hat``, ``tau_reac_hat``, ``theta_hat[i]``, ``omega_hat[i]`` and the
   innovation; ``--json`` prints a summary. The step may vary.
+
+Every method names, on a line ``assumption, defaults``, the drive's parameters (J_mo,
+k_to, D_m, f_c, encoder_cpr, the chain) it left at the paper bench's default.
 
 A bad log (missing column, non-increasing time, NaN, empty file, not UTF-8) gives a
 one-line error naming the row or column, and exit status 2. So does a ``--start-k``
@@ -57,6 +63,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -97,7 +104,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim identify``."""
     p = subparsers.add_parser(
         "identify",
-        help="run the observer FMU on a recorded log",
+        help="a drive from its log: replay the observer FMU, fit the chain, or the load torque",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -179,6 +186,11 @@ def _execute(args: argparse.Namespace) -> int:
         return _output_error(args, log, n)
     folder = fmu_folder(args, n)
     _check_out(args, fmu_inputs(folder))
+    defaults = defaults_note(
+        known_parameters(n, args.set),
+        drive_parameters(n, chain=args.mode in (None, STATE_ESTIMATION)),
+        _set_names(args.set),
+    )
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
         recording = replay_log(observer, log, parameters)
@@ -189,8 +201,12 @@ def _execute(args: argparse.Namespace) -> int:
         write_csv(args.out, columns, force=args.force)
     if args.json:
         print(json.dumps(final, indent=2))
+        if defaults:
+            print(f"arcosim identify: assumption, defaults: {defaults}", file=sys.stderr)
     else:
         _print_summary(final, len(log), args.out)
+        if defaults:
+            print(f"assumption, defaults: {defaults}")
     return 0
 
 
@@ -292,6 +308,10 @@ def _output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     report = {names[k]: v for k, v in result.as_dict().items()}
     report["std"] = {names[k]: v for k, v in result.std_dict().items()}
     report.update(evidence(result, record))
+    known = ["J_mo", "k_to", "D_m", "f_c", *(f"J[{i}]" for i in range(1, n + 1))]
+    defaults = defaults_note(values, known, _set_names(args.set))
+    if defaults:
+        report["assumptions"] = {"defaults": defaults}
     _write_report(args, report)
     if args.json:
         print(json.dumps(report, indent=2))
@@ -301,6 +321,8 @@ def _output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
             print(f"  {key:8s} {report[key]:.6g}  ± {report['std'][key]:.2g}")
         for key in ("start", "velocity", "rms_residual", "rms_data", "newey_west_lag"):
             print(f"  {key}: {report[key]}")
+        if defaults:
+            print(f"  assumption, defaults: {defaults}")
     return 0
 
 
@@ -333,13 +355,9 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> 
         g_dist=values["g_dist"],
         **friction,
     )
-    defaults = [name for name in ("J_mo", "k_to", "encoder_cpr") if name not in given]
-    if defaults:
-        result.assumptions["defaults"] = (
-            "not given, so the paper bench's value was used: "
-            + ", ".join(f"{name} = {values[name]:g}" for name in defaults)
-            + " (give your drive's with --set)"
-        )
+    note = defaults_note(values, ("J_mo", "k_to", "encoder_cpr"), given)
+    if note:
+        result.assumptions["defaults"] = note
     report = result.report()
     _write_report(args, report)
     if args.json:
@@ -354,13 +372,14 @@ def _whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> 
         print(f"  assumption, {key}: {text}")
     for text in result.warnings:
         print(f"  warning: {text}")
-    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.chain().items())
-    print(f"observer in mode 2 with this chain: --masses {result.masses} {settings}")
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.observer_parameters().items())
+    print(f"every load angle, the observer with this chain: --masses {result.masses} {settings}")
     return 0
 
 
 def read_chain(path: Path) -> dict[str, float]:
-    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``) from a whole-chain JSON report.
+    """``J[i]``, ``k[i]``, ``B[i]`` (and ``masses``, and the friction ``D_m``, ``f_c`` when
+    there) from a whole-chain JSON report.
 
     Raises
     ------
@@ -379,7 +398,7 @@ def read_chain(path: Path) -> dict[str, float]:
     chain = {
         k: v
         for k, v in data.items()
-        if (k.split("[")[0] in ("J", "k", "B") and k.endswith("]")) or k == "masses"
+        if (k.split("[")[0] in ("J", "k", "B") and k.endswith("]")) or k in ("masses", "D_m", "f_c")
     }
     for key, value in chain.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -398,7 +417,9 @@ def read_chain(path: Path) -> dict[str, float]:
 
 def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[str, float]) -> int:
     values = known_parameters(n, args.set)
-    values.update({k: v for k, v in chain.items() if k not in _set_names(args.set)})
+    given = _set_names(args.set)
+    values.update({k: v for k, v in chain.items() if k not in given})
+    defaults = defaults_note(values, drive_parameters(n), given | set(chain))
     load_mass = int(values["load_mass"])
     if not 1 <= load_mass <= n:
         raise UserError(
@@ -427,7 +448,9 @@ def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[st
         raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
     c = log.columns
     try:
-        result = load_torque.estimate(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
+        result = load_torque.estimate_load_torque(
+            settings, log.time, c["i_a"], c["omega_m"], c["theta_m"]
+        )
     except (ValueError, ZeroDivisionError, OverflowError) as error:  # the Kalman design
         raise UserError(
             f"--method load-torque: no estimator for these settings ({error}); check "
@@ -447,6 +470,8 @@ def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[st
         "std_last_second": float(np.std(result.tau_load[last])),
         "rms_innovation": float(np.sqrt(np.mean(result.innovation**2))),
     }
+    if defaults:
+        report["assumptions"] = {"defaults": defaults}
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
@@ -454,12 +479,14 @@ def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[st
         f"{len(log)} samples, load torque on mass {load_mass} of {n} "
         f"(bandwidth {settings.load_torque_bandwidth:g} rad/s):"
     )
-    print(f"  final              {report['final']:.6g} N.m")
+    print(f"  final              {report['final']:.6g} N·m")
     print(
         f"  last second        {report['mean_last_second']:.6g} ± "
-        f"{report['std_last_second']:.2g} N.m (mean ± std)"
+        f"{report['std_last_second']:.2g} N·m (mean ± std)"
     )
-    print(f"  rms innovation     {report['rms_innovation']:.3g} N.m")
+    print(f"  rms innovation     {report['rms_innovation']:.3g} N·m")
+    if defaults:
+        print(f"  assumption, defaults: {defaults}")
     if args.out:
         print(f"wrote {args.out}")
     return 0
@@ -467,6 +494,41 @@ def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[st
 
 def _set_names(assignments: Sequence[str]) -> set[str]:
     return {parse_assignment(text)[0] for text in assignments}
+
+
+def drive_parameters(n: int, chain: bool = True) -> list[str]:
+    """The observer parameters that describe the drive (and, with ``chain``, its n-mass
+    chain): the ones whose default is the paper bench's, not a tuning choice."""
+    names = ["J_mo", "k_to", "D_m", "f_c", "encoder_cpr"]
+    if chain:
+        names += [f"{p}[{i}]" for p in "JkB" for i in range(1, n + 1)]
+    return names
+
+
+def defaults_note(values: Mapping[str, float], names: Sequence[str], given: set[str]) -> str | None:
+    """One sentence naming the parameters among ``names`` left at their default (None when
+    every one was given); a chain left whole at its default is named as one.
+
+    Examples
+    --------
+    >>> defaults_note({"k_to": 0.0406, "D_m": 0.0}, ["k_to", "D_m"], {"k_to"})
+    "not given, so the paper bench's value was used: D_m = 0 (give your drive's with --set)"
+    """
+    missing = [name for name in names if name not in given]
+    if not missing:
+        return None
+    chain = [name for name in names if "[" in name]
+    parts = [f"{name} = {values[name]:g}" for name in missing if "[" not in name]
+    if chain and set(chain) <= set(missing):
+        kinds = dict.fromkeys(f"{name.split('[')[0]}[i]" for name in chain)
+        parts.append(f"the bench's chain ({', '.join(kinds)})")
+    else:
+        parts += [f"{name} = {values[name]:g}" for name in missing if "[" in name]
+    return (
+        "not given, so the paper bench's value was used: "
+        + ", ".join(parts)
+        + " (give your drive's with --set)"
+    )
 
 
 def evidence(result: Fit, record: MotorRecord) -> dict[str, object]:

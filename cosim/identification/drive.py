@@ -5,7 +5,7 @@ motor's current and encoder alone, with only the motor's datasheet values known.
 --method whole-chain`` runs): it builds the records the fits need from the log
 (:func:`~arcosim.identification.output_error.motor_record`,
 :func:`~arcosim.identification.encoder_fit.encoder_record`), runs
-:func:`~arcosim.identification.whole_chain.identify`, and returns the result with what
+:func:`~arcosim.identification.whole_chain.identify_whole_chain`, and returns the result with what
 it rests on.
 """
 
@@ -21,7 +21,7 @@ from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.encoder_fit import LOADS, encoder_record
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import MotorRecord, motor_record
-from arcosim.identification.whole_chain import Choice, identify
+from arcosim.identification.whole_chain import Choice, identify_whole_chain
 
 
 @dataclass(frozen=True)
@@ -47,12 +47,17 @@ class DriveIdentification:
         The whole-chain fit's evidence (modes, criterion per n, refusals).
     record : MotorRecord
         The reaction-torque record the fit started from.
+    friction : dict of str to float
+        The motor friction the result rests on, given or fitted: ``D_m``
+        (N·m·s/rad) and ``f_c`` (N·m).
 
     Examples
     --------
     >>> from arcosim.identification.drive import DriveIdentification
-    >>> sorted(DriveIdentification.__dataclass_fields__)[:3]
-    ['assumptions', 'choice', 'masses']
+    >>> result = DriveIdentification(1, {"J[1]": 1e-3, "k[1]": 0.5, "B[1]": 1e-4},
+    ...                              {"J[1]": 2e-6, "k[1]": 1e-3, "B[1]": 3e-6}, {})
+    >>> result.chain()["k[1]"], result.std["k[1]"]  # N·m/rad
+    (0.5, 0.001)
     """
 
     masses: int
@@ -62,10 +67,28 @@ class DriveIdentification:
     warnings: list[str] = field(default_factory=list)
     choice: Choice | None = None
     record: MotorRecord | None = None
+    friction: dict[str, float] = field(default_factory=dict)
 
     def chain(self) -> dict[str, float]:
-        """``J[i]``, ``k[i]``, ``B[i]`` only: the observer's parameters for mode 2."""
+        """``J[i]``, ``k[i]``, ``B[i]`` only: the chain's parameters, by the observer's names."""
         return {k: v for k, v in self.parameters.items() if k[0] in "JkB" and "[" in k}
+
+    def observer_parameters(self) -> dict[str, float]:
+        """The observer FMU's parameters that estimate every load angle with this chain.
+
+        ``J[i]``, ``k[i]``, ``B[i]``, the friction ``D_m`` and ``f_c`` (given or fitted),
+        and ``estimator = 1``: the model-based observer (the paper's recursion,
+        estimator 0, diverges from the second mass on; ``docs/method.md``). Mode 2, the
+        FMU's default, runs them.
+
+        Examples
+        --------
+        >>> result = DriveIdentification(1, {"J[1]": 1e-3, "k[1]": 0.5, "B[1]": 1e-4}, {},
+        ...                              {}, friction={"D_m": 2e-5, "f_c": 2e-3})
+        >>> result.observer_parameters()["estimator"], result.observer_parameters()["f_c"]
+        (1, 0.002)
+        """
+        return {**self.chain(), **self.friction, "estimator": 1}
 
     def report(self) -> dict[str, object]:
         """Everything, JSON-able (what ``arcosim identify --json`` prints)."""
@@ -74,6 +97,7 @@ class DriveIdentification:
         extra = fit.extra
         out: dict[str, object] = {"method": "whole-chain", "masses": self.masses}
         out.update(self.parameters)
+        out.update({k: v for k, v in self.friction.items() if k not in out})  # given
         out["std"] = dict(self.std)
         out.update(
             start=fit.start_note,
@@ -134,9 +158,9 @@ def identify_drive(
     theta_m : array_like
         Motor angle (rad), shape ``(N,)``, as the encoder gives it (whole counts).
     k_t : float
-        Torque constant (N·m/A), from the datasheet.
+        Torque constant (N·m/A), from the datasheet (the observer FMU's ``k_to``).
     J_m : float
-        Motor inertia (kg·m²), from the datasheet.
+        Motor inertia (kg·m²), from the datasheet (the observer FMU's ``J_mo``).
     encoder_cpr : int
         The encoder's counts per revolution (a count); 0 for an angle that is not
         quantized (then the friction must be given and no load torque modelled).
@@ -202,14 +226,18 @@ def identify_drive(
             "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
             "(D_m and f_c) and no load torque model"
         )
-    choice = identify(record, masses, encoder)
+    choice = identify_whole_chain(record, masses, encoder)
     fit = choice.fit
+    parameters = fit.as_dict()
     return DriveIdentification(
         masses=choice.n,
-        parameters=fit.as_dict(),
+        parameters=parameters,
         std=fit.std_dict(),
         assumptions=dict(fit.extra["assumptions"]),
         warnings=list(fit.extra["warnings"]),
         choice=choice,
         record=record,
+        friction={"D_m": D_m, "f_c": f_c}
+        if friction_given
+        else {k: parameters[k] for k in ("D_m", "f_c") if k in parameters},
     )
