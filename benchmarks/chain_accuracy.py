@@ -19,7 +19,7 @@ from arcosim.experiments.metrics import percent_error
 from arcosim.experiments.scenarios import SCENARIOS
 from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.output_error import motor_record
-from arcosim.identification.whole_chain import identify, split
+from arcosim.identification.whole_chain import identify_whole_chain, split
 from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
 
 #: The chains: the bench and two with unequal springs (n = 2 and n = 5).
@@ -46,7 +46,7 @@ def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None
         )
         started = time.perf_counter()
         encoder = encoder_record(log["time"], log["i_a"], log["theta_m"], ACTUATOR, ENCODER_CPR)
-        choice = identify(record, "auto", encoder)
+        choice = identify_whole_chain(record, "auto", encoder)
         seconds.append(time.perf_counter() - started)
         chosen.append(choice.n)
         if choice.n != case.n:

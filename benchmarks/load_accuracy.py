@@ -1,15 +1,15 @@
 """Accuracy rows of the load torque estimate (part of ``arcosim bench accuracy``).
 
 The accuracy benchmark's two- and five-mass chains, realistic sensors, the
-``load-torque`` scenario's profile (:class:`arcosim.experiments.scenarios.LoadProfile`: the
-broadband
-multi-sine at 1 A, a step of a tenth of the drive's peak torque, then a 2 rad/s sine)
-on the last mass and on a middle one, one run per seed. The estimate is the observer
-FMU's own code run offline on the recorded log (:func:`arcosim.identification.load_torque.estimate`)
-with the true chain and the plant's actuator terms, and once more with every spring
-of the model 5 % stiff (the model is wrong). Per row: the step's settled error (mean
-over seeds, and the worst |error| of any seed in the settled window), the settling
-time, the rms error during the flexible motion, the sine's amplitude ratio and lag.
+``load-torque`` scenario's profile (:class:`arcosim.experiments.scenarios.LoadProfile`:
+the broadband multi-sine at 1 A, a step of a tenth of the drive's peak torque, then a 2
+rad/s sine) on the last mass and on a middle one, one run per seed. The estimate is the
+observer FMU's own code run offline on the recorded log
+(:func:`arcosim.identification.load_torque.estimate_load_torque`) with the true chain
+and the plant's actuator terms, and once more with every spring of the model 5 % stiff
+(the model is wrong). Per row: the step's settled error (mean over seeds, and the worst
+|error| of any seed in the settled window), the settling time, the rms error during the
+flexible motion, the sine's amplitude ratio and lag.
 
 Then the bandwidth's trade-off on the bench (seed 1): for ``load_torque_bandwidth`` of
 2.5 … 20 rad/s, the same scores with the true chain and with every inertia 1 % high.
@@ -26,7 +26,7 @@ import numpy as np
 
 from arcosim.experiments.scenarios import LoadProfile
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION
-from arcosim.identification.load_torque import LoadScore, estimate, score_profile
+from arcosim.identification.load_torque import LoadScore, estimate_load_torque, score_profile
 from benchmarks.cases import CASES, Case, run_case, settings_for
 
 
@@ -84,7 +84,7 @@ def row_estimate(
         k=tuple(row.k_scale * x for x in case.k),
         **extra,
     )
-    result = estimate(settings, log["time"], log["i_a"], log["omega_m"], log["theta_m"])
+    result = estimate_load_torque(settings, log["time"], log["i_a"], log["omega_m"], log["theta_m"])
     return score_profile(log["time"], result.tau_load, row.profile())
 
 

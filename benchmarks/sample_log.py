@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.identification.chain_excitation import excite
+from arcosim.identification.chain_excitation import design_excitation
 from benchmarks import field_sim
 
 OUT = Path(__file__).resolve().parents[1] / "examples" / "data" / "belt_drive.csv"
@@ -41,12 +41,12 @@ def drive() -> field_sim.Drive:
         f_c=2e-3,
         current_bandwidth=2000.0,
         current_noise=0.005,
-        counts=COUNTS,
+        encoder_cpr=COUNTS,
     )
 
 
 def main() -> None:
-    design = excite((3.0, 150.0), 3.0)
+    design = design_excitation((3.0, 150.0), 3.0)
 
     def current(t: np.ndarray) -> np.ndarray:
         return np.interp(t, design.time, design.signal)

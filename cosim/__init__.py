@@ -26,6 +26,7 @@ encoder_record      -- a log as the current → encoder record of the refinement
 identify_whole_chain -- the whole-chain fit from those records (what identify_drive runs)
 uniform_chain       -- the paper's uniform chain: k and B by output error
 estimate_load_torque -- the torque on a load mass over a log (the observer's estimator)
+ObserverSettings    -- the observer FMU's parameters as one value (estimate_load_torque's)
 
 Scenarios and co-simulation
 ---------------------------
@@ -89,6 +90,7 @@ _API = {
     "check_log": "arcosim.identification.log_check",
     "design_excitation": "arcosim.identification.chain_excitation",
     "estimate_load_torque": "arcosim.identification.load_torque",
+    "ObserverSettings": "arcosim.fmu.flexchain.observer",
     "Actuator": "arcosim.fmu.flexchain.dob",
     "motor_record": "arcosim.identification.output_error",
     "encoder_record": "arcosim.identification.encoder_fit",
@@ -114,21 +116,13 @@ _API = {
     "BuildError": "arcosim.errors",
     "IdentificationError": "arcosim.identification.errors",
 }
-#: Where the public name differs from the defining module's name.
-_ALIASES = {
-    "identify_whole_chain": "identify",
-    "check_log": "check",
-    "design_excitation": "excite",
-    "estimate_load_torque": "estimate",
-}
-
 __all__ = ["__version__", *_API]
 
 
 def __getattr__(name: str) -> object:
     if name not in _API:
         raise AttributeError(f"module 'arcosim' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_API[name]), _ALIASES.get(name, name))
+    value = getattr(importlib.import_module(_API[name]), name)
     globals()[name] = value
     return value
 

@@ -10,7 +10,7 @@ import scipy.linalg
 
 from arcosim.fmu.flexchain import defaults, excitation
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.chain_excitation import ExcitationError, excite
+from arcosim.identification.chain_excitation import ExcitationError, design_excitation
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.encoder_fit import (
     Drive,
@@ -21,9 +21,9 @@ from arcosim.identification.encoder_fit import (
     output_recursion,
 )
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.log_check import check
+from arcosim.identification.log_check import check_log
 from arcosim.identification.output_error import linear_recursion, motor_record
-from arcosim.identification.whole_chain import identify, split
+from arcosim.identification.whole_chain import identify_whole_chain, split
 from benchmarks import field_sim
 
 LINES = np.geomspace(3.0, 150.0, 40)
@@ -45,7 +45,7 @@ def fit(d: field_sim.Drive, log: field_sim.Log, friction_given=True, load="none"
     encoder = encoder_record(
         log.time, log.i_a, log.theta_m, actuator, d.counts, friction_given, load
     )
-    return identify(record, masses, encoder)
+    return identify_whole_chain(record, masses, encoder)
 
 
 def assert_chain(choice, d: field_sim.Drive, rtol: float) -> None:
@@ -183,7 +183,7 @@ def test_a_slowly_varying_load_torque_is_modelled_not_taken_for_the_chain() -> N
 
 
 def test_excite_designs_what_the_excitation_source_plays() -> None:
-    e = excite((3.0, 150.0), 3.0, k_t=defaults.K_T, f_c=defaults.F_C)
+    e = design_excitation((3.0, 150.0), 3.0, k_t=defaults.K_T, f_c=defaults.F_C)
     assert e.source_parameters == {
         "signal": 1,
         "amplitude": 3.0,
@@ -195,23 +195,23 @@ def test_excite_designs_what_the_excitation_source_plays() -> None:
     same = [excitation.multisine(t, 3.0, list(e.frequencies), list(e.phases)) for t in e.time[:50]]
     np.testing.assert_allclose(e.signal[:50], same, atol=1e-12)
     assert np.max(np.abs(e.signal)) <= 3.0 and not e.warnings
-    weak = excite((3.0, 150.0), 1.0, k_t=defaults.K_T, f_c=defaults.F_C)
+    weak = design_excitation((3.0, 150.0), 1.0, k_t=defaults.K_T, f_c=defaults.F_C)
     assert any("stick" in w for w in weak.warnings)
-    speed = excite((3.0, 150.0), 3.0, kind="speed", speed_gain=0.3)
+    speed = design_excitation((3.0, 150.0), 3.0, kind="speed", speed_gain=0.3)
     assert speed.source_parameters is None and speed.amplitudes[-1] > 10 * speed.amplitudes[0]
     with pytest.raises(ExcitationError, match=r"0\.3/h"):
-        excite((3.0, 500.0), 3.0, h=1e-3)
+        design_excitation((3.0, 500.0), 3.0, h=1e-3)
 
 
 def test_check_tells_a_good_log_from_a_poor_one() -> None:
     d = drive()
     good = field_sim.simulate(d, 1e-3, 20.0, current=field_sim.multisine(LINES, 3.0))
-    report = check(good.time, good.i_a, good.omega_m, good.theta_m, d.k_t, d.J_m, d.counts)
+    report = check_log(good.time, good.i_a, good.omega_m, good.theta_m, d.k_t, d.J_m, d.counts)
     assert report.ok, report.text()
     np.testing.assert_allclose(report.modes, driving_point_modes(d.J, d.k)[0], rtol=2e-3)
     poor_current = field_sim.multisine(np.geomspace(3.0, 30.0, 11), 0.5)
     poor = field_sim.simulate(d, 1e-3, 20.0, current=poor_current)
-    report = check(poor.time, poor.i_a, poor.omega_m, poor.theta_m, d.k_t, d.J_m, d.counts)
+    report = check_log(poor.time, poor.i_a, poor.omega_m, poor.theta_m, d.k_t, d.J_m, d.counts)
     assert not report.ok
     text = report.text()
     assert "counts/s" in text and "excitation stops at 30 rad/s" in text

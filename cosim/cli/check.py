@@ -19,7 +19,7 @@ import json
 from arcosim.cli.identify import known_parameters
 from arcosim.cli.options import log_options
 from arcosim.host.overrides import parse_assignment
-from arcosim.identification.log_check import check
+from arcosim.identification.log_check import check_log
 from arcosim.logs import parse_scales, read_log
 
 #: The drive's figures a check needs, as observer parameter names.
@@ -44,14 +44,14 @@ def _execute(args: argparse.Namespace) -> int:
     values = known_parameters(3, args.set)
     given = {parse_assignment(text)[0] for text in args.set}
     c = log.columns
-    report = check(
+    report = check_log(
         log.time,
         c["i_a"],
         c["omega_m"],
         c["theta_m"],
         k_t=values["k_to"],
         J_m=values["J_mo"],
-        counts=int(values["encoder_cpr"]),
+        encoder_cpr=int(values["encoder_cpr"]),
         g_dist=values["g_dist"],
     )
     defaults = [name for name in NEEDED if name not in given]

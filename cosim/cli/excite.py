@@ -5,7 +5,7 @@ Designs a multi-sine of log-spaced lines over ``--band`` whose amplitudes add up
 PI speed loop of gain ``--speed-gain``, lines growing with frequency). Writes it as a
 CSV (``time`` s and ``i_ref`` A, or ``omega_ref`` rad/s) and prints the
 ExcitationSource FMU's parameters that play the same current. Given the drive's
-figures (``--k-t``, ``--f-c``, ``--J-total``, ``--counts``, ``--g-dist``), the design
+figures (``--k-t``, ``--f-c``, ``--J-total``, ``--encoder-cpr``, ``--g-dist``), the design
 is checked against the friction (sticking), the encoder (motion at the top line) and
 the band the disturbance observer reads, and warns with what to change.
 """
@@ -17,7 +17,7 @@ import json
 from pathlib import Path
 
 from arcosim.cli.options import force_option, number, step_option, whole_number
-from arcosim.identification.chain_excitation import DURATION, LINES, excite
+from arcosim.identification.chain_excitation import DURATION, LINES, design_excitation
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
 
@@ -62,7 +62,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         ("--g-dist", "rad/s", "disturbance observer bandwidth"),
     ):
         p.add_argument(name, type=number(0.0, low_open=True, unit=unit), help=f"{what} ({unit})")
-    p.add_argument("--counts", type=whole_number(1, 2**31 - 1), help="encoder counts/rev")
+    p.add_argument("--encoder-cpr", type=whole_number(1, 2**31 - 1), help="encoder counts/rev")
     p.add_argument("--out", type=Path, required=True, help="CSV file to write")
     force_option(p)
     p.add_argument("--json", action="store_true", help="print the design as one JSON object")
@@ -71,7 +71,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def _execute(args: argparse.Namespace) -> int:
     check_output(args.out, force=args.force)
-    design = excite(
+    design = design_excitation(
         tuple(args.band),
         args.current_limit,
         h=args.step,
@@ -82,7 +82,7 @@ def _execute(args: argparse.Namespace) -> int:
         k_t=args.k_t,
         f_c=args.f_c,
         J_total=args.J_total,
-        counts=args.counts,
+        encoder_cpr=args.encoder_cpr,
         g_dist=args.g_dist,
         speed_gain=args.speed_gain,
     )

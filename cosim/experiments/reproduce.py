@@ -57,8 +57,7 @@ from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.load_torque import score_profile, step_truth
 from arcosim.identification.offline_observer import estimate_states
 from arcosim.identification.output_error import motor_record, through_g
-from arcosim.identification.whole_chain import Choice
-from arcosim.identification.whole_chain import identify as identify_chain
+from arcosim.identification.whole_chain import Choice, identify_whole_chain
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, write_text
 from arcosim.version import __version__
@@ -293,7 +292,7 @@ def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int
     encoder = None
     if cpr > 0:  # ideal sensors: no counts
         encoder = encoder_record(identification.time, signals[0], signals[2], terms, cpr)
-    return identify_chain(record, "auto", encoder)
+    return identify_whole_chain(record, "auto", encoder)
 
 
 WHOLE_CHAIN_HEADER = ["parameter", "identified", "σ", "true", "error"]

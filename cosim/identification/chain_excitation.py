@@ -1,6 +1,6 @@
 """The excitation a user plays on a drive for whole-chain identification (offline design).
 
-:func:`excite` turns a band and a current limit into a multi-sine: as arrays, and (for a
+:func:`design_excitation` turns a band and a current limit into a multi-sine: as arrays, and (for a
 current) as the ExcitationSource FMU's parameters, which play the same signal (the same
 ``arcosim.fmu.flexchain.excitation`` functions). What the design rests on, measured on the
 whole-chain rows (README):
@@ -77,7 +77,7 @@ class Excitation:
         return {"time": self.time, "i_ref" if self.kind == "current" else "omega_ref": self.signal}
 
 
-def excite(
+def design_excitation(
     band: tuple[float, float],
     current_limit: float,
     h: float = STEP,
@@ -88,7 +88,7 @@ def excite(
     k_t: float | None = None,
     f_c: float | None = None,
     J_total: float | None = None,
-    counts: int | None = None,
+    encoder_cpr: int | None = None,
     g_dist: float | None = None,
     speed_gain: float | None = None,
 ) -> Excitation:
@@ -125,8 +125,9 @@ def excite(
         Coulomb friction (N·m), for the friction check.
     J_total : float, optional
         Motor and load inertia (kg·m²), for the encoder check.
-    counts : int, optional
-        Encoder counts per revolution (a count), for the encoder check.
+    encoder_cpr : int, optional
+        Encoder counts per revolution (a count; the observer FMU's ``encoder_cpr``),
+        for the encoder check.
     g_dist : float, optional
         DOB bandwidth (rad/s), for the band check.
     speed_gain : float, optional
@@ -204,9 +205,9 @@ def excite(
                 f"rms drive torque {rms_torque:.3g} N·m is under {TORQUE_PER_FRICTION:g}·f_c: "
                 f"the motor will stick often; raise the current {need:.1f}× or use fewer lines"
             )
-    if k_t and J_total and counts:
+    if k_t and J_total and encoder_cpr:
         motion = k_t * float(per_line_current[-1]) / (J_total * high**2)
-        seen = motion / (2.0 * math.pi / counts)
+        seen = motion / (2.0 * math.pi / encoder_cpr)
         t_value = seen * math.sqrt(6.0 * len(time))
         if t_value < LINE_T:
             warnings.append(

@@ -54,7 +54,7 @@ class LoadEstimate:
         return columns
 
 
-def estimate(
+def estimate_load_torque(
     settings: ObserverSettings,
     time: np.ndarray,
     i_a: np.ndarray,
@@ -95,9 +95,8 @@ def estimate(
     --------
     >>> import dataclasses
     >>> from arcosim.fmu.flexchain import defaults
-    >>> from arcosim.fmu.flexchain.observer import ObserverSettings
     >>> run = arcosim.run_scenario(dataclasses.replace(arcosim.SCENARIOS["flexible"], duration=2.0))
-    >>> settings = ObserverSettings(
+    >>> settings = arcosim.ObserverSettings(
     ...     mode=2, actuator=arcosim.Actuator(defaults.J_M, defaults.K_T, D_m=2e-5, f_c=2e-3),
     ...     g_dist=100.0, g_lpf=100.0, J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3,
     ...     estimator=1, encoder_cpr=2000, load_mass=3)

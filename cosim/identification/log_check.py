@@ -37,6 +37,9 @@ STUCK_LIMIT = 0.1
 LINE_T = 5.0
 #: A mode whose residue t value is below this is flagged as weakly determined.
 MODE_T = 30.0
+#: A stable pole whose residue t value is below this (or negative: a spring chain's
+#: modes all have positive residues) is as likely a pole of the noise as a mode.
+WEAK_T = 2.0
 #: Least encoder range (counts).
 LEAST_RANGE_COUNTS = 50
 #: Largest number of masses the mode search looks for.
@@ -60,7 +63,8 @@ class CheckReport:
             (the counts' noise): how well the encoder sees the line.
         band: highest mode sought, min(3·g_dist, 0.3/h) (rad/s).
         modes: the modes the record shows (rad/s); t_values: their residue t values.
-        weak: modes seen but too weakly excited (rad/s, t value).
+        weak: stable poles seen whose residue t value is below the fit's threshold
+            (rad/s, t value): too weakly excited modes (t ≥ WEAK_T), or not modes.
     """
 
     ok: bool
@@ -96,27 +100,40 @@ class CheckReport:
                 ", ".join(f"{w:.2f} (t = {t:.0f})" for w, t in zip(self.modes, self.t_values))
                 or "none"
             )
-            + (
-                "; too weak: " + ", ".join(f"{w:.1f} (t = {t:.1f})" for w, t in self.weak)
-                if self.weak
-                else ""
-            ),
+            + self._weak_text(),
         ]
         out += [f"problem: {p}" for p in self.problems]
         out += [f"warning: {w}" for w in self.warnings]
         out.append("ok: the log can support identification" if self.ok else "not ok")
         return "\n".join(out)
 
+    def _weak_text(self) -> str:
+        """The modes seen but too weakly excited, and how many other stable poles were
+        set aside as not modes of the chain."""
+        weak = [(w, t) for w, t in self.weak if t >= WEAK_T]
+        text = ""
+        if weak:
+            text = "; too weakly excited to fit: " + ", ".join(
+                f"{w:.1f} (t = {t:.1f})" for w, t in weak
+            )
+        others = len(self.weak) - len(weak)
+        if others:
+            text += (
+                f"; {others} other stable pole(s) set aside (t < {WEAK_T:g} or a negative "
+                "residue: not modes of a spring chain)"
+            )
+        return text
+
 
 @single_threaded
-def check(
+def check_log(
     time: np.ndarray,
     i_a: np.ndarray,
     omega_m: np.ndarray,
     theta_m: np.ndarray,
     k_t: float,
     J_m: float,
-    counts: int,
+    encoder_cpr: int,
     g_dist: float = G_DIST,
 ) -> CheckReport:
     """Can a log support whole-chain identification? Checks before any fit.
@@ -138,11 +155,12 @@ def check(
     theta_m : ndarray
         Motor angle (rad), shape ``(N,)``.
     k_t : float
-        Torque constant (N·m/A), from the datasheet.
+        Torque constant (N·m/A), from the datasheet (the observer FMU's ``k_to``).
     J_m : float
-        Motor inertia (kg·m²), from the datasheet.
-    counts : int
-        Encoder counts per revolution (a count); 0 for an angle not quantized.
+        Motor inertia (kg·m²), from the datasheet (the observer FMU's ``J_mo``).
+    encoder_cpr : int
+        Encoder counts per revolution (a count; the observer FMU's ``encoder_cpr``);
+        0 for an angle not quantized.
     g_dist : float
         Bandwidth of the disturbance observer (rad/s).
 
@@ -157,7 +175,7 @@ def check(
     >>> run = arcosim.run_scenario(arcosim.SCENARIOS["identification"], 2,
     ...                            plant={"J[1]": 4e-4, "J[2]": 8e-4, "k[1]": 0.3, "k[2]": 0.2})
     >>> signals = [run[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
-    >>> report = arcosim.check_log(run.time, *signals, k_t=0.0406, J_m=2.09e-5, counts=2000)
+    >>> report = arcosim.check_log(run.time, *signals, k_t=0.0406, J_m=2.09e-5, encoder_cpr=2000)
     >>> report.ok, len(report.modes)
     (True, 2)
     """
@@ -175,7 +193,7 @@ def check(
             f"the sample step varies by {report.step_spread:.1e} of its mean: the fits need "
             "a constant step (resample the log, or log at a fixed rate)"
         )
-    count = 2.0 * np.pi / counts if counts > 0 else 0.0
+    count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0
     theta = np.asarray(theta_m, dtype=float)
     report.range_counts = float(np.ptp(theta) / count) if count else float("inf")
     if report.range_counts < LEAST_RANGE_COUNTS:
@@ -214,7 +232,8 @@ def check(
                 "encoder or a longer record"
             )
     try:
-        detected = _modes(time, np.asarray(i_a, float), omega_m, theta, k_t, J_m, counts, g_dist)
+        i_a = np.asarray(i_a, float)
+        detected = _modes(time, i_a, omega_m, theta, k_t, J_m, encoder_cpr, g_dist)
     except IdentificationError as error:
         detected = None
         report.problems.append(str(error))
@@ -225,7 +244,7 @@ def check(
         if not detected.n:
             report.problems.append(
                 "the record shows no excited mode: excite the chain across its modes "
-                "(a multi-sine of many lines, `chain_excitation.excite`)"
+                "(a multi-sine of many lines, `arcosim.design_excitation`)"
             )
         for w, t in zip(report.modes, report.t_values):
             if t < MODE_T:
@@ -234,7 +253,7 @@ def check(
                     f"{MODE_T:g}): the fit will confirm it by its information criterion"
                 )
         for w, t in detected.weak:
-            if t >= 2.0:  # below, a pole of the noise as likely as a mode
+            if t >= WEAK_T:
                 report.warnings.append(
                     f"a mode near {w:.1f} rad/s is too weakly excited (t = {t:.1f}): more "
                     "current per line there, a longer record or a finer encoder"
@@ -243,15 +262,15 @@ def check(
     return report
 
 
-def _modes(time, i_a, omega_m, theta, k_t, J_m, counts, g_dist) -> Detected:
+def _modes(time, i_a, omega_m, theta, k_t, J_m, encoder_cpr, g_dist) -> Detected:
     """The record's modes as the whole-chain fit reads them (friction not known: first
     estimated from the modes, taken out of τ̂, and the modes read again)."""
     actuator = Actuator(J_m, k_t)
     record = motor_record(time, i_a, omega_m, theta, actuator, g_dist)
     detected = detect_modes(record, LARGEST)
-    if detected.n and counts > 0:
+    if detected.n and encoder_cpr > 0:
         encoder = encoder_record(
-            time, i_a, theta, actuator, counts, friction_given=False, g_dist=g_dist
+            time, i_a, theta, actuator, encoder_cpr, friction_given=False, g_dist=g_dist
         )
         modes = detected.modes()
         J0, k0 = modes.chain()

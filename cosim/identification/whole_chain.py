@@ -136,7 +136,7 @@ class Choice:
 
 
 @single_threaded
-def identify(
+def identify_whole_chain(
     record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
 ) -> Choice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
@@ -428,7 +428,7 @@ def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str
         ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
         "lines on both sides of each mode, up to the band; a longer record; a finer "
         f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
-        "see `excite`, or fit fewer masses"
+        "see `arcosim.design_excitation`, or fit fewer masses"
     )
 
 

@@ -27,27 +27,52 @@ RECURSION, MODEL_BASED = 0, 1
 
 @dataclass(frozen=True)
 class ObserverSettings:
-    """Everything the observer is configured with (units as the FMU parameters).
+    """Everything the observer is configured with: its FMU parameters as one value.
 
-    Attributes:
-        mode: 0, 1 or 2 (see module doc).
-        actuator: nominal and identified actuator terms.
-        g_dist: DOB bandwidth (rad/s).
-        g_lpf: bandwidth of the recursion's extra filter (rad/s).
-        J, k, B: load inertias (kg·m²), spring stiffnesses (N·m/rad), dampings (N·m·s/rad).
-        kappa_correction: multi-mass correction κ in mode 1.
-        estimator: 0 = recursion (eq. 22–26); 1 = model-based observer.
-        omega_min: speed below which mode 0 treats the motor as stopped (rad/s).
-        g_id: bandwidth of mode 0's extra filter on target and regressors (rad/s); 0 = none.
-        encoder_cpr: counts per revolution of the motor encoder (0: not quantized). Mode 2
-            takes the motor angle at the middle of its count (an encoder that reports
-            whole counts reads half a count low on average), and the model-based
-            observer takes its quantization noise, 2π/cpr/√12 rad, into its gain.
-        torque_noise_std: model-based observer: unmodelled torque on each mass (N·m).
-        tau_noise_std: model-based observer: noise on τ̂_reac (N·m).
-        load_mass: model-based observer: 0, or the load mass (1 … n) whose external
-            torque is estimated too (:mod:`arcosim.fmu.flexchain.load_observer`).
-        load_torque_bandwidth: bandwidth of that estimate (rad/s), > 0.
+    Parameters
+    ----------
+    mode : int
+        0, 1 or 2, an index (see the module doc); 2 estimates the states.
+    actuator : Actuator
+        Nominal and identified actuator terms (J_mo, k_to, Δk_t, ΔJ, D_m, f_c).
+    g_dist : float
+        DOB bandwidth (rad/s).
+    g_lpf : float
+        Bandwidth of the recursion's extra filter (rad/s).
+    J, k, B : tuple of float
+        Load inertias (kg·m²), spring stiffnesses (N·m/rad) and dampings (N·m·s/rad),
+        mass 1 (next to the motor) first, shape ``(n,)`` each.
+    kappa_correction : bool
+        Mode 1: apply the multi-mass correction κ.
+    estimator : int
+        Mode 2, an index: 0 = the paper's recursion (eq. 22–26); 1 = the model-based
+        observer (use it: the recursion diverges from the second mass on).
+    omega_min : float
+        Speed below which mode 0 treats the motor as stopped (rad/s).
+    g_id : float
+        Bandwidth of mode 0's extra filter on target and regressors (rad/s); 0 = none.
+    encoder_cpr : int
+        Counts per revolution of the motor encoder (a count; 0: not quantized). Mode 2
+        takes the motor angle at the middle of its count (an encoder that reports
+        whole counts reads half a count low on average), and the model-based observer
+        takes its quantization noise, 2π/cpr/√12 rad, into its gain.
+    torque_noise_std : float
+        Model-based observer: unmodelled torque on each mass (N·m).
+    tau_noise_std : float
+        Model-based observer: noise on τ̂_reac (N·m).
+    load_mass : int
+        Model-based observer: 0, or the index (1 … n) of the load mass whose external
+        torque is estimated too (:mod:`arcosim.fmu.flexchain.load_observer`).
+    load_torque_bandwidth : float
+        Bandwidth of that estimate (rad/s), > 0.
+
+    Examples
+    --------
+    >>> actuator = arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406)
+    >>> settings = arcosim.ObserverSettings(mode=2, actuator=actuator, g_dist=100.0, g_lpf=100.0,
+    ...                                     J=(1e-3,), k=(0.5,), B=(1e-4,), estimator=1)
+    >>> settings.estimator, settings.load_mass
+    (1, 0)
     """
 
     mode: int

@@ -1,0 +1,1 @@
+"""The plant FMU's C sources (package data, compiled by :mod:`arcosim.build.cplant`)."""
