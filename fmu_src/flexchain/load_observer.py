@@ -75,9 +75,9 @@ from .model_observer import (
     ModelObserver,
     NoiseModel,
     StepModel,
-    filter_riccati,
+    chain_process_noise,
     measurement_noise,
-    theta_noise_covariance,
+    steady_state_gain,
 )
 
 #: Default bandwidth ω_L of the load torque estimate (rad/s). Measured on the bench
@@ -133,6 +133,18 @@ def smoothing_filter(bandwidth: float, h: float) -> tuple[Matrix, list[float]]:
     return [X[0][:2], X[1][:2]], [X[0][2], X[1][2]]
 
 
+def check_load_settings(n: int, load_mass: int, bandwidth: float) -> None:
+    """Refuse a ``load_mass`` outside 1 … n or a bandwidth ω_L (rad/s) that is not > 0.
+
+    Raises:
+        ValueError: naming the setting.
+    """
+    if not 1 <= load_mass <= n:
+        raise ValueError(f"load_mass = {load_mass}: use a load mass 1 … {n}")
+    if not bandwidth > 0.0:
+        raise ValueError(f"load torque bandwidth {bandwidth!r} rad/s: it must be > 0")
+
+
 def load_step_model(
     J: Sequence[float],
     k: Sequence[float],
@@ -158,10 +170,7 @@ def load_step_model(
         low-pass at ``SMOOTHING_RATIO · bandwidth``.
     """
     n = len(J)
-    if not 1 <= load_mass <= n:
-        raise ValueError(f"load_mass = {load_mass}: use a load mass 1 … {n}")
-    if not bandwidth > 0.0:
-        raise ValueError(f"load torque bandwidth {bandwidth!r} rad/s: it must be > 0")
+    check_load_settings(n, load_mass, bandwidth)
     chain = discretize(J, k, B, h)
     b_d = load_column(J, k, B, h, load_mass)
     m = 2 * n + 2
@@ -178,20 +187,15 @@ def load_step_model(
     F[m - 1][2 * n] = b * e_d
     F[m - 1][m - 1] = a
     Gamma = [row[:] for row in chain.Bd] + [[0.0, 0.0], [b * du[0], b * du[1]]]
-    Q = theta_noise_covariance(Gamma, noise.theta_noise_std, h)
-    for i in range(n):
-        Q[n + i][n + i] += (noise.torque_noise_std * h / J[i]) ** 2
+    Q = chain_process_noise(Gamma, J, noise, h)
     r = measurement_noise(noise)
     q = (bandwidth * math.sqrt(r) * h) ** 2  # the random walk's increment variance
     g = [*b_d, 1.0, b * e_d]  # where an increment of d goes within the step
     for i in range(m):
         for j in range(m):
             Q[i][j] += q * g[i] * g[j]
-        Q[i][i] += 1e-30  # keeps the Riccati equation regular when every noise is zero
-    P = filter_riccati(F, Q, r)
-    K = [P[i][m - 1] / (P[m - 1][m - 1] + r) for i in range(m)]
     Phi, phi = smoothing_filter(SMOOTHING_RATIO * bandwidth, h)
-    return LoadStepModel(F, Gamma, K, Phi, phi)
+    return LoadStepModel(F, Gamma, steady_state_gain(F, Q, r), Phi, phi)
 
 
 class LoadTorqueObserver(ModelObserver):
@@ -225,10 +229,7 @@ class LoadTorqueObserver(ModelObserver):
         bandwidth: float = LOAD_TORQUE_BANDWIDTH,
     ) -> None:
         n = len(J)
-        if not 1 <= load_mass <= n:
-            raise ValueError(f"load_mass = {load_mass}: use a load mass 1 … {n}")
-        if not bandwidth > 0.0:
-            raise ValueError(f"load torque bandwidth {bandwidth!r} rad/s: it must be > 0")
+        check_load_settings(n, load_mass, bandwidth)
         super().__init__(J, k, B, g_dist, noise, theta0)
         self.load_mass = load_mass
         self.bandwidth = bandwidth

@@ -103,6 +103,28 @@ def measurement_noise(noise: NoiseModel) -> float:
     return max(noise.tau_noise_std**2, 1e-30)
 
 
+def chain_process_noise(Gamma: Matrix, J: Sequence[float], noise: NoiseModel, h: float) -> Matrix:
+    """Process noise of the chain's states over a step of ``h`` s: the motor angle's noise
+    through ``Γ`` (:func:`theta_noise_covariance`) plus each load mass's unmodelled torque
+    on its velocity (states n … 2n − 1). Shape m × m, m = ``len(Gamma)`` ≥ 2n."""
+    n = len(J)
+    Q = theta_noise_covariance(Gamma, noise.theta_noise_std, h)
+    for i in range(n):
+        Q[n + i][n + i] += (noise.torque_noise_std * h / J[i]) ** 2
+    return Q
+
+
+def steady_state_gain(F: Matrix, Q: Matrix, r: float) -> list[float]:
+    """Gain ``K`` (length m) of the steady-state Kalman filter of ``s ← F s`` with process
+    noise ``Q`` (m × m) and the last state measured with variance ``r``."""
+    m = len(F)
+    Q = [row[:] for row in Q]
+    for i in range(m):  # keeps the Riccati equation regular when every noise is zero
+        Q[i][i] += 1e-30
+    P = filter_riccati(F, Q, r)
+    return [P[i][m - 1] / (P[m - 1][m - 1] + r) for i in range(m)]
+
+
 def step_model(
     J: Sequence[float],
     k: Sequence[float],
@@ -124,15 +146,8 @@ def step_model(
     F[m - 1][: 2 * n] = [b * x for x in c]
     F[m - 1][m - 1] = a
     Gamma = [row[:] for row in chain.Bd] + [[b * d[0], b * d[1]]]
-    Q = theta_noise_covariance(Gamma, noise.theta_noise_std, h)
-    for i in range(n):
-        Q[n + i][n + i] += (noise.torque_noise_std * h / J[i]) ** 2
-    for i in range(m):  # keeps the Riccati equation regular when every noise is zero
-        Q[i][i] += 1e-30
-    r = measurement_noise(noise)
-    P = filter_riccati(F, Q, r)
-    K = [P[i][m - 1] / (P[m - 1][m - 1] + r) for i in range(m)]
-    return StepModel(F, Gamma, K)
+    Q = chain_process_noise(Gamma, J, noise, h)
+    return StepModel(F, Gamma, steady_state_gain(F, Q, measurement_noise(noise)))
 
 
 class ModelObserver:
