@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 from arcosim.cli import main
 from arcosim.errors import UserError
 from arcosim.logs import LOG_COLUMNS, read_log
+from arcosim.sweeps.spec import DISTRIBUTIONS
 
 FAST = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 #: Through the command line: each example runs the FMUs, so fewer.
@@ -288,15 +289,8 @@ LITERALS = st.recursive(
     ),
     max_leaves=6,
 )
-PARAMETERS = {
-    "uniform": ("low", "high"),
-    "loguniform": ("low", "high"),
-    "normal": ("mean", "std"),
-    "randint": ("low", "high"),
-    "choice": ("values",),
-    "grid": ("values",),
-    "wobbly": ("low",),
-}
+#: The spec's distributions and the keys each takes, and one kind the spec does not know.
+PARAMETERS = {**DISTRIBUTIONS, "wobbly": ("low",)}
 
 
 @st.composite
