@@ -28,7 +28,6 @@ J_m alone shows as an error of the first inertia mostly.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -188,7 +187,7 @@ def encoder_record(
     J_m = actuator.J_mo + actuator.dJm
     D_m, f_c = actuator.D_m, actuator.f_c
     if not friction_given:
-        D_m, f_c = rigid_friction(drive, theta, h, cutoff)
+        D_m, f_c = rigid_friction(drive, theta, velocity, h)
     drift = LOAD_DRIFT * float(np.sqrt(np.mean(drive**2))) * np.sqrt(h)
     return EncoderRecord(
         h=h,
@@ -199,7 +198,7 @@ def encoder_record(
         J_m=J_m,
         D_m=D_m,
         f_c=f_c,
-        torque_std=max(f_c / 2.0, TORQUE_STD_FLOOR),
+        torque_std=torque_std(f_c),
         friction_given=friction_given,
         load=load,
         load_std=drift if load == "slow" else 0.0,
@@ -220,18 +219,19 @@ def opening(record: EncoderRecord, seconds: float) -> EncoderRecord:
 
 
 def rigid_friction(
-    drive: np.ndarray, theta: np.ndarray, h: float, sign_cutoff: float
+    drive: np.ndarray, theta: np.ndarray, velocity: np.ndarray, h: float
 ) -> tuple[float, float]:
     """Start values ``(D_m, f_c)`` from the record read as one rigid body: below a
     few rad/s the chain moves with the motor, so ``k_t i ≈ J_total α + D_m ω + f_c sgn ω``;
-    least squares on the signals low-passed at 2 rad/s (J_total fitted too)."""
+    least squares on the signals low-passed at 2 rad/s (J_total fitted too); sgn ω from
+    the record's smoothed ``velocity`` (rad/s)."""
     cutoff = 2.0
     b, a = signal.butter(2, min(cutoff * h / np.pi, 0.5))
     torque = signal.filtfilt(b, a, drive)
     angle = signal.filtfilt(b, a, theta)
     omega = np.gradient(angle, h)
     alpha = np.gradient(omega, h)
-    sign = signal.filtfilt(b, a, np.sign(smooth_velocity(theta, h, sign_cutoff)))
+    sign = signal.filtfilt(b, a, np.sign(velocity))
     X = np.column_stack([alpha, omega, sign])
     coef = np.linalg.lstsq(X, torque, rcond=None)[0]
     scale = float(np.sqrt(np.mean(drive**2)))
@@ -253,10 +253,17 @@ def mean_sign(velocity: np.ndarray) -> np.ndarray:
     return np.concatenate([[np.sign(velocity[0])], out])
 
 
-def torque_std(actuator: Actuator) -> float:
-    """Unmodelled motor torque (N·m per step): half the Coulomb friction (what the
-    friction model misses while the motor sticks), at least :data:`TORQUE_STD_FLOOR`."""
-    return max(actuator.f_c / 2.0, TORQUE_STD_FLOOR)
+def torque_std(f_c: float) -> float:
+    """Unmodelled motor torque (N·m per step): half the Coulomb friction ``f_c`` (N·m;
+    what the friction model misses while the motor sticks), at least
+    :data:`TORQUE_STD_FLOOR`."""
+    return max(f_c / 2.0, TORQUE_STD_FLOOR)
+
+
+def with_friction(record: EncoderRecord, D_m: float, f_c: float) -> EncoderRecord:
+    """``record`` with the motor friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m) and the
+    process noise that goes with it (:func:`torque_std`)."""
+    return replace(record, D_m=D_m, f_c=f_c, torque_std=torque_std(f_c))
 
 
 @dataclass(frozen=True)
@@ -427,16 +434,8 @@ def output_recursion(F: np.ndarray, G: np.ndarray, u: np.ndarray) -> np.ndarray:
     return out
 
 
-def innovations(
-    record: EncoderRecord,
-    J: Sequence[float],
-    k: Sequence[float],
-    B: Sequence[float],
-    drive: Drive | None = None,
-) -> np.ndarray:
+def innovations(record: EncoderRecord, drive: Drive) -> np.ndarray:
     """Normalized one-step prediction errors of the encoder angle, shape (N − 1,)."""
-    if drive is None:
-        drive = Drive(np.asarray(J), np.asarray(k), np.asarray(B), record.D_m, record.f_c)
     kalman = _Kalman.of(record, drive)
     predicted = kalman.predicted_angle(record, drive)[1:]
     y = record.theta_m[1:] - record.theta_m[0]
@@ -573,7 +572,7 @@ def _least_squares(
 
     def residual(x: np.ndarray) -> np.ndarray:
         with np.errstate(all="ignore"):
-            e = innovations(record, (), (), (), unpack(x * scale, n, record))
+            e = innovations(record, unpack(x * scale, n, record))
         if not np.all(np.isfinite(e)):
             raise IdentificationError(
                 f"the prediction-error fit of {n} mass(es) diverged (the record does not "

@@ -27,13 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
-from arcosim.fmu.flexchain.filters import lowpass_pole
 from arcosim.identification.chain_modes import chain_from_modes
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.output_error import (
     MotorRecord,
-    decorrelation_lag,
     newey_west_covariance,
+    newey_west_lag,
     through_g,
 )
 
@@ -236,12 +235,13 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
     frequency = np.array([c[0] for c in clusters])
     damping = np.array([c[1] for c in clusters])
     orders = np.array([c[2] for c in clusters])
-    residue, std = residues_with_errors(record, frequency, damping)
+    regressors = _modal_regressors(record, frequency, damping)  # a column per mode
+    residue, std = _residues_of(regressors, record)
     t_value = residue / np.maximum(std, 1e-300)
     counts = t_value >= RESIDUE_T
     weak = [(float(w), float(t)) for w, t, c in zip(frequency, t_value, counts) if not c]
     while np.any(counts) and not np.all(counts):  # refit without the weak ones, until
-        residue_c, std_c = residues_with_errors(record, frequency[counts], damping[counts])
+        residue_c, std_c = _residues_of(regressors[:, counts], record)
         residue[counts], std[counts] = residue_c, std_c
         t_value[counts] = residue_c / np.maximum(std_c, 1e-300)
         still = t_value >= RESIDUE_T
@@ -313,26 +313,6 @@ def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, in
             continue
         merged.append(mode)
     return merged
-
-
-def singular_values(record: MotorRecord) -> np.ndarray:
-    """Singular values of the subspace step (relative to the first, shape (rows,)):
-    each lightly damped mode the record shows adds a pair above the noise floor."""
-    band = _band(record)
-    u, y, _ = _decimated(record, band)
-    rows = min(ROWS, len(u) // 8)
-    if rows < 4:
-        raise IdentificationError(
-            f"the record ({record.duration:g} s) is too short to show its modes"
-        )
-    singular = moesp(u, y, 2, rows)[1]
-    return singular / singular[0]
-
-
-def masses_seen(singular: np.ndarray, largest: int) -> int:
-    """The n ≤ ``largest`` after whose 2n-th singular value the largest drop comes."""
-    pairs = range(1, min(largest, (len(singular) - 1) // 2) + 1)
-    return max(pairs, key=lambda n: singular[2 * n - 1] / max(singular[2 * n], 1e-300))
 
 
 def _band(record: MotorRecord) -> float:
@@ -416,10 +396,8 @@ def residues(record: MotorRecord, frequency: np.ndarray, damping: np.ndarray) ->
     (so the static torque k_1 − Σ r_i / p_i² is zero, as it is for a free load chain);
     0 means the mode does not explain the record.
     """
-    regressors = _modal_regressors(record, frequency, damping)
-    norms = np.linalg.norm(regressors, axis=0)
-    norms[norms == 0.0] = 1.0
-    r, _ = optimize.nnls(regressors / norms, record.tau_hat)
+    X, norms = _normalized(_modal_regressors(record, frequency, damping))
+    r, _ = optimize.nnls(X, record.tau_hat)
     return r / norms
 
 
@@ -429,28 +407,30 @@ def _modal_regressors(
     """The motor angle through ``1/p² − 1/(s² + 2ζps + p²)`` and G(s), per mode (N, n)."""
     h = record.h
     u = record.theta_m - record.theta_m[0]
-    a = lowpass_pole(record.g_dist, h)
     columns = []
     for p, zeta in zip(frequency, np.clip(damping, 1e-4, None)):
         numerator = [1.0, 2.0 * zeta * p, 0.0]
         denominator = [p**2, 2.0 * zeta * p**3, p**4]
         b, a_, _ = signal.cont2discrete((numerator, denominator), h, method="bilinear")
-        columns.append(signal.lfilter([1.0 - a], [1.0, -a], signal.lfilter(b.ravel(), a_, u)))
+        columns.append(through_g(signal.lfilter(b.ravel(), a_, u), record.g_dist, h))
     return np.array(columns).T
 
 
-def residues_with_errors(
-    record: MotorRecord, frequency: np.ndarray, damping: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Residues r_i of the modal model on the record, the modes held, by ordinary
-    least squares (any sign), and their Newey–West standard errors (shapes (n,))."""
-    regressors = _modal_regressors(record, frequency, damping)
+def _normalized(regressors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The regressors (N, n) scaled to unit norm per column, and the norms (n,); a
+    column of zeros keeps the norm 1."""
     norms = np.linalg.norm(regressors, axis=0)
     norms[norms == 0.0] = 1.0
-    X = regressors / norms
+    return regressors / norms, norms
+
+
+def _residues_of(regressors: np.ndarray, record: MotorRecord) -> tuple[np.ndarray, np.ndarray]:
+    """Residues r_i of the modal model (:func:`_modal_regressors`, shape (N, n)) on the
+    record, the modes held, by ordinary least squares (any sign), and their Newey–West
+    standard errors (shapes (n,))."""
+    X, norms = _normalized(regressors)
     r = np.linalg.lstsq(X, record.tau_hat, rcond=None)[0]
     residual = record.tau_hat - X @ r
-    lag = decorrelation_lag(residual, int(np.ceil(5.0 / (record.g_dist * record.h))))
-    cov = newey_west_covariance(X, residual, lag)
+    cov = newey_west_covariance(X, residual, newey_west_lag(residual, record))
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return r / norms, std / norms

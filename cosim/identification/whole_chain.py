@@ -30,7 +30,7 @@ from scipy import optimize
 
 from arcosim.fmu.flexchain.chain import spring_matrix
 from arcosim.identification.blas import single_threaded
-from arcosim.identification.encoder_fit import EncoderRecord, refine
+from arcosim.identification.encoder_fit import EncoderRecord, refine, with_friction
 from arcosim.identification.encoder_fit import opening as encoder_opening
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import Detected, Modes, chain_of, detect_modes, record_modes
@@ -203,17 +203,18 @@ def identify_whole_chain(
         J0, k0 = modes.chain()
         D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
         record = without_friction(raw, encoder, D_m, f_c)
-        encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+        encoder = with_friction(encoder, D_m, f_c)
         detected = detect_modes(record, largest, lines)
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
         # the fit's friction is far better than the start's: read the modes once more
         # with it, and fit again if they changed
         D_m, f_c = result.extra["D_m"], result.extra["f_c"]
-        again = detect_modes(without_friction(raw, encoder, D_m, f_c), largest, lines)
+        cleaned = without_friction(raw, encoder, D_m, f_c)
+        again = detect_modes(cleaned, largest, lines)
         if not _same_modes(again, detected):
-            record = without_friction(raw, encoder, D_m, f_c)
-            encoder = replace(encoder, D_m=D_m, f_c=f_c, torque_std=max(f_c / 2.0, 1e-4))
+            record = cleaned
+            encoder = with_friction(encoder, D_m, f_c)
             detected = again
             n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     result.extra.update(
@@ -430,10 +431,6 @@ def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str
         f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
         "see `arcosim.design_excitation`, or fit fewer masses"
     )
-
-
-def _refined(result: Fit, record: MotorRecord, encoder: EncoderRecord | None, n: int) -> Fit:
-    return result if encoder is None else refine(encoder, record, result, n)
 
 
 def _masses(masses: int | str) -> int:
