@@ -41,11 +41,12 @@ def drive() -> field_sim.Drive:
         f_c=2e-3,
         current_bandwidth=2000.0,
         current_noise=0.005,
-        encoder_cpr=COUNTS,
+        counts=COUNTS,
     )
 
 
-def main() -> None:
+def main(out: Path = OUT) -> None:
+    """Simulate the belt drive and write its log to ``out`` (CSV, columns above)."""
     design = design_excitation((3.0, 150.0), 3.0)
 
     def current(t: np.ndarray) -> np.ndarray:
@@ -54,8 +55,8 @@ def main() -> None:
     log = field_sim.simulate(drive(), 1e-3, 20.0, current=current, seed=7)
     count = 2 * np.pi / COUNTS
     counts = np.rint(log.theta_m / count).astype(np.int64)
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    with open(OUT, "w", newline="", encoding="utf-8") as f:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with open(out, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f)
         writer.writerow(["time", "i_a", "omega_m", "theta_m", "theta_1_true", "theta_2_true"])
         previous = counts[0]
@@ -72,7 +73,7 @@ def main() -> None:
                     f"{log.theta_true[k, 2]:.7g}",
                 ]
             )
-    print(f"wrote {OUT} ({OUT.stat().st_size / 1e3:.0f} kB)")
+    print(f"wrote {out} ({out.stat().st_size / 1e3:.0f} kB)")
 
 
 if __name__ == "__main__":

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -38,3 +40,20 @@ def test_identify_your_drive_finds_the_belt_drive(build_fmus, tmp_path) -> None:
     ]
     assert len(scores) == 2 and max(scores) < 5.0  # % of the flexible motion; measured 0.6 %
     assert (tmp_path / "belt_drive_estimate.csv").stat().st_size > 100_000
+
+
+def test_the_sample_log_is_what_its_script_writes(tmp_path) -> None:
+    """``python -m benchmarks.sample_log`` regenerates examples/data/belt_drive.csv: the
+    same times and, within one step's rounding, the same current (0.01 mA, as written),
+    counts (± 1) and true angles (7 digits as written)."""
+    from benchmarks import sample_log
+
+    out = tmp_path / "belt_drive.csv"
+    sample_log.main(out)
+    fresh = np.loadtxt(out, delimiter=",", skiprows=1)
+    shipped = np.loadtxt(EXAMPLES / "data" / "belt_drive.csv", delimiter=",", skiprows=1)
+    assert fresh.shape == shipped.shape
+    np.testing.assert_array_equal(fresh[:, 0], shipped[:, 0])
+    assert np.max(np.abs(fresh[:, 1] - shipped[:, 1])) <= 0.0100001  # mA
+    assert np.max(np.abs(fresh[:, 3] - shipped[:, 3])) <= 1  # counts
+    np.testing.assert_allclose(fresh[:, 4:], shipped[:, 4:], rtol=1e-6, atol=1e-9)  # rad
