@@ -26,7 +26,7 @@ def folder(build_fmus) -> Path:
 
 
 def outputs_finite(fmu: FmuInstance) -> bool:
-    names = [v.name for v in fmu.description.modelVariables if v.causality == "output"]
+    names = fmu.output_names()
     return all(math.isfinite(x) for x in fmu.reader(names)())
 
 

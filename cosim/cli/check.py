@@ -16,9 +16,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from arcosim.cli.identify import known_parameters
+from arcosim.cli.identify import defaults_note, known_parameters, set_names
 from arcosim.cli.options import log_options
-from arcosim.host.overrides import parse_assignment
 from arcosim.identification.log_check import check_log
 from arcosim.logs import parse_scales, read_log
 
@@ -42,7 +41,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
     values = known_parameters(3, args.set)
-    given = {parse_assignment(text)[0] for text in args.set}
+    given = set_names(args.set)
     c = log.columns
     report = check_log(
         log.time,
@@ -54,14 +53,7 @@ def _execute(args: argparse.Namespace) -> int:
         encoder_cpr=int(values["encoder_cpr"]),
         g_dist=values["g_dist"],
     )
-    defaults = [name for name in NEEDED if name not in given]
-    note = (
-        "not given, so the paper bench's value was used: "
-        + ", ".join(f"{name} = {values[name]:g}" for name in defaults)
-        + " (give your drive's with --set)"
-        if defaults
-        else ""
-    )
+    note = defaults_note(values, NEEDED, given)
     if args.json:
         out = {k: v for k, v in vars(report).items()}
         out["assumptions"] = {"defaults": note} if note else {}

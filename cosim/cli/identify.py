@@ -189,7 +189,7 @@ def _execute(args: argparse.Namespace) -> int:
     defaults = defaults_note(
         known_parameters(n, args.set),
         drive_parameters(n, chain=args.mode in (None, STATE_ESTIMATION)),
-        _set_names(args.set),
+        set_names(args.set),
     )
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
@@ -309,7 +309,7 @@ def _output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     report["std"] = {names[k]: v for k, v in result.std_dict().items()}
     report.update(evidence(result, record))
     known = ["J_mo", "k_to", "D_m", "f_c", *(f"J[{i}]" for i in range(1, n + 1))]
-    defaults = defaults_note(values, known, _set_names(args.set))
+    defaults = defaults_note(values, known, set_names(args.set))
     if defaults:
         report["assumptions"] = {"defaults": defaults}
     _write_report(args, report)
@@ -338,7 +338,7 @@ def _masses(text: str) -> int:
 
 def _whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
     values = known_parameters(masses if isinstance(masses, int) else 3, args.set)
-    given = {parse_assignment(text)[0] for text in args.set}
+    given = set_names(args.set)
     friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
     actuator = actuator_of(values)
     c = log.columns
@@ -417,7 +417,7 @@ def read_chain(path: Path) -> dict[str, float]:
 
 def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[str, float]) -> int:
     values = known_parameters(n, args.set)
-    given = _set_names(args.set)
+    given = set_names(args.set)
     values.update({k: v for k, v in chain.items() if k not in given})
     defaults = defaults_note(values, drive_parameters(n), given | set(chain))
     load_mass = int(values["load_mass"])
@@ -492,7 +492,8 @@ def _load_torque(args: argparse.Namespace, log: DriveLog, n: int, chain: dict[st
     return 0
 
 
-def _set_names(assignments: Sequence[str]) -> set[str]:
+def set_names(assignments: Sequence[str]) -> set[str]:
+    """The parameter names of ``--set NAME=VALUE`` assignments."""
     return {parse_assignment(text)[0] for text in assignments}
 
 

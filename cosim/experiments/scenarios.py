@@ -326,9 +326,7 @@ def run_scenario(
                 *(f"omega[{i}]" for i in range(1, n + 1)),
             ]
         if record_observer is None:
-            record_observer = [
-                v.name for v in o.description.modelVariables if v.causality == "output"
-            ]
+            record_observer = o.output_names()
         return cosimulate(
             p,
             o,

@@ -228,6 +228,10 @@ class FmuInstance:
 
     # -- values -----------------------------------------------------------------------
 
+    def output_names(self) -> list[str]:
+        """Every output of the FMU, in declaration order."""
+        return [v.name for v in self.description.modelVariables if v.causality == "output"]
+
     def vrs(self, names: Iterable[str]) -> list[int]:
         """Value references of ``names``; unknown names raise :class:`UserError`."""
         return [self._variable(n).valueReference for n in names]

@@ -67,7 +67,7 @@ def replay_log(
     (200,)
     """
     if outputs is None:
-        outputs = output_names(observer)
+        outputs = observer.output_names()
     write = observer.real_writer(list(MEASURED))
     read = observer.reader(outputs)
     inputs = np.column_stack([log.columns[c] for c in MEASURED])
@@ -89,11 +89,6 @@ def replay_log(
     for j, name in enumerate(outputs):
         recording.signals[f"observer.{name}"] = samples[:, j]
     return recording
-
-
-def output_names(fmu: FmuInstance) -> list[str]:
-    """Every output of ``fmu``, in value-reference order."""
-    return [v.name for v in fmu.description.modelVariables if v.causality == "output"]
 
 
 def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer") -> dict:

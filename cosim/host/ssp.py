@@ -168,16 +168,9 @@ def run_ssp(
             (instances[a].reader([ca]), instances[b].real_writer([cb]))
             for a, ca, b, cb in system.connections
         ]
+        outputs = {name: fmu.output_names() for name, fmu in instances.items()}
         readers = {
-            name: (
-                fmu.reader(
-                    outs := [
-                        v.name for v in fmu.description.modelVariables if v.causality == "output"
-                    ]
-                ),
-                outs,
-            )
-            for name, fmu in instances.items()
+            name: (fmu.reader(outputs[name]), outputs[name]) for name, fmu in instances.items()
         }
         logs = {name: np.empty((steps + 1, len(outs))) for name, (_, outs) in readers.items()}
         for name, (read, _) in readers.items():

@@ -61,7 +61,7 @@ def check_runtime(fmu: Path) -> list[str]:
             for v in instance.description.modelVariables
             if v.causality == "input" and v.type == "Real"
         ]
-        outputs = [v.name for v in instance.description.modelVariables if v.causality == "output"]
+        outputs = instance.output_names()
         read = instance.reader(outputs)
         if _status(lambda: instance.slave.doStep(0.0, 1e-3)) != 2:
             problems.append("doStep before initialization was not refused with fmi2Discard")
