@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import tempfile
+
 import pytest
 
 from arcosim.build.ssp import BENCH, CONNECTIONS
@@ -32,6 +34,30 @@ def test_run_ssp_applies_the_parameter_set(build_fmus) -> None:
 def test_unknown_parameter_set_is_named(build_fmus) -> None:
     with pytest.raises(UserError, match="no parameter set 'lab'"):
         run_ssp(build_fmus(3) / "ActionReaction.ssp", "lab", stop=0.01)
+
+
+@pytest.mark.parametrize(
+    "parameter_set, stop, h, said",
+    [
+        ("lab", 0.01, 1e-3, "no parameter set"),
+        ("bench", -1.0, 1e-3, "stop time"),
+        ("bench", 0.01, 1.0, "steps"),
+    ],
+)
+def test_a_refused_run_leaves_no_unpacked_ssp_behind(
+    build_fmus, tmp_path, monkeypatch, parameter_set, stop, h, said
+) -> None:
+    ssp = build_fmus(3) / "ActionReaction.ssp"
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    try:
+        run_ssp(ssp, parameter_set, stop=stop, h=h)
+    except UserError as error:
+        assert said in str(error)
+        # checked while the error (and the runner's frame) is alive: the runner removed
+        # the folder itself, not the garbage collector after it
+        assert not list(tmp_path.glob("arcosim_ssp_*"))
+    else:
+        pytest.fail("the run was not refused")
 
 
 def test_arcosim_ssp_command(build_fmus, tmp_path, capsys) -> None:

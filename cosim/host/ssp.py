@@ -135,25 +135,23 @@ def run_ssp(
     ((51,), True)
     """
     system = read_ssp(path)
-    if parameter_set is not None and parameter_set not in system.parameter_sets:
-        known = ", ".join(system.parameter_sets) or "none"
-        raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
-    chosen = system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
-    stop = system.stop if stop is None else stop
-    if not (math.isfinite(stop) and stop > system.start):
-        system.folder.cleanup()
-        raise UserError(
-            f"stop time {stop:g} s: it must be finite and after the start, {system.start:g} s"
-        )
-    steps = round((stop - system.start) / h) if h > 0 and math.isfinite(h) else 0
-    if not 1 <= steps <= MAX_STEPS:
-        system.folder.cleanup()
-        raise UserError(
-            f"step {h:g} s from {system.start:g} to {stop:g} s gives {steps:.3g} steps; "
-            f"a run takes 1 to {MAX_STEPS:,} steps"
-        )
     instances: dict[str, FmuInstance] = {}
     try:
+        if parameter_set is not None and parameter_set not in system.parameter_sets:
+            known = ", ".join(system.parameter_sets) or "none"
+            raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
+        chosen = system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
+        stop = system.stop if stop is None else stop
+        if not (math.isfinite(stop) and stop > system.start):
+            raise UserError(
+                f"stop time {stop:g} s: it must be finite and after the start, {system.start:g} s"
+            )
+        steps = round((stop - system.start) / h) if h > 0 and math.isfinite(h) else 0
+        if not 1 <= steps <= MAX_STEPS:
+            raise UserError(
+                f"step {h:g} s from {system.start:g} to {stop:g} s gives {steps:.3g} steps; "
+                f"a run takes 1 to {MAX_STEPS:,} steps"
+            )
         for name, fmu in system.components.items():
             if not fmu.is_file():
                 raise UserError(f"{path}: component {name}: no file {fmu.name} in the SSP")
