@@ -208,17 +208,9 @@ def reproduce(
                     write_csv(out / name, recording_columns(loaded[label]), force=True)
                 )
     motor = flexible["plant.theta_m_true"]
-    results.scores = [
-        flexible_score(flexible[f"observer.theta_hat[{i}]"], flexible[f"plant.theta[{i}]"], motor)
-        for i in range(1, N_MASSES + 1)
-    ]
+    results.scores = _angle_scores(flexible, motor)
     if estimated is not None:
-        results.whole_scores = [
-            flexible_score(
-                estimated[f"observer.theta_hat[{i}]"], estimated[f"plant.theta[{i}]"], motor
-            )
-            for i in range(1, N_MASSES + 1)
-        ]
+        results.whole_scores = _angle_scores(estimated, motor)
     if estimated is not None:
         results.files.append(_load_experiment(loaded, results, cpr, out / "fig8_load_torque.png"))
     results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean, estimated)
@@ -237,17 +229,22 @@ TRUE_CHAIN = {
 }
 
 
+def _angle_scores(run: Recording, motor: np.ndarray) -> list[float]:
+    """:func:`flexible_score` of every mass's estimated angle in ``run`` against the
+    plant's, over the true motor angle ``motor`` (rad, shape (N,))."""
+    return [
+        flexible_score(run[f"observer.theta_hat[{i}]"], run[f"plant.theta[{i}]"], motor)
+        for i in range(1, N_MASSES + 1)
+    ]
+
+
 def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, figure: Path) -> Path:
     """Experiment 5's scores (into ``results``) and its figure."""
     estimates = {}
     for label, rec in runs.items():
         estimates[label] = rec["observer.tau_load_hat"]
         results.load[label] = score_profile(rec.time, estimates[label], LOAD_PROFILE).as_dict()
-        motor = rec["plant.theta_m_true"]
-        results.load_angles[label] = [
-            flexible_score(rec[f"observer.theta_hat[{i}]"], rec[f"plant.theta[{i}]"], motor)
-            for i in range(1, N_MASSES + 1)
-        ]
+        results.load_angles[label] = _angle_scores(rec, rec["plant.theta_m_true"])
     # the same run and chain without the torque state: what the unmodelled load costs
     rec = runs["true chain"]
     settings = ObserverSettings(
@@ -344,9 +341,7 @@ def _figures(
 
 def _whole_chain_figure(out: Path, identification: Recording, results: Results) -> Path:
     """Fig. 7: experiment 4's parameters against the truth, and its model's response."""
-    true = {}
-    for i in range(1, N_MASSES + 1):
-        true.update({f"J[{i}]": defaults.J[i - 1], f"k[{i}]": defaults.K, f"B[{i}]": defaults.B})
+    true = dict(TRUE_CHAIN)
     lines = IDENTIFICATION_LINES
     measured = measured_response(
         identification.time,

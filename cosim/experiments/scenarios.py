@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -148,6 +149,10 @@ class LoadProfile:
 
     def size(self) -> float:
         """The step (N·m): ``fraction`` of the bench drive's peak torque over the run."""
+        return self._size
+
+    @functools.cached_property
+    def _size(self) -> float:  # the whole run's multi-sine: computed once per profile
         t = np.arange(round(self.duration / STEP)) * STEP
         return self.fraction * defaults.K_T * float(np.max(np.abs(self.current(t))))
 
