@@ -142,7 +142,7 @@ def remove_exit_bug(data: bytes) -> bytes:
     if functions[-1] != address:
         raise ValueError(
             f"{UNLOAD_SYMBOL} is not the last .fini_array entry; this pythonfmu binary "
-            "has a layout cosim/exit_fix.py does not know (pythonfmu 0.7 is supported)"
+            "has a layout arcosim.build.exit_fix does not know (pythonfmu 0.7 is supported)"
         )
     elf = _parse(data)
     at, size = elf.dynamic[_DT_FINI_ARRAYSZ]

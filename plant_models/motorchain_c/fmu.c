@@ -3,7 +3,7 @@
  * Same variables, value references, checks, messages, timing contract and trace
  * file as the Python plant (plant_models/motorchain/fmu.py with fmu_src/fmukit),
  * which is the reference its tests compare with. plant_variables.h is generated at
- * build time from that class's variable list (cosim/cplant.py): names, types,
+ * build time from that class's variable list (cosim/build/cplant.py): names, types,
  * causalities, start values, value-reference macros (VR_<name>, the first element
  * for arrays) and the GUID; chain_size.h fixes n.
  *
@@ -25,12 +25,8 @@
 
 #define TEXT 2048
 #define PATH 1024
-/* The numbers the FMU computes in (fmukit/checks.py, the same for every FMU): the
- * largest magnitude of a Real parameter or input (SI units), the smallest step (s),
- * the fastest mode (rad/s) or decay (1/s) of the chain. */
-#define LARGEST 1e15
-#define SMALLEST_STEP 1e-9
-#define FASTEST_RATE 1e6
+/* LARGEST, SMALLEST_STEP and FASTEST_RATE come with plant_variables.h, from
+ * fmukit/checks.py (the same for every FMU). */
 
 /* Everything an FMU state holds (copied whole by get/set/serialize). */
 typedef struct {
@@ -758,7 +754,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 /* fmi2Terminated: true exactly when the parameters were refused at
  * exitInitializationMode (every doStep is refused until fmi2Reset or a restored state);
  * a refused step leaves the state unchanged and the master may retry: false. The
- * Python FMUs answer the same (cosim/native/fmu_trampoline.c). */
+ * Python FMUs answer the same (cosim/build/native/fmu_trampoline.c). */
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     Plant *p = c;
     if (s != fmi2Terminated || !value) return fmi2Discard;

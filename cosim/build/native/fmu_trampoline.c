@@ -44,7 +44,7 @@
  *   - serialized FMU states in an envelope (magic, format version, identity, n, length,
  *     CRC-32) checked before the core sees any byte.
  *
- * Compiled per build by cosim/portable.py with
+ * Compiled per build by cosim/build/portable.py with
  *   -DARCOSIM_IDENTIFIER="..." -DARCOSIM_GUID="{...}" -DARCOSIM_BUILD="<package>"
  *   -DARCOSIM_N=<n> -DARCOSIM_CORE="<core file name>"
  * Needs POSIX and glibc's dladdr / dl_iterate_phdr (Linux).
@@ -174,9 +174,7 @@ typedef struct {
     char tried[TEXT];       /* what was tried, for the message when nothing is found */
     char seen[64][PATH_MAX]; /* libraries already tried (by real path) */
     int nseen;
-    void *handle;           /* the libpython opened here, or NULL */
-    char home[PATH_MAX];
-    char library[PATH_MAX];
+    char home[PATH_MAX];    /* the home of the libpython last opened */
 } Search;
 
 static int already_tried(Search *s, const char *real) {
@@ -202,13 +200,10 @@ static int try_library(Search *s, const char *path) {
                path, minor);
         return 0;
     }
-    void *handle = dlopen(real, RTLD_NOW | RTLD_GLOBAL);
-    if (!handle) {
+    if (!dlopen(real, RTLD_NOW | RTLD_GLOBAL)) { /* kept open: the interpreter runs in it */
         append(s->tried, sizeof s->tried, "\n  %s: %s", path, dlerror());
         return 0;
     }
-    s->handle = handle;
-    snprintf(s->library, sizeof s->library, "%s", real);
     return 1;
 }
 
