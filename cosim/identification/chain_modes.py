@@ -22,13 +22,20 @@ import numpy as np
 from arcosim.fmu.flexchain.chain import spring_matrix
 
 
-def driving_point_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """Clamped frequencies p (rad/s) and residues r (N·m/rad·s⁻²) of the chain, shape (n,)."""
+def clamped_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The chain's modes with the motor held still: squared frequencies p² (rad²/s²,
+    shape (n,), ascending) and mass-normalized shapes φ (shape (n, n); rows: masses,
+    columns: modes) of the inertias J (kg·m²) and stiffnesses k (N·m/rad)."""
     root = np.sqrt(np.asarray(J, dtype=float))
     K = np.array(spring_matrix([float(x) for x in k]))[1:, 1:]  # motor held still
     eigenvalues, shapes = np.linalg.eigh(K / root[:, None] / root[None, :])
-    first = shapes[0] / root[0]  # φ_{1i}
-    return np.sqrt(eigenvalues), float(k[0]) ** 2 * first**2
+    return eigenvalues, shapes / root[:, None]
+
+
+def driving_point_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Clamped frequencies p (rad/s) and residues r (N·m/rad·s⁻²) of the chain, shape (n,)."""
+    eigenvalues, phi = clamped_modes(J, k)
+    return np.sqrt(eigenvalues), float(k[0]) ** 2 * phi[0] ** 2  # φ_{1i}
 
 
 def chain_from_modes(p: Sequence[float], r: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:

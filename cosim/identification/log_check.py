@@ -23,9 +23,14 @@ from arcosim.identification.encoder_fit import (
     encoder_record,
 )
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.modal_start import Detected, detect_modes, excitation_lines
+from arcosim.identification.modal_start import (
+    Detected,
+    detect_modes,
+    excitation_lines,
+    search_band,
+)
 from arcosim.identification.output_error import motor_record, smooth_velocity
-from arcosim.identification.whole_chain import friction_start, modal_damping, without_friction
+from arcosim.identification.whole_chain import MAX_AUTO_MASSES, friction_cleaned
 
 #: Largest relative spread of the sample step the fits accept.
 STEP_TOLERANCE = 1e-6
@@ -42,8 +47,6 @@ MODE_T = 30.0
 WEAK_T = 2.0
 #: Least encoder range (counts).
 LEAST_RANGE_COUNTS = 50
-#: Largest number of masses the mode search looks for.
-LARGEST = 8
 
 
 @dataclass
@@ -210,7 +213,7 @@ def check_log(
                 "it there; the fit's friction model is then approximate: J_i, k_i 1–2 % "
                 "off at 18 %): raise the current, use fewer lines, or add a slow speed offset"
             )
-    report.band = min(3.0 * g_dist, 0.3 / h)
+    report.band = search_band(g_dist, h)
     report.lines = [float(w) for w in excitation_lines(np.asarray(i_a, dtype=float), h)]
     if report.lines and max(report.lines) < 0.5 * report.band:
         report.problems.append(
@@ -267,15 +270,12 @@ def _modes(time, i_a, omega_m, theta, k_t, J_m, encoder_cpr, g_dist) -> Detected
     estimated from the modes, taken out of τ̂, and the modes read again)."""
     actuator = Actuator(J_m, k_t)
     record = motor_record(time, i_a, omega_m, theta, actuator, g_dist)
-    detected = detect_modes(record, LARGEST)
+    detected = detect_modes(record, MAX_AUTO_MASSES)
     if detected.n and encoder_cpr > 0:
         encoder = encoder_record(
             time, i_a, theta, actuator, encoder_cpr, friction_given=False, g_dist=g_dist
         )
-        modes = detected.modes()
-        J0, k0 = modes.chain()
-        D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
-        detected = detect_modes(without_friction(record, encoder, D_m, f_c), LARGEST)
+        detected = friction_cleaned(record, encoder, detected.modes(), MAX_AUTO_MASSES)[3]
     return detected
 
 

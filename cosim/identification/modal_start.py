@@ -111,13 +111,6 @@ DAMPING_TOLERANCE = 0.01
 STABLE_ORDERS = 4
 #: A mode's residue must exceed this many of its standard errors to count as excited.
 RESIDUE_T = 4.0
-#: With ``lines`` given to :func:`detect_modes`, a pole this lightly damped within
-#: :data:`LINE_TOLERANCE` (relative, or a quarter of the record's bin 2π/T) of an
-#: excitation line is taken for the line (a multi-sine is itself the output of undamped
-#: oscillators). The whole-chain fit does not ask for it: a lightly damped mode may sit
-#: on a line (the bench's first mode does), and the information criterion decides.
-LINE_DAMPING = 0.003
-LINE_TOLERANCE = 0.005
 #: An excitation line stands this many times above the current spectrum's median.
 LINE_PROMINENCE = 30.0
 
@@ -132,7 +125,6 @@ class Detected:
         residue: their residues (N·m/rad·s⁻²).
         t_value: residue / its standard error, per mode that counts.
         weak: modes found stable but too weakly excited: (frequency, t value) pairs.
-        lines: stable poles taken for excitation lines (rad/s).
         orders: per mode that counts, the number of model orders it was found at.
         band: highest frequency sought (rad/s).
         singular_values: of the subspace step, relative to the first.
@@ -143,7 +135,6 @@ class Detected:
     residue: np.ndarray
     t_value: np.ndarray
     weak: list[tuple[float, float]]
-    lines: list[float]
     orders: np.ndarray
     band: float
     singular_values: np.ndarray
@@ -179,7 +170,7 @@ def excitation_lines(current: np.ndarray, h: float) -> np.ndarray:
     return frequency[j] + np.clip(shift, -0.5, 0.5) * (frequency[1] - frequency[0])
 
 
-def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = None) -> Detected:
+def detect_modes(record: MotorRecord, largest: int) -> Detected:
     """The clamped modes a record shows, and which of them it excites enough.
 
     One PO-MOESP decomposition (:func:`moesp`) gives models of every even order
@@ -189,8 +180,7 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
     :data:`STABLE_ORDERS` orders or more. The residues of all such modes are then
     fitted together by least squares (modes held); a mode whose residue is below
     :data:`RESIDUE_T` standard errors (Newey–West) is too weakly excited to count.
-    A stable pole as lightly damped as :data:`LINE_DAMPING` at one of ``lines`` (the
-    excitation's, :func:`excitation_lines`) is that line. Nothing here depends on the
+    Nothing here depends on the
     spacing of the modes or the size of their residues.
 
     Raises:
@@ -216,21 +206,10 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
         keep = (frequency < band) & (damping > DAMPING_RANGE[0]) & (damping < DAMPING_RANGE[1])
         per_order.append(np.column_stack([frequency[keep], damping[keep]]))
     clusters = _stable_clusters(per_order)
-    taken: list[float] = []
-    if lines is not None and len(lines):
-        bin_width = 2.0 * np.pi / max(record.duration, 1e-300)
-        kept = []
-        for c in clusters:
-            distance = float(np.min(np.abs(np.asarray(lines) - c[0])))
-            if abs(c[1]) < LINE_DAMPING and distance < max(LINE_TOLERANCE * c[0], bin_width / 4):
-                taken.append(c[0])
-            else:
-                kept.append(c)
-        clusters = kept
     if not clusters:
         empty = np.empty(0)
         return Detected(
-            empty, empty, empty, empty, [], taken, np.empty(0, int), band, singular / singular[0]
+            empty, empty, empty, empty, [], np.empty(0, int), band, singular / singular[0]
         )
     frequency = np.array([c[0] for c in clusters])
     damping = np.array([c[1] for c in clusters])
@@ -258,7 +237,6 @@ def detect_modes(record: MotorRecord, largest: int, lines: np.ndarray | None = N
         residue[counts],
         t_value[counts],
         weak,
-        taken,
         orders[counts],
         band,
         singular / singular[0],
@@ -315,10 +293,15 @@ def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, in
     return merged
 
 
+def search_band(g_dist: float, h: float) -> float:
+    """Highest clamped frequency sought (rad/s): :data:`BAND_PER_G` · ``g_dist`` (rad/s),
+    at most 0.3/``h`` (the band the sample step ``h``, s, leaves)."""
+    return min(BAND_PER_G * g_dist, 0.3 / h)
+
+
 def _band(record: MotorRecord) -> float:
-    """Highest clamped frequency sought (rad/s): :data:`BAND_PER_G` · g_dist, at most
-    0.3/h (the band the sample rate leaves)."""
-    return min(BAND_PER_G * record.g_dist, 0.3 / record.h)
+    """:func:`search_band` of the record."""
+    return search_band(record.g_dist, record.h)
 
 
 def chain_of(n: int) -> str:

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy import optimize
 
-from arcosim.fmu.flexchain.chain import spring_matrix
 from arcosim.identification.blas import single_threaded
+from arcosim.identification.chain_modes import clamped_modes
 from arcosim.identification.encoder_fit import EncoderRecord, refine, with_friction
 from arcosim.identification.encoder_fit import opening as encoder_opening
 from arcosim.identification.errors import IdentificationError
@@ -191,27 +191,23 @@ def identify_whole_chain(
     auto = masses == "auto"
     n_asked = None if auto else _masses(masses)
     check_excited(record)
-    lines = None  # excitation lines are not rejected: a lightly damped mode may sit on one
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
-    detected = detect_modes(record, largest, lines)
+    detected = detect_modes(record, largest)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
     if unknown and detected.n:
         # τ̂ was computed without friction: estimate it from the first modes, take it
         # out of τ̂, and read the modes again
         modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
-        J0, k0 = modes.chain()
-        D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
-        record = without_friction(raw, encoder, D_m, f_c)
+        record, D_m, f_c, detected = friction_cleaned(raw, encoder, modes, largest)
         encoder = with_friction(encoder, D_m, f_c)
-        detected = detect_modes(record, largest, lines)
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
         # the fit's friction is far better than the start's: read the modes once more
         # with it, and fit again if they changed
         D_m, f_c = result.extra["D_m"], result.extra["f_c"]
         cleaned = without_friction(raw, encoder, D_m, f_c)
-        again = detect_modes(cleaned, largest, lines)
+        again = detect_modes(cleaned, largest)
         if not _same_modes(again, detected):
             record = cleaned
             encoder = with_friction(encoder, D_m, f_c)
@@ -221,7 +217,6 @@ def identify_whole_chain(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
         weak_modes=[{"rad_s": w, "t": t} for w, t in detected.weak],
-        excitation_lines_taken=[float(w) for w in detected.lines],
         assumptions=assumptions(encoder),
         warnings=[
             f"the mode at {w:.1f} rad/s is weakly determined (residue t = {t:.0f} < "
@@ -343,15 +338,26 @@ def modal_damping(J: np.ndarray, k: np.ndarray, modes: Modes) -> np.ndarray:
     order in the damping: 2 ζ_i p_i = Σ_j B_j (φ_ji − φ_(j−1)i)², φ the mass-normalized
     clamped mode shapes, φ_0 = 0), shape (n,); a floor of 1e-3 of their mean."""
     n = len(J)
-    root = np.sqrt(np.asarray(J, dtype=float))
-    K = np.array(spring_matrix([float(x) for x in k]))[1:, 1:]
-    eigenvalues, shapes = np.linalg.eigh(K / root[:, None] / root[None, :])
-    phi = shapes / root[:, None]  # mass-normalized, rows: masses
+    eigenvalues, phi = clamped_modes(J, k)
     stretch = np.diff(np.vstack([np.zeros(n), phi]), axis=0) ** 2  # (spring j, mode i)
     target = 2.0 * np.clip(modes.damping, 1e-4, 0.2) * np.sqrt(eigenvalues)
     B, _ = optimize.nnls(stretch.T, target)
     floor = 1e-3 * max(float(np.mean(B)), 1e-12)
     return np.maximum(B, floor)
+
+
+def friction_cleaned(
+    record: MotorRecord, encoder: EncoderRecord, modes: Modes, largest: int
+) -> tuple[MotorRecord, float, float, Detected]:
+    """For a record whose τ̂_reac was computed without friction: the friction's start
+    (:func:`friction_start`) from the chain of ``modes``, the record with it taken out
+    of τ̂ (:func:`without_friction`), ``D_m`` (N·m·s/rad), ``f_c`` (N·m), and the modes
+    that record shows (:func:`~arcosim.identification.modal_start.detect_modes`, up to
+    ``largest`` masses)."""
+    J0, k0 = modes.chain()
+    D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
+    cleaned = without_friction(record, encoder, D_m, f_c)
+    return cleaned, D_m, f_c, detect_modes(cleaned, largest)
 
 
 def friction_start(
@@ -422,9 +428,6 @@ def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str
     if detected.weak:
         weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
         text += f"; seen but too weakly excited: {weak}"
-    if detected.lines:
-        lines = ", ".join(f"{w:.1f}" for w in detected.lines)
-        text += f"; poles at excitation lines ({lines} rad/s) were taken for the lines"
     return text + (
         ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
         "lines on both sides of each mode, up to the band; a longer record; a finer "
