@@ -93,7 +93,7 @@ from arcosim.identification.output_error import (
     motor_record,
     uniform_chain,
 )
-from arcosim.logs import DriveLog, parse_scales, read_log, write_csv
+from arcosim.logs import DriveLog, parse_scales, read_log, read_text_file, write_csv
 from arcosim.outputs import check_output, write_text
 
 #: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
@@ -177,7 +177,7 @@ def _execute(args: argparse.Namespace) -> int:
         return _whole_chain(args, log, masses)
     if args.method == "load-torque":
         chain = read_chain(args.chain) if args.chain else {}
-        n = check_masses(int(chain.pop("masses")) if "masses" in chain else _masses(args.masses))
+        n = int(chain.pop("masses")) if "masses" in chain else _masses(args.masses)  # checked
         return _load_torque(args, log, n, chain)
     if args.chain:
         raise UserError("--chain is for --method load-torque")
@@ -387,8 +387,6 @@ def read_chain(path: Path) -> dict[str, float]:
         When the file is not UTF-8 JSON, or a value is missing, not a finite number,
         or ``masses`` not a supported number of masses.
     """
-    from arcosim.logs import read_text_file
-
     try:
         data = json.loads(read_text_file(path, "chain"))
     except ValueError as error:

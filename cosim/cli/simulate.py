@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.builder import fmu_variables
-from arcosim.build.recipes import MAX_MASSES, MIN_MASSES, check_masses
+from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.cli.options import (
     MAX_TIME,
     add_fmus_option,
@@ -101,7 +101,7 @@ def _execute(args: argparse.Namespace) -> int:
     if args.duration is not None:
         scenario = dataclasses.replace(scenario, duration=args.duration)
     check_steps("--step", scenario.duration, args.step)
-    n = check_masses(args.masses)
+    n = args.masses  # checked by its option type
     if args.out:
         check_output(args.out, force=args.force, inputs=fmu_inputs(args.fmus) if args.fmus else ())
     folder = fmu_folder(args, n)

@@ -68,6 +68,6 @@ def _execute(args: argparse.Namespace) -> int:
     failed = sum(1 for r in rows if r["error"])
     print(
         f"{len(rows)} runs ({failed} failed) in {time.perf_counter() - start:.1f} s; "
-        f"wrote {results} and {out / 'summary.md'}"
+        f"wrote {results} and {out / SUMMARY}"
     )
     return 0

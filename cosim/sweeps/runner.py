@@ -209,7 +209,7 @@ def sweep(
             )
         pending = [(i, v) for i, v in enumerate(runs) if i not in done]
         blobs = {name: path.read_bytes() for name, path in fmus.items()}
-        if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
+        if results.exists() and _last_byte(results) not in (b"", b"\n"):
             with open(results, "a", encoding="utf-8") as f:
                 f.write("\n")  # an interrupted write: keep its partial line apart
         with open(results, "a", newline="", encoding="utf-8") as f:
@@ -250,6 +250,15 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _last_byte(path: Path) -> bytes:
+    """The file's last byte (``b""`` for an empty file), without reading the rest."""
+    with open(path, "rb") as f:
+        if f.seek(0, os.SEEK_END) == 0:
+            return b""
+        f.seek(-1, os.SEEK_END)
+        return f.read(1)
 
 
 def _finished_runs(results: Path, columns: Sequence[str]) -> set[int]:
