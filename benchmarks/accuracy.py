@@ -44,6 +44,7 @@ import numpy as np
 from arcosim.errors import UserError
 from arcosim.experiments import excitation
 from arcosim.experiments.metrics import flexible_score, percent_error
+from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.observer import (
@@ -222,11 +223,16 @@ def shortest_for_b(rows: Sequence[dict]) -> float | None:
 
 def markdown(results: dict[str, CaseResult], cases: Sequence[Case]) -> str:
     """The method × case table."""
-    lines = [
-        "| method | case | k error % (mean) | k spread % | B error % (mean) | B spread % "
-        "| state error per mass (mean over seeds) |",
-        "|---|---|---|---|---|---|---|",
+    header = [
+        "method",
+        "case",
+        "k error % (mean)",
+        "k spread %",
+        "B error % (mean)",
+        "B spread %",
+        "state error per mass (mean over seeds)",
     ]
+    rows = []
     methods = [
         "eq. 21 (literal)",
         "eq. 21 + kappa",
@@ -257,8 +263,8 @@ def markdown(results: dict[str, CaseResult], cases: Sequence[Case]) -> str:
                 cells.append(" / ".join(_state_cell(x) for x in per_mass))
             else:
                 cells.append("")
-            lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+            rows.append(cells)
+    return markdown_table(header, rows) + "\n"
 
 
 def _state_cell(x: float) -> str:

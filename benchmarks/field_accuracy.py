@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.drive import identify_drive
@@ -250,21 +251,34 @@ def summary(results: list[dict], row: Row) -> dict:
 
 def markdown(summaries: dict[str, dict]) -> str:
     """The table."""
-    lines = [
-        "| row | n right | max abs J_i err % | max abs k_i err % | B_i within 2σ "
-        "| J_i, k_i within 2σ | B_i err % (median abs) | s wall (median / max) | s CPU (median) |",
-        "|---|---|---|---|---|---|---|---|---|",
+    header = [
+        "row",
+        "n right",
+        "max abs J_i err %",
+        "max abs k_i err %",
+        "B_i within 2σ",
+        "J_i, k_i within 2σ",
+        "B_i err % (median abs)",
+        "s wall (median / max)",
+        "s CPU (median)",
     ]
+    rows = []
     for name, s in summaries.items():
         b, j, k = s["B_inside_2_sigma"], s["J_inside_2_sigma"], s["k_inside_2_sigma"]
-        lines.append(
-            f"| {name} | {s['n_right']} of {s['seeds']} | {s['max_abs_J_error_percent']:.2f} "
-            f"| {s['max_abs_k_error_percent']:.2f} | {b[0]} of {b[1]} "
-            f"| {j[0] + k[0]} of {j[1] + k[1]} | {s['median_abs_B_error_percent']:.1f} "
-            f"| {s['seconds_median']:.1f} / {s['seconds_max']:.1f} "
-            f"| {s['cpu_seconds_median']:.1f} |"
+        rows.append(
+            [
+                name,
+                f"{s['n_right']} of {s['seeds']}",
+                f"{s['max_abs_J_error_percent']:.2f}",
+                f"{s['max_abs_k_error_percent']:.2f}",
+                f"{b[0]} of {b[1]}",
+                f"{j[0] + k[0]} of {j[1] + k[1]}",
+                f"{s['median_abs_B_error_percent']:.1f}",
+                f"{s['seconds_median']:.1f} / {s['seconds_max']:.1f}",
+                f"{s['cpu_seconds_median']:.1f}",
+            ]
         )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, rows) + "\n"
 
 
 #: Speed rows: (label, row, record length s).
@@ -302,16 +316,18 @@ def speed(repeats: int = 3, quick: bool = False) -> list[dict]:
 
 def speed_markdown(rows: list[dict]) -> str:
     """The speed table."""
-    lines = [
-        "| what | n right | s wall (median) | s CPU | load average |",
-        "|---|---|---|---|---|",
+    header = ["what", "n right", "s wall (median)", "s CPU", "load average"]
+    cells = [
+        [
+            r["what"],
+            f"{r['n_right']} of {r['runs']}",
+            f"{r['seconds']:.2f}",
+            f"{r['cpu_seconds']:.2f}",
+            f"{r['load_average']:.1f}",
+        ]
+        for r in rows
     ]
-    for r in rows:
-        lines.append(
-            f"| {r['what']} | {r['n_right']} of {r['runs']} | {r['seconds']:.2f} "
-            f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
-        )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, cells) + "\n"
 
 
 def score_rows(
