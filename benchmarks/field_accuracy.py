@@ -42,15 +42,6 @@ AMPLITUDE = 3.0
 DURATION = 20.0
 
 
-def _five_mass(top_share: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The chain whose clamped modes are 14.3, 42.3, 70.0, 86.8, 106.6 rad/s, residue
-    shares r_i/p_i² of k_1 = 0.4 N·m/rad: 0.2, 0.1, 0.05, 0.03 and ``top_share``."""
-    p = np.array([14.3, 42.3, 70.0, 86.8, 106.6])
-    r = p**2 * np.array([0.2, 0.1, 0.05, 0.03, top_share])
-    J, k = chain_from_modes(p, r)
-    return tuple(float(x) for x in J), tuple(float(x) for x in k)
-
-
 def _modal_chain(p: Sequence[float], shares: Sequence[float]):
     """The chain with clamped modes ``p`` (rad/s) and residue shares r_i/p_i² (N·m/rad)."""
     p = np.asarray(p, dtype=float)
@@ -111,7 +102,8 @@ def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
     return field_sim.Drive(J=tuple(J), k=tuple(k), B=_damped(J, k, zeta), **base)
 
 
-_FIVE = _five_mass(0.005)
+#: Clamped modes 14.3 … 106.6 rad/s; residue shares r_i/p_i² sum to k_1 = 0.385 N·m/rad.
+_FIVE = _modal_chain((14.3, 42.3, 70.0, 86.8, 106.6), (0.2, 0.1, 0.05, 0.03, 0.005))
 _THREE = ((3e-4, 5e-4, 4e-4), (0.25, 0.4, 0.15))
 _CLOSE = _modal_chain((20.0, 40.0, 42.0), (0.3, 0.1, 0.1))  # two modes 5 % apart
 _BELT = ((6e-4, 3e-4), (20.0, 10.0))
