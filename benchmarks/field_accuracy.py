@@ -85,15 +85,14 @@ class Row:
 
     def log(self, seed: int, duration: float = DURATION) -> field_sim.Log:
         """Simulate the row's record (``duration`` s) for ``seed``."""
-        drive = replace(self.drive)
         if self.speed_loop is None:
             current = field_sim.multisine(self.lines, self.amplitude, seed=seed)
-            return field_sim.simulate(drive, self.h, duration, current=current, seed=seed)
+            return field_sim.simulate(self.drive, self.h, duration, current=current, seed=seed)
         kp, ki = self.speed_loop
         # speed lines ∝ frequency: about equal torque per line, as an open-loop current
         reference = field_sim.multisine(self.lines, self.amplitude, seed=seed, slope=1.0)
         loop = field_sim.SpeedLoop(kp, ki, reference, limit=10.0)
-        return field_sim.simulate(drive, self.h, duration, speed_loop=loop, seed=seed)
+        return field_sim.simulate(self.drive, self.h, duration, speed_loop=loop, seed=seed)
 
 
 def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
