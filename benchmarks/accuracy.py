@@ -11,8 +11,8 @@ then run again on the recorded logs, offline, in every configuration (the same
 ``flexchain`` code the FMU bundles), so one pair of runs scores every method:
 
 * identification: literal eq. 21 and eq. 21 with κ (rigid maneuver, mode 1) and
-  output error (broadband, ``cosim/output_error.py``); k̂ and B̂ against the truth
-  (the mean of the springs for the non-uniform case);
+  output error (broadband, ``cosim/identification/output_error.py``); k̂ and B̂
+  against the truth (the mean of the springs for the non-uniform case);
 * state estimation on the broadband run: the paper's recursion (eq. 22–26), the
   model-based observer, and the naive ``θ̂_i = θ_m``; score per mass
   rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (docs/method.md). The estimators use the output-error
@@ -23,7 +23,7 @@ The bench also gets the honesty check of B's standard error (over ``--b-seeds`` 
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
 within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accuracy.py``:
 three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
-Last, the load torque rows (``cosim/load_accuracy.py``: the two- and five-mass chains,
+Last, the load torque rows (``benchmarks/load_accuracy.py``: the two- and five-mass chains,
 the load on the last and on a middle mass, a model with springs 5 % off, the same
 seeds; and the bandwidth's trade-off on the bench).
 """
@@ -44,6 +44,7 @@ import numpy as np
 from arcosim.errors import UserError
 from arcosim.experiments import excitation
 from arcosim.experiments.metrics import flexible_score, percent_error
+from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.observer import (
@@ -222,11 +223,16 @@ def shortest_for_b(rows: Sequence[dict]) -> float | None:
 
 def markdown(results: dict[str, CaseResult], cases: Sequence[Case]) -> str:
     """The method × case table."""
-    lines = [
-        "| method | case | k error % (mean) | k spread % | B error % (mean) | B spread % "
-        "| state error per mass (mean over seeds) |",
-        "|---|---|---|---|---|---|---|",
+    header = [
+        "method",
+        "case",
+        "k error % (mean)",
+        "k spread %",
+        "B error % (mean)",
+        "B spread %",
+        "state error per mass (mean over seeds)",
     ]
+    rows = []
     methods = [
         "eq. 21 (literal)",
         "eq. 21 + kappa",
@@ -257,8 +263,8 @@ def markdown(results: dict[str, CaseResult], cases: Sequence[Case]) -> str:
                 cells.append(" / ".join(_state_cell(x) for x in per_mass))
             else:
                 cells.append("")
-            lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+            rows.append(cells)
+    return markdown_table(header, rows) + "\n"
 
 
 def _state_cell(x: float) -> str:

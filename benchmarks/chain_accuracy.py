@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from arcosim.experiments.metrics import percent_error
+from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import SCENARIOS
 from arcosim.identification.encoder_fit import encoder_record
 from arcosim.identification.output_error import motor_record
@@ -75,11 +76,17 @@ def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None
 
 def markdown(rows: dict[str, dict]) -> str:
     """The whole-chain table."""
-    lines = [
-        "| chain | n right | max abs J_i error % | max abs k_i error % | B_i within 2σ "
-        "| worst B_i within 2σ | B_i error % (median abs) | seconds (median / max) |",
-        "|---|---|---|---|---|---|---|---|",
+    header = [
+        "chain",
+        "n right",
+        "max abs J_i error %",
+        "max abs k_i error %",
+        "B_i within 2σ",
+        "worst B_i within 2σ",
+        "B_i error % (median abs)",
+        "seconds (median / max)",
     ]
+    cells = []
     for name, r in rows.items():
         worst = {
             key: f"{np.max(np.abs(r[key])):.2f}" if r[key] else "—"
@@ -87,10 +94,16 @@ def markdown(rows: dict[str, dict]) -> str:
         }
         B_median = f"{np.median(np.abs(r['B_error_percent'])):.0f}" if r["B_error_percent"] else "—"
         inside, count = r["B_inside_2_sigma"], r["B_count"]
-        lines.append(
-            f"| {name} | {r['right_n']} of {r['seeds']} | {worst['J_error_percent']} "
-            f"| {worst['k_error_percent']} | {sum(inside)} of {count * len(inside)} "
-            f"| {min(inside, default=0)} of {count} "
-            f"| {B_median} | {np.median(r['seconds']):.1f} / {np.max(r['seconds']):.1f} |"
+        cells.append(
+            [
+                name,
+                f"{r['right_n']} of {r['seeds']}",
+                worst["J_error_percent"],
+                worst["k_error_percent"],
+                f"{sum(inside)} of {count * len(inside)}",
+                f"{min(inside, default=0)} of {count}",
+                B_median,
+                f"{np.median(r['seconds']):.1f} / {np.max(r['seconds']):.1f}",
+            ]
         )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, cells) + "\n"

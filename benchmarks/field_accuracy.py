@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.drive import identify_drive
@@ -39,15 +40,6 @@ J_M, K_T, D_M, F_C = 2.09e-5, 0.0406, 2e-5, 2e-3
 LINES = np.geomspace(3.0, 150.0, 40)
 AMPLITUDE = 3.0
 DURATION = 20.0
-
-
-def _five_mass(top_share: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The chain whose clamped modes are 14.3, 42.3, 70.0, 86.8, 106.6 rad/s, residue
-    shares r_i/p_i² of k_1 = 0.4 N·m/rad: 0.2, 0.1, 0.05, 0.03 and ``top_share``."""
-    p = np.array([14.3, 42.3, 70.0, 86.8, 106.6])
-    r = p**2 * np.array([0.2, 0.1, 0.05, 0.03, top_share])
-    J, k = chain_from_modes(p, r)
-    return tuple(float(x) for x in J), tuple(float(x) for x in k)
 
 
 def _modal_chain(p: Sequence[float], shares: Sequence[float]):
@@ -93,15 +85,14 @@ class Row:
 
     def log(self, seed: int, duration: float = DURATION) -> field_sim.Log:
         """Simulate the row's record (``duration`` s) for ``seed``."""
-        drive = replace(self.drive)
         if self.speed_loop is None:
             current = field_sim.multisine(self.lines, self.amplitude, seed=seed)
-            return field_sim.simulate(drive, self.h, duration, current=current, seed=seed)
+            return field_sim.simulate(self.drive, self.h, duration, current=current, seed=seed)
         kp, ki = self.speed_loop
         # speed lines ∝ frequency: about equal torque per line, as an open-loop current
         reference = field_sim.multisine(self.lines, self.amplitude, seed=seed, slope=1.0)
         loop = field_sim.SpeedLoop(kp, ki, reference, limit=10.0)
-        return field_sim.simulate(drive, self.h, duration, speed_loop=loop, seed=seed)
+        return field_sim.simulate(self.drive, self.h, duration, speed_loop=loop, seed=seed)
 
 
 def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
@@ -110,7 +101,8 @@ def _drive(J, k, zeta=0.002, **kw) -> field_sim.Drive:
     return field_sim.Drive(J=tuple(J), k=tuple(k), B=_damped(J, k, zeta), **base)
 
 
-_FIVE = _five_mass(0.005)
+#: Clamped modes 14.3 … 106.6 rad/s; residue shares r_i/p_i² sum to k_1 = 0.385 N·m/rad.
+_FIVE = _modal_chain((14.3, 42.3, 70.0, 86.8, 106.6), (0.2, 0.1, 0.05, 0.03, 0.005))
 _THREE = ((3e-4, 5e-4, 4e-4), (0.25, 0.4, 0.15))
 _CLOSE = _modal_chain((20.0, 40.0, 42.0), (0.3, 0.1, 0.1))  # two modes 5 % apart
 _BELT = ((6e-4, 3e-4), (20.0, 10.0))
@@ -250,21 +242,34 @@ def summary(results: list[dict], row: Row) -> dict:
 
 def markdown(summaries: dict[str, dict]) -> str:
     """The table."""
-    lines = [
-        "| row | n right | max abs J_i err % | max abs k_i err % | B_i within 2σ "
-        "| J_i, k_i within 2σ | B_i err % (median abs) | s wall (median / max) | s CPU (median) |",
-        "|---|---|---|---|---|---|---|---|---|",
+    header = [
+        "row",
+        "n right",
+        "max abs J_i err %",
+        "max abs k_i err %",
+        "B_i within 2σ",
+        "J_i, k_i within 2σ",
+        "B_i err % (median abs)",
+        "s wall (median / max)",
+        "s CPU (median)",
     ]
+    rows = []
     for name, s in summaries.items():
         b, j, k = s["B_inside_2_sigma"], s["J_inside_2_sigma"], s["k_inside_2_sigma"]
-        lines.append(
-            f"| {name} | {s['n_right']} of {s['seeds']} | {s['max_abs_J_error_percent']:.2f} "
-            f"| {s['max_abs_k_error_percent']:.2f} | {b[0]} of {b[1]} "
-            f"| {j[0] + k[0]} of {j[1] + k[1]} | {s['median_abs_B_error_percent']:.1f} "
-            f"| {s['seconds_median']:.1f} / {s['seconds_max']:.1f} "
-            f"| {s['cpu_seconds_median']:.1f} |"
+        rows.append(
+            [
+                name,
+                f"{s['n_right']} of {s['seeds']}",
+                f"{s['max_abs_J_error_percent']:.2f}",
+                f"{s['max_abs_k_error_percent']:.2f}",
+                f"{b[0]} of {b[1]}",
+                f"{j[0] + k[0]} of {j[1] + k[1]}",
+                f"{s['median_abs_B_error_percent']:.1f}",
+                f"{s['seconds_median']:.1f} / {s['seconds_max']:.1f}",
+                f"{s['cpu_seconds_median']:.1f}",
+            ]
         )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, rows) + "\n"
 
 
 #: Speed rows: (label, row, record length s).
@@ -302,16 +307,18 @@ def speed(repeats: int = 3, quick: bool = False) -> list[dict]:
 
 def speed_markdown(rows: list[dict]) -> str:
     """The speed table."""
-    lines = [
-        "| what | n right | s wall (median) | s CPU | load average |",
-        "|---|---|---|---|---|",
+    header = ["what", "n right", "s wall (median)", "s CPU", "load average"]
+    cells = [
+        [
+            r["what"],
+            f"{r['n_right']} of {r['runs']}",
+            f"{r['seconds']:.2f}",
+            f"{r['cpu_seconds']:.2f}",
+            f"{r['load_average']:.1f}",
+        ]
+        for r in rows
     ]
-    for r in rows:
-        lines.append(
-            f"| {r['what']} | {r['n_right']} of {r['runs']} | {r['seconds']:.2f} "
-            f"| {r['cpu_seconds']:.2f} | {r['load_average']:.1f} |"
-        )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, cells) + "\n"
 
 
 def score_rows(

@@ -22,10 +22,8 @@ on one load mass.
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -103,23 +101,6 @@ class Log:
     i_true: np.ndarray  # mean current over each step (A), shape (N,)
     load_torque: np.ndarray  # N·m, shape (N,)
     stuck_fraction: float = 0.0
-    extra: dict = field(default_factory=dict)
-
-    def write_csv(self, path: Path) -> None:
-        """The log as the CLI reads it: ``time, i_a, omega_m, theta_m``."""
-        with open(path, "w", newline="") as f:
-            writer = csv.writer(f)
-            writer.writerow(["time", "i_a", "omega_m", "theta_m"])
-            for row in zip(self.time, self.i_a, self.omega_m, self.theta_m):
-                writer.writerow([repr(float(x)) for x in row])
-
-    def columns(self) -> dict[str, np.ndarray]:
-        return {
-            "time": self.time,
-            "i_a": self.i_a,
-            "omega_m": self.omega_m,
-            "theta_m": self.theta_m,
-        }
 
 
 class _Model:

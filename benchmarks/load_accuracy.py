@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import LoadProfile
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION
 from arcosim.identification.load_torque import LoadScore, estimate_load_torque, score_profile
@@ -123,12 +124,16 @@ def bandwidth_rows(progress: Callable[[str], None], seed: int = 1) -> dict[str, 
 
 def markdown(rows: dict[str, dict]) -> str:
     """The load torque table (errors in % of the step)."""
-    lines = [
-        "| chain, load | settled error % (mean ± std over seeds) | worst settled abs error % "
-        "| settling s (median / max) | rms error % (mean) | sine amplitude (median) "
-        "| sine lag ms (median) |",
-        "|---|---|---|---|---|---|---|",
+    header = [
+        "chain, load",
+        "settled error % (mean ± std over seeds)",
+        "worst settled abs error %",
+        "settling s (median / max)",
+        "rms error % (mean)",
+        "sine amplitude (median)",
+        "sine lag ms (median)",
     ]
+    cells = []
     for name, r in rows.items():
         s = r["scores"]
         mean = np.array([x["settled_mean_percent"] for x in s])
@@ -139,28 +144,44 @@ def markdown(rows: dict[str, dict]) -> str:
         settle = (f"{np.median(finite):.2f} / {np.max(finite):.2f}" if len(finite) else "never") + (
             f" ({never} of {len(s)} never)" if never else ""
         )
-        lines.append(
-            f"| {name} | {mean.mean():+.2f} ± {mean.std():.2f} | {worst:.2f} | {settle} "
-            f"| {np.mean([x['settled_rms_percent'] for x in s]):.2f} "
-            f"| {np.median([x['sine_amplitude_ratio'] for x in s]):.3f} "
-            f"| {1e3 * np.median([x['sine_lag_s'] for x in s]):.0f} |"
+        cells.append(
+            [
+                name,
+                f"{mean.mean():+.2f} ± {mean.std():.2f}",
+                f"{worst:.2f}",
+                settle,
+                f"{np.mean([x['settled_rms_percent'] for x in s]):.2f}",
+                f"{np.median([x['sine_amplitude_ratio'] for x in s]):.3f}",
+                f"{1e3 * np.median([x['sine_lag_s'] for x in s]):.0f}",
+            ]
         )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, cells) + "\n"
 
 
 def bandwidth_markdown(rows: dict[str, dict]) -> str:
     """The bandwidth trade-off table."""
-    lines = [
-        "| load_torque_bandwidth (rad/s) | model | settling s | settled max abs error % "
-        "| rms error % | sine amplitude | sine lag ms |",
-        "|---|---|---|---|---|---|---|",
+    header = [
+        "load_torque_bandwidth (rad/s)",
+        "model",
+        "settling s",
+        "settled max abs error %",
+        "rms error %",
+        "sine amplitude",
+        "sine lag ms",
     ]
+    cells = []
     for w, models in rows.items():
         for model, x in models.items():
             settling = "never" if math.isnan(x["settling_s"]) else f"{x['settling_s']:.2f}"
-            lines.append(
-                f"| {w} | {model} | {settling} | {x['settled_max_percent']:.2f} "
-                f"| {x['settled_rms_percent']:.2f} | {x['sine_amplitude_ratio']:.3f} "
-                f"| {1e3 * x['sine_lag_s']:.0f} |"
+            cells.append(
+                [
+                    w,
+                    model,
+                    settling,
+                    f"{x['settled_max_percent']:.2f}",
+                    f"{x['settled_rms_percent']:.2f}",
+                    f"{x['sine_amplitude_ratio']:.3f}",
+                    f"{1e3 * x['sine_lag_s']:.0f}",
+                ]
             )
-    return "\n".join(lines) + "\n"
+    return markdown_table(header, cells) + "\n"

@@ -39,6 +39,7 @@ import numpy as np
 from arcosim.build.builder import ensure_built
 from arcosim.build.recipes import OBSERVER, PLANT
 from arcosim.errors import UserError
+from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import SCENARIOS
 from arcosim.fmu.flexchain.observer import STATE_ESTIMATION
 from arcosim.host.instance import FmuInstance
@@ -254,29 +255,29 @@ def run(out: Path, runs: int, quick: bool, progress: Callable[[str], None] = pri
 
 def markdown(loop, model_based, split, plain, by_n, by_length, oe, base, runs, quick) -> str:
     """The report: medians with min–max over runs."""
+    steps = [
+        ["bench co-simulation, whole loop (recursion, default)", loop.cell()],
+        ["bench co-simulation, whole loop (model-based observer)", model_based.cell()],
+        *([f"of the loop: {name}", f.cell(2)] for name, f in split.items()),
+        ["observer algorithms in plain Python, no FMI", plain.cell(2)],
+    ]
+    three = by_n[3].median
+    masses = [[n, f.cell(), f"{f.median / three:.2f}"] for n, f in by_n.items()]
+    first = next(iter(by_length.values())).median
+    records = [[f"{d:g} s", f.cell(3), f"{f.median / first:.1f}"] for d, f in by_length.items()]
     lines = [
         f"Median (min–max) over {runs} run(s); {base:g} s records at 1 kHz"
         + (" — quick mode, not figures to quote" if quick else "")
         + ".",
         "",
-        "| what | µs per 1 ms step |",
-        "|---|---|",
-        f"| bench co-simulation, whole loop (recursion, default) | {loop.cell()} |",
-        f"| bench co-simulation, whole loop (model-based observer) | {model_based.cell()} |",
-    ]
-    lines += [f"| of the loop: {name} | {f.cell(2)} |" for name, f in split.items()]
-    lines += [
-        f"| observer algorithms in plain Python, no FMI | {plain.cell(2)} |",
+        markdown_table(["what", "µs per 1 ms step"], steps),
         "",
-        "| load masses n | µs per step, whole loop | × n = 3 |",
-        "|---|---|---|",
+        markdown_table(["load masses n", "µs per step, whole loop", "× n = 3"], masses),
+        "",
+        markdown_table(["record", "seconds, whole run", "× shortest"], records),
+        "",
+        f"Output-error identification of a 10 s bench record: {oe.cell(2)} s.",
     ]
-    three = by_n[3].median
-    lines += [f"| {n} | {f.cell()} | {f.median / three:.2f} |" for n, f in by_n.items()]
-    lines += ["", "| record | seconds, whole run | × shortest |", "|---|---|---|"]
-    first = next(iter(by_length.values())).median
-    lines += [f"| {d:g} s | {f.cell(3)} | {f.median / first:.1f} |" for d, f in by_length.items()]
-    lines += ["", f"Output-error identification of a 10 s bench record: {oe.cell(2)} s."]
     return "\n".join(lines) + "\n"
 
 

@@ -1,4 +1,4 @@
-"""pythonfmu 0.7's exit-time use-after-free, and the build's fix (cosim/exit_fix.py).
+"""pythonfmu 0.7's exit-time use-after-free, and the build's fix (cosim/build/exit_fix.py).
 
 CI once failed on it: a process that had instantiated an FMU aborted at exit with
 "corrupted double-linked list" (about one process in 30-50). Valgrind shows the invalid

@@ -1,5 +1,5 @@
 """Whole-chain identification on logs of the independent drive simulator
-(cosim/field_sim.py): chains, rates, friction, closed loops and loads the project's
+(benchmarks/field_sim.py): chains, rates, friction, closed loops and loads the project's
 plant never made; and the simulator itself, against the project's plant."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""Output-error identification (cosim/output_error.py), its CLI, and the accuracy
-benchmark in quick mode."""
+"""Output-error identification (cosim/identification/output_error.py), its CLI, and
+the accuracy benchmark in quick mode."""
 
 from __future__ import annotations
 

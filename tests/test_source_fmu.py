@@ -1,4 +1,4 @@
-"""The ExcitationSource FMU: the same signals as cosim.excitation, in any host."""
+"""The ExcitationSource FMU: the same signals as arcosim.experiments.excitation, in any host."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """The speed benchmark still runs (quick mode; no thresholds: timing is for
-benchmarks/throughput.py on a quiet machine, not for CI)."""
+benchmarks/speed.py, ``arcosim bench speed``, on a quiet machine, not for CI)."""
 
 from __future__ import annotations
 

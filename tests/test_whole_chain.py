@@ -1,5 +1,5 @@
-"""Whole-chain identification (cosim/whole_chain.py, cosim/modal_start.py,
-cosim/chain_modes.py): every J_i, k_i, B_i from the motor side alone."""
+"""Whole-chain identification (cosim/identification/whole_chain.py, modal_start.py,
+chain_modes.py): every J_i, k_i, B_i from the motor side alone."""
 
 from __future__ import annotations
 
