@@ -20,6 +20,7 @@ from pathlib import Path
 from xml.etree.ElementTree import SubElement, tostring
 
 from arcosim.build.cache import plant_package_dir
+from arcosim.build.recipes import PLANT
 from arcosim.errors import BuildError
 from arcosim.version import __version__
 
@@ -78,7 +79,7 @@ def plant_class(n: int):
     from arcosim.plant.motorchain.fmu import MotorChainPlant
 
     return type(
-        f"MotorChainPlant_n{n}",
+        PLANT.identifier(n),
         (MotorChainPlant,),
         {"n_masses": n, "project_version": __version__},
     )
@@ -138,7 +139,7 @@ def variables_header(n: int, guid: str) -> str:
         f"#define SMALLEST_STEP {checks.SMALLEST_STEP!r}",
         f"#define FASTEST_RATE {checks.FASTEST_RATE!r}",
         f'#define MODEL_GUID "{guid}"',
-        f'#define MODEL_IDENTIFIER "MotorChainPlant_n{n}"',
+        f'#define MODEL_IDENTIFIER "{PLANT.identifier(n)}"',
         f'#define PLANT_BUILD "{sources_digest(n)}"',
         f"#define N_VARS {len(variables)}",
         "enum { T_REAL, T_INTEGER, T_BOOLEAN, T_STRING };",
@@ -173,7 +174,7 @@ def build_c_plant(n: int, destination: Path) -> Path:
     """Compile the plant for n load masses and package it as ``destination`` (.fmu)."""
     from xml.etree.ElementTree import fromstring
 
-    identifier = f"MotorChainPlant_n{n}"
+    identifier = PLANT.identifier(n)
     description = model_description_xml(identifier, n)
     guid = fromstring(description).get("guid")
     with tempfile.TemporaryDirectory(prefix="arcosim_cplant_") as tmp:

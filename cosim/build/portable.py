@@ -196,9 +196,12 @@ def _bundle_sources(
     )
     files[f"{bundle}/slave.py"] = (
         f'"""The FMU\'s slave class: {cls} for n = {n} load masses."""\n\n'
-        f"from .{module} import {cls}\n\n\n"
-        f"class {identifier}({cls}):\n"
-        f"    n_masses = {n}\n"
-        f"    project_version = {version!r}\n"
+        f"from .{module} import {cls}\n\n\n" + slave_class(identifier, cls, n, version)
     )
     return files
+
+
+def slave_class(identifier: str, base: str, n: int, version: str) -> str:
+    """Source of the FMU's slave class ``identifier``: ``base`` for ``n`` load masses,
+    built by arcosim ``version``."""
+    return f"class {identifier}({base}):\n    n_masses = {n}\n    project_version = {version!r}\n"
