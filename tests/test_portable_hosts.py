@@ -31,6 +31,7 @@ import shutil
 import subprocess
 import sys
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -237,7 +238,7 @@ def test_chain_in_fmpy_of_another_python(
 
 
 def test_user_pythonhome_for_another_python_changes_nothing(
-    fmus, reference, tmp_path, declared_outputs
+    c_host, fmus, reference, tmp_path, declared_outputs
 ):
     """PYTHONHOME and PYTHONPATH meant for another Python in a C host's environment: the
     FMU's interpreter ignores the environment and takes the home of its libpython."""
@@ -245,7 +246,7 @@ def test_user_pythonhome_for_another_python_changes_nothing(
     if not other:
         pytest.skip("no pyenv CPython 3.13 to point PYTHONHOME at")
     env = {**bare_env(), "PYTHONHOME": other[-1], "PYTHONPATH": f"{other[-1]}/lib/python3.13"}
-    out = run_c_host(fmus, tmp_path, env)
+    out = run_c_host(c_host, fmus, tmp_path, env)
     assert "environ same" in out["tail"]
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
@@ -253,26 +254,35 @@ def test_user_pythonhome_for_another_python_changes_nothing(
 # -- the C host and ecos ----------------------------------------------------------------
 
 
-@functools.cache
-def c_host(folder: str) -> Path:
-    from arcosim.build.cplant import fmi_headers
+@pytest.fixture(scope="session")
+def c_host(tmp_path_factory) -> Callable[[], Path]:
+    """``c_host()`` → tests/hosts/chain_host.c compiled, once per session (on first use)."""
+    compiled: list[Path] = []
 
-    binary = Path(folder) / "chain_host"
-    command = [
-        shutil.which("cc") or "gcc",
-        "-std=c99",
-        "-O1",
-        "-Wall",
-        "-Wextra",
-        f"-I{fmi_headers()}",
-        str(HERE / "chain_host.c"),
-        "-o",
-        str(binary),
-        "-ldl",
-    ]
-    result = subprocess.run(command, capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    return binary
+    def get() -> Path:
+        if compiled:
+            return compiled[0]
+        from arcosim.build.cplant import fmi_headers
+
+        binary = tmp_path_factory.mktemp("c_host") / "chain_host"
+        command = [
+            shutil.which("cc") or "gcc",
+            "-std=c99",
+            "-O1",
+            "-Wall",
+            "-Wextra",
+            f"-I{fmi_headers()}",
+            str(HERE / "chain_host.c"),
+            "-o",
+            str(binary),
+            "-ldl",
+        ]
+        result = subprocess.run(command, capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+        compiled.append(binary)
+        return binary
+
+    return get
 
 
 def host_spec(fmus: dict[str, Path], folder: Path) -> str:
@@ -309,8 +319,8 @@ def host_spec(fmus: dict[str, Path], folder: Path) -> str:
     return json.dumps(order)
 
 
-def run_c_host(fmus, tmp_path: Path, env: dict[str, str]) -> dict:
-    binary = c_host(str(tmp_path))
+def run_c_host(c_host, fmus, tmp_path: Path, env: dict[str, str]) -> dict:
+    binary = c_host()
     order = json.loads(host_spec(fmus, tmp_path))
     result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
     assert result.returncode == 0, result.stderr[-3000:]
@@ -324,8 +334,10 @@ def run_c_host(fmus, tmp_path: Path, env: dict[str, str]) -> dict:
     return {"outputs": outputs, "tail": tail, "stderr": result.stderr}
 
 
-def test_chain_in_a_c_host_with_a_bare_path(fmus, reference, tmp_path, declared_outputs) -> None:
-    out = run_c_host(fmus, tmp_path, bare_env())
+def test_chain_in_a_c_host_with_a_bare_path(
+    c_host, fmus, reference, tmp_path, declared_outputs
+) -> None:
+    out = run_c_host(c_host, fmus, tmp_path, bare_env())
     assert "environ same" in out["tail"], out["tail"]
     libpythons = [t for t in out["tail"] if t.startswith("libpython ")]
     assert len(libpythons) == 1 and str(HIDDEN) not in libpythons[0], libpythons
@@ -333,10 +345,10 @@ def test_chain_in_a_c_host_with_a_bare_path(fmus, reference, tmp_path, declared_
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
 
-def test_no_python_found_fails_instantiation_cleanly(fmus, tmp_path) -> None:
+def test_no_python_found_fails_instantiation_cleanly(c_host, fmus, tmp_path) -> None:
     """Nothing on PATH, an ARCOSIM_LIBPYTHON that does not exist: fmi2Instantiate logs
     what it tried and returns NULL; the host goes on (exit 5, not a crash)."""
-    binary = c_host(str(tmp_path))
+    binary = c_host()
     host_spec({"source": fmus["source"]}, tmp_path)
     env = {"PATH": "/nonexistent", "ARCOSIM_LIBPYTHON": "/nonexistent/libpython3.12.so.1.0"}
     result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
@@ -345,25 +357,29 @@ def test_no_python_found_fails_instantiation_cleanly(fmus, tmp_path) -> None:
     assert "set ARCOSIM_LIBPYTHON" in result.stderr
 
 
-def test_arcosim_libpython_chooses_the_python(fmus, reference, tmp_path, declared_outputs) -> None:
+def test_arcosim_libpython_chooses_the_python(
+    c_host, fmus, reference, tmp_path, declared_outputs
+) -> None:
     chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.12.*/lib/libpython3.12.so.1.0")))
     if not chosen:
         pytest.skip("no pyenv CPython 3.12 with a shared libpython")
-    out = run_c_host(fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
+    out = run_c_host(c_host, fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
     libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
     assert libpythons == [str(Path(chosen[-1]).resolve())]
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
 
 def test_a_libpython_the_host_loaded_privately_is_the_one_used(
-    fmus, reference, tmp_path, declared_outputs
+    c_host, fmus, reference, tmp_path, declared_outputs
 ):
     """The host dlopen()ed a libpython with RTLD_LOCAL and did not start it; a Debian
     Python is on PATH. The FMU promotes and starts the host's library, maps no other."""
     chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.13.*/lib/libpython3.13.so.1.0")))
     if not chosen:
         pytest.skip("no pyenv CPython 3.13 with a shared libpython")
-    out = run_c_host(fmus, tmp_path, {**bare_env(), "CHAIN_HOST_LOCAL_LIBPYTHON": chosen[-1]})
+    out = run_c_host(
+        c_host, fmus, tmp_path, {**bare_env(), "CHAIN_HOST_LOCAL_LIBPYTHON": chosen[-1]}
+    )
     libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
     assert libpythons == [str(Path(chosen[-1]).resolve())]
     assert "environ same" in out["tail"]
