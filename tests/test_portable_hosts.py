@@ -38,15 +38,11 @@ import numpy as np
 import pytest
 
 from arcosim.build.ssp import BENCH, CONNECTIONS
+from tests.chain_harness import chain_fmus, chain_spec, run_chain
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only")
 
 HERE = Path(__file__).parent / "hosts"
-COMPONENTS = {
-    "source": "ExcitationSource",
-    "plant": "MotorChainPlant",
-    "observer": "ReactionTorqueObserver",
-}
 STOP, H = 1.0, 1e-3
 RTOL = 1e-9
 HIDDEN = Path(sys.base_prefix).resolve()
@@ -95,8 +91,7 @@ def hidden(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 
 
 @pytest.fixture(scope="session")
 def fmus(build_fmus) -> dict[str, Path]:
-    folder = build_fmus(3)
-    return {c: folder / f"{name}.fmu" for c, name in COMPONENTS.items()}
+    return chain_fmus(build_fmus(3))
 
 
 @pytest.fixture(scope="module")
@@ -111,34 +106,11 @@ def declared_outputs(fmus) -> int:
     )
 
 
-def spec(fmus: dict[str, Path], shadow: Path | None = None) -> dict:
-    return {
-        "components": {c: str(p) for c, p in fmus.items()},
-        "parameters": BENCH,
-        "connections": [list(c) for c in CONNECTIONS],
-        "stop": STOP,
-        "h": H,
-        "shadow": str(shadow) if shadow else None,
-    }
-
-
-def run_chain(python: str, spec_: dict, workdir: Path, env: dict[str, str], in_namespace: bool):
-    workdir.mkdir(parents=True, exist_ok=True)
-    (workdir / "spec.json").write_text(json.dumps(spec_))
-    command = [python, str(HERE / "chain_run.py"), "spec.json", "out.json"]
-    if in_namespace:
-        result = hidden(command, env, workdir)
-    else:
-        result = subprocess.run(command, capture_output=True, text=True, env=env, cwd=workdir)
-    assert result.returncode == 0, result.stderr[-3000:]
-    return json.loads((workdir / "out.json").read_text())
-
-
 @pytest.fixture(scope="session")
 def reference(fmus, tmp_path_factory) -> dict[str, dict[str, np.ndarray]]:
     """The building environment's fmpy run (this interpreter, nothing hidden)."""
     out = run_chain(
-        sys.executable, spec(fmus), tmp_path_factory.mktemp("ref"), dict(os.environ), False
+        sys.executable, chain_spec(fmus, STOP, H), tmp_path_factory.mktemp("ref"), dict(os.environ)
     )
     return {c: {k: np.array(v) for k, v in o.items()} for c, o in out["outputs"].items()}
 
@@ -228,7 +200,7 @@ def test_chain_in_fmpy_of_another_python(
     fmus, reference, venvs, tmp_path, label, declared_outputs
 ) -> None:
     python = venvs(label)
-    out = run_chain(python, spec(fmus), tmp_path, bare_env(python), True)
+    out = run_chain(python, chain_spec(fmus, STOP, H), tmp_path, bare_env(python), hidden)
     assert out["environ_changed"] == [], out["environ_changed"]
     # the host's own libpython (none for Debian's static python3), never a second one
     assert out["libpython_after"] == out["libpython_before"], out["libpython_after"]
@@ -456,7 +428,7 @@ def test_chain_in_libcosim_under_another_python(
         for c, p in fmus.items()
     }
     traces = {c: str(tmp_path / f"trace_{c}.csv") for c in fmus}
-    spec_ = {**spec(fmus), "variables": variables, "traces": traces}
+    spec_ = {**chain_spec(fmus, STOP, H), "variables": variables, "traces": traces}
     (tmp_path / "spec.json").write_text(json.dumps(spec_))
     env = {**bare_env(libcosim_python), "PYTHONPATH": str(HERE)}
     command = [libcosim_python, str(HERE / "libcosim_run.py"), "spec.json", "out.json"]
