@@ -53,6 +53,16 @@ def build_fmus(session_cache: Path) -> Callable[[int], Path]:
 
 
 @pytest.fixture(scope="session")
+def fmus(build_fmus: Callable[[int], Path]) -> Path:
+    """The folder of the FMUs for the paper's bench (n = 3).
+
+    Modules that want the FMUs in another shape (by component, as a pair) define a
+    ``fmus`` fixture of their own, which takes precedence there.
+    """
+    return build_fmus(3)
+
+
+@pytest.fixture(scope="session")
 def plant_fmu(build_fmus: Callable[[int], Path]) -> Path:
     """The plant FMU for the paper's bench (n = 3)."""
     return build_fmus(3) / "MotorChainPlant.fmu"

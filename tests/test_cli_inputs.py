@@ -39,11 +39,6 @@ def snapshot(path: Path) -> tuple[bytes, int]:
 
 
 @pytest.fixture(scope="module")
-def fmus(build_fmus) -> Path:
-    return build_fmus(3)
-
-
-@pytest.fixture(scope="module")
 def log(fmus, tmp_path_factory) -> Path:
     """A 1 s log of the flexible maneuver (as `arcosim simulate --out` writes it)."""
     path = tmp_path_factory.mktemp("log") / "flexible.csv"

@@ -12,6 +12,7 @@ from arcosim.fmu.flexchain import defaults, excitation
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_excitation import ExcitationError, design_excitation
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
+from arcosim.identification.drive import identify_drive
 from arcosim.identification.encoder_fit import (
     Drive,
     _discrete,
@@ -22,8 +23,8 @@ from arcosim.identification.encoder_fit import (
 )
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import check_log
-from arcosim.identification.output_error import linear_recursion, motor_record
-from arcosim.identification.whole_chain import identify_whole_chain, split
+from arcosim.identification.output_error import linear_recursion
+from arcosim.identification.whole_chain import split
 from benchmarks import field_sim
 
 LINES = np.geomspace(3.0, 150.0, 40)
@@ -39,13 +40,19 @@ def drive(**kw) -> field_sim.Drive:
 
 
 def fit(d: field_sim.Drive, log: field_sim.Log, friction_given=True, load="none", masses="auto"):
-    D_m, f_c = (d.D_m, d.f_c) if friction_given else (0.0, 0.0)
-    actuator = Actuator(d.J_m, d.k_t, 0.0, 0.0, D_m, f_c)
-    record = motor_record(log.time, log.i_a, log.omega_m, log.theta_m, actuator, 100.0)
-    encoder = encoder_record(
-        log.time, log.i_a, log.theta_m, actuator, d.counts, friction_given, load
-    )
-    return identify_whole_chain(record, masses, encoder)
+    friction = {"D_m": d.D_m, "f_c": d.f_c} if friction_given else {}
+    return identify_drive(
+        log.time,
+        log.i_a,
+        log.omega_m,
+        log.theta_m,
+        k_t=d.k_t,
+        J_m=d.J_m,
+        encoder_cpr=d.counts,
+        masses=masses,
+        load=load,
+        **friction,
+    ).choice
 
 
 def assert_chain(choice, d: field_sim.Drive, rtol: float) -> None:
@@ -131,7 +138,7 @@ def test_the_friction_sign_over_a_step_counts_a_reversal_inside_it() -> None:
 
 
 def test_three_masses_at_4_khz_and_a_refusal_that_names_the_modes() -> None:
-    d = drive(J=THREE["J"], k=THREE["k"], B=THREE["B"])
+    d = drive()
     log = field_sim.simulate(d, 2.5e-4, 10.0, current=field_sim.multisine(LINES, 3.0))
     assert_chain(fit(d, log), d, rtol=5e-3)
     with pytest.raises(

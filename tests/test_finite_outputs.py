@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 import re
-from pathlib import Path
 
 import pytest
 
@@ -18,11 +17,6 @@ from arcosim.errors import UserError
 from arcosim.fmu.fmukit import FmuSlave, inp, out
 from arcosim.fmu.fmukit.checks import FASTEST_RATE, LARGEST, SMALLEST_STEP
 from arcosim.host.instance import FmuInstance
-
-
-@pytest.fixture(scope="module")
-def folder(build_fmus) -> Path:
-    return build_fmus(3)
 
 
 def outputs_finite(fmu: FmuInstance) -> bool:
@@ -48,21 +42,21 @@ def outputs_finite(fmu: FmuInstance) -> bool:
     ],
 )
 def test_parameters_that_make_the_model_not_finite_are_refused_by_name(
-    folder, name, parameters, phrase
+    fmus, name, parameters, phrase
 ) -> None:
-    with FmuInstance(folder / f"{name}.fmu", "x") as fmu:
+    with FmuInstance(fmus / f"{name}.fmu", "x") as fmu:
         with pytest.raises(UserError, match=re.escape(phrase)):
             fmu.initialize(parameters)
         assert fmu.do_step(0.0, 1e-3) == 2  # every step refused, never a NaN with OK
 
 
-def test_the_bound_on_the_chain_follows_its_stated_rate(folder) -> None:
+def test_the_bound_on_the_chain_follows_its_stated_rate(fmus) -> None:
     """Gershgorin's bound 2 (k_1 + k_2) / J_1 ≤ FASTEST_RATE² is where the refusal starts:
     just inside it the plant runs, just outside it refuses (J_1 = 1 kg·m², k_2 = 0)."""
     inside = FASTEST_RATE**2 / 2.0 * 0.99
     outside = FASTEST_RATE**2 / 2.0 * 1.01
     for k1, accepted in ((inside, True), (outside, False)):
-        with FmuInstance(folder / "MotorChainPlant.fmu", "x") as plant:
+        with FmuInstance(fmus / "MotorChainPlant.fmu", "x") as plant:
             chain = {"J_m": 1e3, "J[1]": 1.0, "k[1]": k1, "k[2]": 0.0, "k[3]": 0.0}
             if accepted:
                 plant.initialize(chain)
@@ -76,9 +70,9 @@ def test_the_bound_on_the_chain_follows_its_stated_rate(folder) -> None:
 
 
 @pytest.mark.parametrize("name", ["ReactionTorqueObserver", "MotorChainPlant"])
-def test_a_step_below_a_nanosecond_and_inputs_beyond_the_range_are_refused(folder, name):
+def test_a_step_below_a_nanosecond_and_inputs_beyond_the_range_are_refused(fmus, name):
     first_input = {"ReactionTorqueObserver": "i_a", "MotorChainPlant": "i_ref"}[name]
-    with FmuInstance(folder / f"{name}.fmu", "x") as fmu:
+    with FmuInstance(fmus / f"{name}.fmu", "x") as fmu:
         fmu.initialize()
         assert fmu.do_step(0.0, 1e-308) == 2
         assert f"it must be at least {SMALLEST_STEP:g} s" in fmu.messages[-1]

@@ -10,9 +10,7 @@ Each run is its own process (tests/hosts/chain_run.py with this interpreter).
 
 from __future__ import annotations
 
-import json
 import os
-import subprocess
 import sys
 import zipfile
 from pathlib import Path
@@ -23,17 +21,12 @@ import pytest
 
 from arcosim.build.cplant import fmi_headers
 from arcosim.build.portable import compile_trampoline
-from arcosim.build.ssp import BENCH, CONNECTIONS
 from arcosim.portability import bundle_name, portability_problems
+from tests.chain_harness import chain_fmus, chain_spec, run_chain
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux binaries")
 
-RUNNER = Path(__file__).parent / "hosts" / "chain_run.py"
-COMPONENTS = {
-    "source": "ExcitationSource",
-    "plant": "MotorChainPlant",
-    "observer": "ReactionTorqueObserver",
-}
+STOP, H = 0.3, 1e-3
 VARIANT = """
 
 # --- test variant: d_hat + 1 ------------------------------------------------------
@@ -50,45 +43,18 @@ ReactionTorqueObserver.step = _variant_step
 
 
 def run(spec: dict, folder: Path) -> dict:
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "spec.json").write_text(json.dumps(spec))
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    result = subprocess.run(
-        [sys.executable, str(RUNNER), "spec.json", "out.json"],
-        capture_output=True,
-        text=True,
-        cwd=folder,
-        env=env,
-        timeout=600,
-    )
-    assert result.returncode == 0, result.stderr[-3000:]
-    return json.loads((folder / "out.json").read_text())
-
-
-def chain_spec(fmus: dict[str, Path], shadow: Path | None = None) -> dict:
-    return {
-        "components": {c: str(p) for c, p in fmus.items()},
-        "parameters": {c: BENCH[c.rstrip("2")] for c in fmus},
-        "connections": [list(c) for c in CONNECTIONS]
-        + [
-            [a, o, "observer2", i]
-            for a, o, b, i in CONNECTIONS
-            if b == "observer" and "observer2" in fmus
-        ],
-        "stop": 0.3,
-        "h": 1e-3,
-        "shadow": str(shadow) if shadow else None,
-    }
+    return run_chain(sys.executable, spec, folder, env, timeout=600)
 
 
 @pytest.fixture(scope="session")
 def fmus(build_fmus) -> dict[str, Path]:
-    return {c: build_fmus(3) / f"{n}.fmu" for c, n in COMPONENTS.items()}
+    return chain_fmus(build_fmus(3))
 
 
 @pytest.fixture(scope="session")
 def reference(fmus, tmp_path_factory) -> dict:
-    return run(chain_spec(fmus), tmp_path_factory.mktemp("reference"))["outputs"]
+    return run(chain_spec(fmus, STOP, H), tmp_path_factory.mktemp("reference"))["outputs"]
 
 
 def equal(a, b) -> bool:
@@ -116,7 +82,7 @@ def test_a_host_with_its_own_fmukit_flexchain_pythonfmu_gets_the_fmus_results(
         )
         for module in modules:
             (shadow / package / f"{module}.py").write_text("HOST = 1\n")
-    out = run(chain_spec(fmus, shadow), tmp_path / "run")
+    out = run(chain_spec(fmus, STOP, H, shadow), tmp_path / "run")
     assert out["shadowed"] == ["flexchain", "fmukit", "pythonfmu"]
     assert all(str(shadow) in path for path in out["shadow_modules"].values())
     for component, signals in reference.items():
@@ -155,7 +121,7 @@ def test_two_builds_of_the_observer_run_in_one_process(fmus, reference, tmp_path
     new = rebundle(fmus["observer"], variant, "f" * 40, VARIANT)
     assert portability_problems(variant) == []
     both = {**fmus, "observer2": variant}
-    out = run(chain_spec(both), tmp_path / "run")["outputs"]
+    out = run(chain_spec(both, STOP, H), tmp_path / "run")["outputs"]
     for name, values in reference["observer"].items():
         assert equal(out["observer"][name], values), f"observer.{name}"
         expected = np.asarray(values) + (1.0 if name == "d_hat" else 0.0)

@@ -23,21 +23,14 @@ from arcosim.fmu.flexchain.load_observer import (
 )
 from arcosim.fmu.flexchain.model_observer import NoiseModel
 from arcosim.fmu.fmukit.state import restore, snapshot
+from tests.test_model_observer import B, H, J, K, motor_angle
 
-J = (5.15299e-4, 5.15299e-4, 6.192707e-4)
-K = (0.12, 0.1627, 0.21)
-B = (8.88e-6, 2e-5, 5e-6)
-#: The same chain with about 5 % damping, so a torque's ringing dies within seconds.
+#: The chain of tests/test_model_observer.py with about 5 % damping, so a torque's
+#: ringing dies within seconds.
 B_DAMPED = (1.5e-3, 1.5e-3, 1.5e-3)
-H = 1e-3
 G_DIST = 100.0
 NOISE = NoiseModel(2 * math.pi / 2000 / math.sqrt(12), 1e-4, 1.5e-3)
 D = 2.6e-3  # N·m: a tenth of the bench drive's peak torque under a 1 A multi-sine
-
-
-def motor_angle(t: np.ndarray) -> np.ndarray:
-    """A motor angle with energy at the chain's modes (rad)."""
-    return 0.3 * np.sin(3.0 * t) + 0.02 * np.sin(17.0 * t + 1) + 0.01 * np.sin(41.0 * t + 2)
 
 
 class ExactChain:

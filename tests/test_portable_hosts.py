@@ -31,21 +31,18 @@ import shutil
 import subprocess
 import sys
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from arcosim.build.ssp import BENCH, CONNECTIONS
+from tests.chain_harness import chain_fmus, chain_spec, run_chain
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only")
 
 HERE = Path(__file__).parent / "hosts"
-COMPONENTS = {
-    "source": "ExcitationSource",
-    "plant": "MotorChainPlant",
-    "observer": "ReactionTorqueObserver",
-}
 STOP, H = 1.0, 1e-3
 RTOL = 1e-9
 HIDDEN = Path(sys.base_prefix).resolve()
@@ -94,8 +91,7 @@ def hidden(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 
 
 @pytest.fixture(scope="session")
 def fmus(build_fmus) -> dict[str, Path]:
-    folder = build_fmus(3)
-    return {c: folder / f"{name}.fmu" for c, name in COMPONENTS.items()}
+    return chain_fmus(build_fmus(3))
 
 
 @pytest.fixture(scope="module")
@@ -110,34 +106,11 @@ def declared_outputs(fmus) -> int:
     )
 
 
-def spec(fmus: dict[str, Path], shadow: Path | None = None) -> dict:
-    return {
-        "components": {c: str(p) for c, p in fmus.items()},
-        "parameters": BENCH,
-        "connections": [list(c) for c in CONNECTIONS],
-        "stop": STOP,
-        "h": H,
-        "shadow": str(shadow) if shadow else None,
-    }
-
-
-def run_chain(python: str, spec_: dict, workdir: Path, env: dict[str, str], in_namespace: bool):
-    workdir.mkdir(parents=True, exist_ok=True)
-    (workdir / "spec.json").write_text(json.dumps(spec_))
-    command = [python, str(HERE / "chain_run.py"), "spec.json", "out.json"]
-    if in_namespace:
-        result = hidden(command, env, workdir)
-    else:
-        result = subprocess.run(command, capture_output=True, text=True, env=env, cwd=workdir)
-    assert result.returncode == 0, result.stderr[-3000:]
-    return json.loads((workdir / "out.json").read_text())
-
-
 @pytest.fixture(scope="session")
 def reference(fmus, tmp_path_factory) -> dict[str, dict[str, np.ndarray]]:
     """The building environment's fmpy run (this interpreter, nothing hidden)."""
     out = run_chain(
-        sys.executable, spec(fmus), tmp_path_factory.mktemp("ref"), dict(os.environ), False
+        sys.executable, chain_spec(fmus, STOP, H), tmp_path_factory.mktemp("ref"), dict(os.environ)
     )
     return {c: {k: np.array(v) for k, v in o.items()} for c, o in out["outputs"].items()}
 
@@ -227,7 +200,7 @@ def test_chain_in_fmpy_of_another_python(
     fmus, reference, venvs, tmp_path, label, declared_outputs
 ) -> None:
     python = venvs(label)
-    out = run_chain(python, spec(fmus), tmp_path, bare_env(python), True)
+    out = run_chain(python, chain_spec(fmus, STOP, H), tmp_path, bare_env(python), hidden)
     assert out["environ_changed"] == [], out["environ_changed"]
     # the host's own libpython (none for Debian's static python3), never a second one
     assert out["libpython_after"] == out["libpython_before"], out["libpython_after"]
@@ -237,7 +210,7 @@ def test_chain_in_fmpy_of_another_python(
 
 
 def test_user_pythonhome_for_another_python_changes_nothing(
-    fmus, reference, tmp_path, declared_outputs
+    c_host, fmus, reference, tmp_path, declared_outputs
 ):
     """PYTHONHOME and PYTHONPATH meant for another Python in a C host's environment: the
     FMU's interpreter ignores the environment and takes the home of its libpython."""
@@ -245,7 +218,7 @@ def test_user_pythonhome_for_another_python_changes_nothing(
     if not other:
         pytest.skip("no pyenv CPython 3.13 to point PYTHONHOME at")
     env = {**bare_env(), "PYTHONHOME": other[-1], "PYTHONPATH": f"{other[-1]}/lib/python3.13"}
-    out = run_c_host(fmus, tmp_path, env)
+    out = run_c_host(c_host, fmus, tmp_path, env)
     assert "environ same" in out["tail"]
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
@@ -253,26 +226,35 @@ def test_user_pythonhome_for_another_python_changes_nothing(
 # -- the C host and ecos ----------------------------------------------------------------
 
 
-@functools.cache
-def c_host(folder: str) -> Path:
-    from arcosim.build.cplant import fmi_headers
+@pytest.fixture(scope="session")
+def c_host(tmp_path_factory) -> Callable[[], Path]:
+    """``c_host()`` → tests/hosts/chain_host.c compiled, once per session (on first use)."""
+    compiled: list[Path] = []
 
-    binary = Path(folder) / "chain_host"
-    command = [
-        shutil.which("cc") or "gcc",
-        "-std=c99",
-        "-O1",
-        "-Wall",
-        "-Wextra",
-        f"-I{fmi_headers()}",
-        str(HERE / "chain_host.c"),
-        "-o",
-        str(binary),
-        "-ldl",
-    ]
-    result = subprocess.run(command, capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    return binary
+    def get() -> Path:
+        if compiled:
+            return compiled[0]
+        from arcosim.build.cplant import fmi_headers
+
+        binary = tmp_path_factory.mktemp("c_host") / "chain_host"
+        command = [
+            shutil.which("cc") or "gcc",
+            "-std=c99",
+            "-O1",
+            "-Wall",
+            "-Wextra",
+            f"-I{fmi_headers()}",
+            str(HERE / "chain_host.c"),
+            "-o",
+            str(binary),
+            "-ldl",
+        ]
+        result = subprocess.run(command, capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+        compiled.append(binary)
+        return binary
+
+    return get
 
 
 def host_spec(fmus: dict[str, Path], folder: Path) -> str:
@@ -309,8 +291,8 @@ def host_spec(fmus: dict[str, Path], folder: Path) -> str:
     return json.dumps(order)
 
 
-def run_c_host(fmus, tmp_path: Path, env: dict[str, str]) -> dict:
-    binary = c_host(str(tmp_path))
+def run_c_host(c_host, fmus, tmp_path: Path, env: dict[str, str]) -> dict:
+    binary = c_host()
     order = json.loads(host_spec(fmus, tmp_path))
     result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
     assert result.returncode == 0, result.stderr[-3000:]
@@ -324,8 +306,10 @@ def run_c_host(fmus, tmp_path: Path, env: dict[str, str]) -> dict:
     return {"outputs": outputs, "tail": tail, "stderr": result.stderr}
 
 
-def test_chain_in_a_c_host_with_a_bare_path(fmus, reference, tmp_path, declared_outputs) -> None:
-    out = run_c_host(fmus, tmp_path, bare_env())
+def test_chain_in_a_c_host_with_a_bare_path(
+    c_host, fmus, reference, tmp_path, declared_outputs
+) -> None:
+    out = run_c_host(c_host, fmus, tmp_path, bare_env())
     assert "environ same" in out["tail"], out["tail"]
     libpythons = [t for t in out["tail"] if t.startswith("libpython ")]
     assert len(libpythons) == 1 and str(HIDDEN) not in libpythons[0], libpythons
@@ -333,10 +317,10 @@ def test_chain_in_a_c_host_with_a_bare_path(fmus, reference, tmp_path, declared_
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
 
-def test_no_python_found_fails_instantiation_cleanly(fmus, tmp_path) -> None:
+def test_no_python_found_fails_instantiation_cleanly(c_host, fmus, tmp_path) -> None:
     """Nothing on PATH, an ARCOSIM_LIBPYTHON that does not exist: fmi2Instantiate logs
     what it tried and returns NULL; the host goes on (exit 5, not a crash)."""
-    binary = c_host(str(tmp_path))
+    binary = c_host()
     host_spec({"source": fmus["source"]}, tmp_path)
     env = {"PATH": "/nonexistent", "ARCOSIM_LIBPYTHON": "/nonexistent/libpython3.12.so.1.0"}
     result = hidden([str(binary), "spec.txt", "out.txt"], env, tmp_path)
@@ -345,25 +329,29 @@ def test_no_python_found_fails_instantiation_cleanly(fmus, tmp_path) -> None:
     assert "set ARCOSIM_LIBPYTHON" in result.stderr
 
 
-def test_arcosim_libpython_chooses_the_python(fmus, reference, tmp_path, declared_outputs) -> None:
+def test_arcosim_libpython_chooses_the_python(
+    c_host, fmus, reference, tmp_path, declared_outputs
+) -> None:
     chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.12.*/lib/libpython3.12.so.1.0")))
     if not chosen:
         pytest.skip("no pyenv CPython 3.12 with a shared libpython")
-    out = run_c_host(fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
+    out = run_c_host(c_host, fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
     libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
     assert libpythons == [str(Path(chosen[-1]).resolve())]
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
 
 def test_a_libpython_the_host_loaded_privately_is_the_one_used(
-    fmus, reference, tmp_path, declared_outputs
+    c_host, fmus, reference, tmp_path, declared_outputs
 ):
     """The host dlopen()ed a libpython with RTLD_LOCAL and did not start it; a Debian
     Python is on PATH. The FMU promotes and starts the host's library, maps no other."""
     chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.13.*/lib/libpython3.13.so.1.0")))
     if not chosen:
         pytest.skip("no pyenv CPython 3.13 with a shared libpython")
-    out = run_c_host(fmus, tmp_path, {**bare_env(), "CHAIN_HOST_LOCAL_LIBPYTHON": chosen[-1]})
+    out = run_c_host(
+        c_host, fmus, tmp_path, {**bare_env(), "CHAIN_HOST_LOCAL_LIBPYTHON": chosen[-1]}
+    )
     libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
     assert libpythons == [str(Path(chosen[-1]).resolve())]
     assert "environ same" in out["tail"]
@@ -440,7 +428,7 @@ def test_chain_in_libcosim_under_another_python(
         for c, p in fmus.items()
     }
     traces = {c: str(tmp_path / f"trace_{c}.csv") for c in fmus}
-    spec_ = {**spec(fmus), "variables": variables, "traces": traces}
+    spec_ = {**chain_spec(fmus, STOP, H), "variables": variables, "traces": traces}
     (tmp_path / "spec.json").write_text(json.dumps(spec_))
     env = {**bare_env(libcosim_python), "PYTHONPATH": str(HERE)}
     command = [libcosim_python, str(HERE / "libcosim_run.py"), "spec.json", "out.json"]

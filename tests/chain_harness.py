@@ -1,0 +1,68 @@
+"""Source → plant → observer run by tests/hosts/chain_run.py in a process of its own:
+the FMUs by component, the run's SPEC, and the run (tests/test_fmu_isolation.py,
+tests/test_portable_hosts.py)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+
+from arcosim.build.ssp import BENCH, CONNECTIONS
+
+RUNNER = Path(__file__).parent / "hosts" / "chain_run.py"
+COMPONENTS = {
+    "source": "ExcitationSource",
+    "plant": "MotorChainPlant",
+    "observer": "ReactionTorqueObserver",
+}
+
+
+def chain_fmus(folder: Path) -> dict[str, Path]:
+    """The bench's FMUs in ``folder``, by component."""
+    return {c: folder / f"{name}.fmu" for c, name in COMPONENTS.items()}
+
+
+def chain_spec(fmus: dict[str, Path], stop: float, h: float, shadow: Path | None = None) -> dict:
+    """chain_run.py's SPEC: the bench's parameters and connections, for ``stop`` s in steps
+    of ``h`` s; a component ``observer2`` gets the observer's parameters and inputs."""
+    return {
+        "components": {c: str(p) for c, p in fmus.items()},
+        "parameters": {c: BENCH[c.rstrip("2")] for c in fmus},
+        "connections": [list(c) for c in CONNECTIONS]
+        + [
+            [a, o, "observer2", i]
+            for a, o, b, i in CONNECTIONS
+            if b == "observer" and "observer2" in fmus
+        ],
+        "stop": stop,
+        "h": h,
+        "shadow": str(shadow) if shadow else None,
+    }
+
+
+def run_chain(
+    python: str,
+    spec: dict,
+    workdir: Path,
+    env: dict[str, str],
+    launch: Callable[[list[str], dict[str, str], Path], subprocess.CompletedProcess] | None = None,
+    timeout: float | None = None,
+) -> dict:
+    """chain_run.py under ``python`` in ``workdir`` (made if needed) with ``env``; its OUT.
+
+    ``launch(command, env, cwd)`` starts it instead of ``subprocess.run`` (with
+    ``timeout``), e.g. in a namespace.
+    """
+    workdir.mkdir(parents=True, exist_ok=True)
+    (workdir / "spec.json").write_text(json.dumps(spec))
+    command = [python, str(RUNNER), "spec.json", "out.json"]
+    if launch is None:
+        result = subprocess.run(
+            command, capture_output=True, text=True, env=env, cwd=workdir, timeout=timeout
+        )
+    else:
+        result = launch(command, env, workdir)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return json.loads((workdir / "out.json").read_text())
