@@ -47,12 +47,7 @@ from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.observer import (
-    MODEL_BASED,
-    RECURSION,
-    RIGID_IDENTIFICATION,
-    STATE_ESTIMATION,
-)
+from arcosim.fmu.flexchain.codes import Estimator, Mode
 from arcosim.identification.offline_observer import estimate_states, replay
 from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
 from benchmarks import chain_accuracy, field_accuracy, load_accuracy
@@ -145,7 +140,9 @@ def score_case(case: Case, seeds: Sequence[int], progress: Callable[[str], None]
         progress(f"{case.name}: seed {seed}, rigid maneuver")
         log = rigid(case, seed)
         for method, kappa in (("eq. 21 (literal)", False), ("eq. 21 + kappa", True)):
-            ident = replay(settings_for(case, RIGID_IDENTIFICATION, kappa_correction=kappa), log)
+            ident = replay(
+                settings_for(case, Mode.RIGID_IDENTIFICATION, kappa_correction=kappa), log
+            )
             ident.estimate()
             result.add(result.k_error, method, percent_error(ident.identifier.k, k_true))
             result.add(result.B_error, method, percent_error(ident.identifier.B, B_true))
@@ -170,8 +167,11 @@ def score_broadband(
     truth = [log[f"theta[{i}]"] for i in range(1, case.n + 1)]
     motor = log["theta_m_true"]
     identified = {"k": (k_hat,) * case.n, "B": (B_hat,) * case.n}
-    for name, estimator in (("recursion", RECURSION), ("model-based", MODEL_BASED)):
-        s = settings_for(case, STATE_ESTIMATION, estimator=estimator, **identified)
+    for name, estimator in (
+        ("recursion", Estimator.RECURSION),
+        ("model-based", Estimator.MODEL_BASED),
+    ):
+        s = settings_for(case, Mode.STATE_ESTIMATION, estimator=estimator, **identified)
         est = estimate_states(s, log)
         scores = [flexible_score(est[:, i], truth[i], motor) for i in range(case.n)]
         result.add(result.state, name + suffix, scores)

@@ -26,7 +26,7 @@ import numpy as np
 
 from arcosim.experiments import excitation
 from arcosim.experiments.scenarios import Scenario
-from arcosim.fmu.flexchain.excitation import log_spaced
+from arcosim.fmu.flexchain.waveforms import log_spaced
 from arcosim.identification.output_error import MotorRecord, motor_record, uniform_chain
 from benchmarks.accuracy import ACTUATOR, CASES, G_DIST, run_case
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import LoadProfile
-from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION
+from arcosim.fmu.flexchain.codes import Estimator, Mode
 from arcosim.identification.load_torque import LoadScore, estimate_load_torque, score_profile
 from benchmarks.cases import CASES, Case, run_case, settings_for
 
@@ -78,8 +78,8 @@ def row_estimate(
     extra = {} if bandwidth is None else {"load_torque_bandwidth": bandwidth}
     settings = settings_for(
         case,
-        STATE_ESTIMATION,
-        estimator=MODEL_BASED,
+        Mode.STATE_ESTIMATION,
+        estimator=Estimator.MODEL_BASED,
         load_mass=row.load_mass,
         J=tuple(row.J_scale * x for x in case.J),
         k=tuple(row.k_scale * x for x in case.k),

@@ -1,13 +1,14 @@
 """One-off measurement: the noise levels the model-based observer's Kalman design solves.
 
-Behind ``NOISE_RANGE`` and ``NOISE_RATIO`` in ``fmu_src/arobserver/fmu.py``: designs
-the steady-state gain (:func:`arcosim.fmu.flexchain.model_observer.step_model`) for
-torque_noise_std and tau_noise_std at the corners and inside of the envelope (both
-in [LOW, HIGH] N.m, neither more than RATIO times the other), over n = 1, 3, 8
-masses (bench chains), encoders of 0, 64, 2000 and 2^20 counts, steps 1e-5 … 1e-2 s
-and g_dist 10, 100, 1000 rad/s, and prints how many fail.
+Behind ``NOISE_RANGE`` and ``NOISE_RATIO`` of :mod:`arcosim.fmu.flexchain.model_observer`
+(LOW, HIGH and RATIO when no arguments are given): designs the steady-state gain
+(:func:`arcosim.fmu.flexchain.model_observer.step_model`) for torque_noise_std and
+tau_noise_std at the corners and inside of the envelope (both in [LOW, HIGH] N.m,
+neither more than RATIO times the other), over n = 1, 3, 8 masses (bench chains),
+encoders of 0, 64, 2000 and 2^20 counts, steps 1e-5 … 1e-2 s and g_dist 10, 100,
+1000 rad/s, and prints how many fail.
 
-    python -m benchmarks.noise_envelope 1e-9 1e4 1e8    # 3312 designs, 0 failed (~3 min)
+    python -m benchmarks.noise_envelope                 # 3312 designs, 0 failed (~3 min)
     python -m benchmarks.noise_envelope 1e-9 1e6 1e15   # fails where one is 1e10 x the other
 """
 
@@ -18,8 +19,8 @@ import math
 import sys
 import time
 
-from arcosim.fmu.flexchain import bench
-from arcosim.fmu.flexchain.model_observer import NoiseModel, step_model
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.model_observer import NOISE_RANGE, NOISE_RATIO, NoiseModel, step_model
 
 
 def envelope_pairs(low: float, high: float, ratio: float) -> list[tuple[float, float]]:
@@ -40,7 +41,7 @@ def main(argv: list[str]) -> int:
     low, high, ratio = (float(x) for x in argv[:3])
     failed, count, start = [], 0, time.perf_counter()
     for n in (1, 3, 8):
-        J, k, B = bench.inertias(n), [bench.K] * n, [bench.B] * n
+        J, k, B = defaults.inertias(n), [defaults.K] * n, [defaults.B] * n
         for cpr, (torque, tau) in itertools.product(
             (0, 64, 2000, 1 << 20), envelope_pairs(low, high, ratio)
         ):
@@ -66,4 +67,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:] or ["1e-9", "1e4", "1e8"]))
+    sys.exit(main(sys.argv[1:] or [repr(x) for x in (*NOISE_RANGE, NOISE_RATIO)]))

@@ -41,7 +41,7 @@ from arcosim.build.recipes import OBSERVER, PLANT
 from arcosim.errors import UserError
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import SCENARIOS
-from arcosim.fmu.flexchain.observer import STATE_ESTIMATION
+from arcosim.fmu.flexchain.codes import Mode
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import MEASURED, cosimulate
 from benchmarks import field_accuracy
@@ -182,7 +182,7 @@ def plain_python_step(duration: float) -> float:
     from benchmarks.cases import CASES, settings_for
 
     i_a, w, th = _bench_sensors(duration)
-    observer = Observer(settings_for(CASES[0], STATE_ESTIMATION), th[0], w[0])
+    observer = Observer(settings_for(CASES[0], Mode.STATE_ESTIMATION), th[0], w[0])
     step = observer.step
     started = time.perf_counter()
     for k in range(1, len(th)):

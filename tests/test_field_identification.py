@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from arcosim.fmu.flexchain import defaults, excitation
+from arcosim.fmu.flexchain import defaults, waveforms
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.chain_excitation import ExcitationError, design_excitation
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
@@ -199,7 +199,7 @@ def test_excite_designs_what_the_excitation_source_plays() -> None:
         "lines": 40,
         "seed": 1,
     }
-    same = [excitation.multisine(t, 3.0, list(e.frequencies), list(e.phases)) for t in e.time[:50]]
+    same = [waveforms.multisine(t, 3.0, list(e.frequencies), list(e.phases)) for t in e.time[:50]]
     np.testing.assert_allclose(e.signal[:50], same, atol=1e-12)
     assert np.max(np.abs(e.signal)) <= 3.0 and not e.warnings
     weak = design_excitation((3.0, 150.0), 1.0, k_t=defaults.K_T, f_c=defaults.F_C)

@@ -73,7 +73,7 @@ def test_a_host_with_its_own_fmukit_flexchain_pythonfmu_gets_the_fmus_results(
     shadow = tmp_path / "host_packages"
     for package, modules in {
         "fmukit": ["slave", "state", "variables", "checks", "model_description", "units"],
-        "flexchain": ["dob", "observer", "excitation", "bench", "linalg", "chain"],
+        "flexchain": ["dob", "observer", "waveforms", "bench", "linalg", "chain"],
         "pythonfmu": ["fmi2slave", "enums"],
     }.items():
         (shadow / package).mkdir(parents=True)

@@ -10,7 +10,7 @@ from fmpy.validation import validate_fmu
 
 from arcosim.errors import UserError
 from arcosim.experiments import excitation
-from arcosim.fmu.flexchain.excitation import log_spaced
+from arcosim.fmu.flexchain.waveforms import log_spaced
 from arcosim.host.instance import FmuInstance
 
 

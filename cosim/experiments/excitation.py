@@ -1,6 +1,6 @@
 """Current commands (A) sampled at the communication steps, for scripts and scenarios.
 
-Thin array wrappers over :mod:`arcosim.fmu.flexchain.excitation`, the standard-library
+Thin array wrappers over :mod:`arcosim.fmu.flexchain.waveforms`, the standard-library
 implementation that the ExcitationSource FMU runs too. Every function takes the
 step times ``t`` (s, shape ``(N,)``) and returns the current held over each step
 (shape ``(N,)``).
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from arcosim.fmu.flexchain import excitation as _signals
+from arcosim.fmu.flexchain import waveforms as _signals
 
 
 def rigid_maneuver(
@@ -25,7 +25,7 @@ def rigid_maneuver(
     The current is proportional to the acceleration of ``w(t) sin(ω t)``, ``w`` a
     raised-cosine window of ``ramp_periods`` periods each side, so the chain swings
     about its start and comes back to rest there (mode 1, eq. 17–21); see
-    :func:`arcosim.fmu.flexchain.excitation.rigid_maneuver`.
+    :func:`arcosim.fmu.flexchain.waveforms.rigid_maneuver`.
 
     Parameters
     ----------

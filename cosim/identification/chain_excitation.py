@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arcosim.fmu.flexchain import excitation
+from arcosim.fmu.flexchain import waveforms as excitation
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.identification.errors import IdentificationError
 

@@ -11,21 +11,16 @@ from __future__ import annotations
 from typing import ClassVar
 
 from ..flexchain import defaults
+from ..flexchain.codes import Mode
 from ..flexchain.dob import Actuator
-from ..flexchain.load_observer import LOAD_TORQUE_BANDWIDTH, SMOOTHING_RATIO
-from ..flexchain.observer import (
-    MODEL_BASED,
-    RIGID_IDENTIFICATION,
-    SELF_IDENTIFICATION,
-    STATE_ESTIMATION,
-    Observer,
-    ObserverSettings,
-)
+from ..flexchain.least_squares import MIN_ROWS, RCOND_MIN
+from ..flexchain.load_observer import SMOOTHING_RATIO
+from ..flexchain.observer import Observer, ObserverSettings
+from ..flexchain.self_identification import SETTLE
 from ..fmukit import (
     FmuSlave,
     Variable,
     array,
-    choice_problem,
     indexed,
     inp,
     out,
@@ -34,21 +29,6 @@ from ..fmukit import (
 )
 from ..fmukit.checks import chain_rate_problems
 
-MODES = {
-    0: "actuator self-identification",
-    1: "rigid-maneuver chain identification",
-    2: "state estimation",
-}
-ESTIMATORS = {0: "the paper's recursion", 1: "model-based observer"}
-#: Noise levels (N.m) the model-based observer's Kalman design is known to solve:
-#: torque_noise_std and tau_noise_std each in this range, neither more than
-#: NOISE_RATIO times the other. Checked over n = 1, 3, 8 masses, encoders of 0 (none),
-#: 64, 2000 and 2^20 counts, steps 1e-5 … 1e-2 s and g_dist 10 … 1000 rad/s: 3312
-#: designs, none failed (``python -m benchmarks.noise_envelope``); outside it (a noise
-#: of 0, or one 1e10 times the other) the Riccati iteration fails to converge or meets
-#: a singular matrix. The load-torque state (load_mass > 0) was not part of that check.
-NOISE_RANGE = (1e-9, 1e4)
-NOISE_RATIO = 1e8
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
 IDENTIFICATION_OUTPUTS = (
     "dkt_hat",
@@ -88,7 +68,7 @@ class ReactionTorqueObserver(FmuSlave):
             inp("theta_m", 0.0, "rad", "Measured motor angle at the sample"),
             par(
                 "mode",
-                STATE_ESTIMATION,
+                int(defaults.MODE),
                 "",
                 "0 = actuator self-identification (load detached), 1 = chain identification "
                 "from a rigid maneuver, 2 = state estimation",
@@ -128,14 +108,14 @@ class ReactionTorqueObserver(FmuSlave):
             ),
             par(
                 "kappa_correction",
-                True,
+                defaults.KAPPA_CORRECTION,
                 "",
                 "Mode 1: multi-mass correction kappa (docs/method.md); false gives the "
                 "paper's literal eq. 21",
             ),
             par(
                 "estimator",
-                0,
+                int(defaults.ESTIMATOR),
                 "",
                 "Mode 2: 0 = the paper's recursion (eq. 22-26); 1 = model-based observer "
                 "(chain model driven by theta_m, Kalman-corrected by tau_reac_hat)",
@@ -150,26 +130,26 @@ class ReactionTorqueObserver(FmuSlave):
             ),
             par(
                 "torque_noise_std",
-                1e-4,
+                defaults.TORQUE_NOISE_STD,
                 "N.m",
                 "Estimator 1: unmodelled white torque on each load mass (Kalman design)",
             ),
             par(
                 "tau_noise_std",
-                1.5e-3,
+                defaults.TAU_NOISE_STD,
                 "N.m",
                 "Estimator 1: white noise on tau_reac_hat (Kalman design)",
             ),
             par(
                 "load_mass",
-                0,
+                defaults.LOAD_MASS,
                 "",
                 "Estimator 1: 0 = off; i = also estimate the external torque on load mass i "
                 "(one mass: constant torques on several masses show only as their sum)",
             ),
             par(
                 "load_torque_bandwidth",
-                LOAD_TORQUE_BANDWIDTH,
+                defaults.LOAD_TORQUE_BANDWIDTH,
                 "rad/s",
                 "Estimator 1 with load_mass > 0: bandwidth of the load torque estimate "
                 "(random-walk noise of the Kalman design; the output is smoothed by a "
@@ -177,14 +157,14 @@ class ReactionTorqueObserver(FmuSlave):
             ),
             par(
                 "omega_min",
-                5.0,
+                defaults.OMEGA_MIN,
                 "rad/s",
                 "Mode 0: speed below which the motor counts as stopped; such samples and the "
-                "5/g_dist + 5/g_id s after them are left out of the fit",
+                f"{SETTLE:g}/g_dist + {SETTLE:g}/g_id s after them are left out of the fit",
             ),
             par(
                 "g_id",
-                30.0,
+                defaults.G_ID,
                 "rad/s",
                 "Mode 0: bandwidth of an extra low-pass on the fit's target and regressors "
                 "(reduces encoder noise in the acceleration); 0 = off",
@@ -225,8 +205,8 @@ class ReactionTorqueObserver(FmuSlave):
             out(
                 "id_valid",
                 "",
-                "Mode 0/1: the fit has at least 40 samples and its scaled normal matrix a "
-                "reciprocal condition number >= 1e-10 (mode 1: and k_hat > 0)",
+                f"Mode 0/1: the fit has at least {MIN_ROWS} samples and its scaled normal matrix a "
+                f"reciprocal condition number >= {RCOND_MIN:g} (mode 1: and k_hat > 0)",
                 "Boolean",
             ),
         ]
@@ -258,52 +238,18 @@ class ReactionTorqueObserver(FmuSlave):
         )
         if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
             problems.append("parameters J_mo + dJm must be > 0 (the motor inertia)")
-        if not problems and self.value("mode") == STATE_ESTIMATION:  # the chain is a model
+        if not problems and self.value("mode") == Mode.STATE_ESTIMATION:  # the chain is a model
             problems += chain_rate_problems(
                 self.value, None, indexed("J", n), indexed("k", n), indexed("B", n)
             )
-        for problem in (
-            choice_problem("mode", self.value("mode"), MODES),
-            choice_problem("estimator", self.value("estimator"), ESTIMATORS),
-        ):
-            if problem is not None:
-                problems.append(problem)
-        model_based = (
-            self.value("mode") == STATE_ESTIMATION and self.value("estimator") == MODEL_BASED
-        )
-        if model_based and not problems:
-            torque, tau = self.value("torque_noise_std"), self.value("tau_noise_std")
-            low, high = NOISE_RANGE
-            inside = low <= torque <= high and low <= tau <= high
-            if not inside or max(torque / tau, tau / torque) > NOISE_RATIO:
-                problems.append(
-                    f"parameters torque_noise_std = {torque!r} and tau_noise_std = {tau!r} N.m: "
-                    "the model-based observer (mode 2, estimator 1) designs its Kalman gain "
-                    f"for noise on both; give each from {low:g} to {high:g} N.m, neither more "
-                    f"than {NOISE_RATIO:g} times the other (defaults 1e-4 and 1.5e-3)"
-                )
-        return problems + self.load_mass_problems()
+        # the observer's own rules; its noise levels only once every number is in range
+        return problems + self.settings().problems(noise=not problems)
 
-    def load_mass_problems(self) -> list[str]:
-        """A sentence if ``load_mass`` names no load mass or the mode cannot run it."""
-        load_mass, mode, estimator = self.values(["load_mass", "mode", "estimator"])
-        n = self.n_masses
-        if not 0 <= load_mass <= n:
-            return [
-                f"parameter load_mass = {load_mass} is not allowed (use 0 = off, or a load "
-                f"mass 1 to {n})"
-            ]
-        if load_mass and not (mode == STATE_ESTIMATION and estimator == MODEL_BASED):
-            return [
-                f"parameter load_mass = {load_mass} needs mode = 2 and estimator = 1 (the "
-                "model-based observer); set load_mass = 0 otherwise"
-            ]
-        return []
-
-    def initialize(self) -> None:
+    def settings(self) -> ObserverSettings:
+        """The parameters as the observer's settings."""
         n = self.n_masses
         v = self.value
-        settings = ObserverSettings(
+        return ObserverSettings(
             mode=v("mode"),
             actuator=Actuator(v("J_mo"), v("k_to"), v("dkt"), v("dJm"), v("D_m"), v("f_c")),
             g_dist=v("g_dist"),
@@ -321,6 +267,11 @@ class ReactionTorqueObserver(FmuSlave):
             load_mass=v("load_mass"),
             load_torque_bandwidth=v("load_torque_bandwidth"),
         )
+
+    def initialize(self) -> None:
+        n = self.n_masses
+        v = self.value
+        settings = self.settings()
         self.observer = Observer(settings, v("theta_m"), v("omega_m"))
         self.inputs = self.indices(["i_a", "omega_m", "theta_m"])
         self.out_theta = self.indices(indexed("theta_hat", n))
@@ -339,7 +290,7 @@ class ReactionTorqueObserver(FmuSlave):
         self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
         self.out_load = self.vr["tau_load_hat"] if settings.load_mass else None
 
-        if settings.mode == STATE_ESTIMATION:
+        if settings.mode == Mode.STATE_ESTIMATION:
             for i, x in zip(self.out_theta, self.observer.estimator.theta):
                 self.v[i] = x
 
@@ -365,13 +316,13 @@ class ReactionTorqueObserver(FmuSlave):
         obs = self.observer
         obs.estimate()
         ident, v, vr = obs.identifier, self.v, self.vr
-        if obs.settings.mode == SELF_IDENTIFICATION:
+        if obs.settings.mode == Mode.SELF_IDENTIFICATION:
             v[vr["dkt_hat"]] = ident.dkt
             v[vr["dJm_hat"]] = ident.dJm
             v[vr["D_m_hat"]] = ident.D_m
             v[vr["f_c_hat"]] = ident.f_c
             v[vr["self_id_rank_deficient"]] = ident.rank_deficient
-        elif obs.settings.mode == RIGID_IDENTIFICATION:
+        elif obs.settings.mode == Mode.RIGID_IDENTIFICATION:
             v[vr["k_hat"]] = ident.k
             v[vr["B_hat"]] = ident.B
             v[vr["theta_rigid_hat"]] = ident.theta_rigid

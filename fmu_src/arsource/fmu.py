@@ -1,7 +1,8 @@
 """``ExcitationSource``: the scenarios' current commands as an FMI 2.0 co-simulation FMU.
 
 Feeds the plant's ``i_ref`` in any FMI host (an SSP system, ecos, Simulink) with the
-same signals that ``arcosim.experiments.excitation`` gives offline. After ``doStep(t, h)`` the
+same signals that ``arcosim.experiments.excitation`` gives offline (both evaluate
+:mod:`arcosim.fmu.flexchain.waveforms`). After ``doStep(t, h)`` the
 output is the command for the step that starts at ``t + h``.
 """
 
@@ -9,16 +10,9 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from ..flexchain import excitation
-from ..fmukit import FmuSlave, Variable, choice_problem, out, par, range_problems
-
-RIGID, MULTISINE, CHIRP, RANDOM = 0, 1, 2, 3
-SIGNALS = {
-    RIGID: "rigid maneuver",
-    MULTISINE: "multi-sine",
-    CHIRP: "chirp",
-    RANDOM: "filtered random",
-}
+from ..flexchain import defaults, waveforms
+from ..flexchain.codes import SIGNAL_NAMES, Signal, choice_problem
+from ..fmukit import FmuSlave, Variable, out, par, range_problems
 
 
 class ExcitationSource(FmuSlave):
@@ -35,20 +29,20 @@ class ExcitationSource(FmuSlave):
         return [
             par(
                 "signal",
-                RIGID,
+                int(Signal.RIGID),
                 "",
-                "0 = rigid maneuver, 1 = multi-sine, 2 = chirp, 3 = filtered random",
+                ", ".join(f"{int(code)} = {name}" for code, name in SIGNAL_NAMES.items()),
             ),
             par(
                 "amplitude",
-                3.0,
+                defaults.RIGID_AMPLITUDE,
                 "A",
                 "Peak current (rms for filtered random); the rigid maneuver's needs to be "
                 "well above f_c / k_t",
             ),
             par(
                 "frequency",
-                2.1,
+                defaults.RIGID_FREQUENCY,
                 "rad/s",
                 "Rigid maneuver frequency; lowest multi-sine line; chirp start",
             ),
@@ -58,8 +52,18 @@ class ExcitationSource(FmuSlave):
                 "rad/s",
                 "Highest multi-sine line; chirp end; filtered random cut-off",
             ),
-            par("periods", 8, "", "Rigid maneuver length in periods, ramps included"),
-            par("ramp_periods", 3, "", "Rigid maneuver raised-cosine ramp length in periods"),
+            par(
+                "periods",
+                defaults.RIGID_PERIODS,
+                "",
+                "Rigid maneuver length in periods, ramps included",
+            ),
+            par(
+                "ramp_periods",
+                defaults.RIGID_RAMP_PERIODS,
+                "",
+                "Rigid maneuver raised-cosine ramp length in periods",
+            ),
             par("lines", 10, "", "Number of multi-sine lines (log-spaced)"),
             par("duration", 10.0, "s", "Chirp length; 0 after it"),
             par("offset", 0.0, "A", "Constant added to the signal"),
@@ -74,7 +78,7 @@ class ExcitationSource(FmuSlave):
             positive=["frequency", "frequency_end", "duration"],
             finite=["amplitude", "offset"],
         )
-        problem = choice_problem("signal", v("signal"), SIGNALS)
+        problem = choice_problem("signal", v("signal"), SIGNAL_NAMES)
         if problem:
             problems.append(problem)
         for name, least in (("periods", 1), ("ramp_periods", 1), ("lines", 1)):
@@ -94,26 +98,26 @@ class ExcitationSource(FmuSlave):
         self.frequency, self.frequency_end = v("frequency"), v("frequency_end")
         self.periods, self.ramp_periods = v("periods"), v("ramp_periods")
         self.duration = v("duration")
-        self.lines = excitation.log_spaced(self.frequency, self.frequency_end, v("lines"))
-        self.phases = excitation.multisine_phases(v("lines"), v("seed"))
-        self.noise = excitation.FilteredNoise(self.amplitude, self.frequency_end, v("seed"))
+        self.lines = waveforms.log_spaced(self.frequency, self.frequency_end, v("lines"))
+        self.phases = waveforms.multisine_phases(v("lines"), v("seed"))
+        self.noise = waveforms.FilteredNoise(self.amplitude, self.frequency_end, v("seed"))
         self.out_vr = self.vr["i_ref"]
         t0 = self.time or 0.0
-        self.v[self.out_vr] = 0.0 if self.signal == RANDOM else self.command(t0, 0.0)
+        self.v[self.out_vr] = 0.0 if self.signal == Signal.RANDOM else self.command(t0, 0.0)
 
     def step(self, t: float, h: float) -> None:
         self.v[self.out_vr] = self.command(t + h, h)
 
     def command(self, t: float, h: float) -> float:
         """The command at time ``t`` (s); ``h`` is the step just taken (random signal)."""
-        if self.signal == RIGID:
-            x = excitation.rigid_maneuver(
+        if self.signal == Signal.RIGID:
+            x = waveforms.rigid_maneuver(
                 t, self.amplitude, self.frequency, self.periods, self.ramp_periods
             )
-        elif self.signal == MULTISINE:
-            x = excitation.multisine(t, self.amplitude, self.lines, self.phases)
-        elif self.signal == CHIRP:
-            x = excitation.chirp(
+        elif self.signal == Signal.MULTISINE:
+            x = waveforms.multisine(t, self.amplitude, self.lines, self.phases)
+        elif self.signal == Signal.CHIRP:
+            x = waveforms.chirp(
                 t, self.amplitude, self.frequency, self.frequency_end, self.duration
             )
         else:

@@ -1,8 +1,42 @@
-"""Algorithms of the action-reaction method for flexible drives.
+"""``fmu_src/flexchain/`` installed as ``arcosim.fmu.flexchain``: the algorithms of the
+action-reaction method for flexible drives, in pure Python.
 
-Pure Python (standard library only): the package is bundled into the FMUs and runs
-in any host that has a Python 3. Modules:
+Standard library only: the package is bundled into the FMUs and runs in any host that has
+a Python 3, and the offline tools (``arcosim.identification``, the experiments, the
+benchmarks) run the same code. Modules, in the order data flows:
 
-* :mod:`arcosim.fmu.flexchain.linalg` — small dense matrices as lists of lists, matrix exponential.
-* :mod:`arcosim.fmu.flexchain.chain` — the motor–spring–mass chain as a linear model.
+Settings
+
+* :mod:`~arcosim.fmu.flexchain.defaults` — every default of the project (SI units).
+* :mod:`~arcosim.fmu.flexchain.codes` — the codes of modes, estimators and signals (enums).
+
+Foundations
+
+* :mod:`~arcosim.fmu.flexchain.linalg` — small dense matrices as lists of lists, the
+  matrix exponential.
+* :mod:`~arcosim.fmu.flexchain.chain` — the motor–spring–mass chain as a linear model.
+* :mod:`~arcosim.fmu.flexchain.driven_chain` — the load chain driven by the motor angle,
+  exact over each step.
+* :mod:`~arcosim.fmu.flexchain.filters` — G(s) = g/(s + g), exact for the step taken.
+
+The signals
+
+* :mod:`~arcosim.fmu.flexchain.waveforms` — the current commands: rigid maneuver,
+  multi-sine, chirp, filtered noise.
+* :mod:`~arcosim.fmu.flexchain.noise` — reproducible noise and the encoder model (the
+  plant's sensors).
+
+The observer
+
+* :mod:`~arcosim.fmu.flexchain.dob` — disturbance and reaction torque observers (eq. 8–16).
+* :mod:`~arcosim.fmu.flexchain.least_squares` — normal equations, one sample at a time.
+* :mod:`~arcosim.fmu.flexchain.self_identification` — mode 0: the actuator's terms.
+* :mod:`~arcosim.fmu.flexchain.rigid_identification` — mode 1: k and B from a rigid
+  maneuver.
+* :mod:`~arcosim.fmu.flexchain.recursion` — mode 2, estimator 0: the paper's recursion.
+* :mod:`~arcosim.fmu.flexchain.model_observer` — mode 2, estimator 1: the model-based
+  observer and the noise levels its Kalman design solves.
+* :mod:`~arcosim.fmu.flexchain.load_observer` — the same with the torque on one load mass.
+* :mod:`~arcosim.fmu.flexchain.observer` — the settings, their rules
+  (``ObserverSettings.problems``) and the observer that runs the configured mode.
 """

@@ -19,8 +19,16 @@ def spring_matrix(gains: Sequence[float]) -> Matrix:
     For stiffnesses it is the stiffness matrix K, for dampings the damping matrix:
     the torque on the bodies is ``−K θ − C θ̇``.
 
-    Args:
-        gains: ``k_1 … k_n`` (or ``B_1 … B_n``), one per spring.
+    Parameters
+    ----------
+    gains : Sequence[float]
+        ``k_1 … k_n`` (N·m/rad) or ``B_1 … B_n`` (N·m·s/rad), one per spring, shape
+        ``(n,)``.
+
+    Returns
+    -------
+    Matrix
+        The Laplacian, shape ``(n + 1, n + 1)``, in the unit of ``gains``.
     """
     n = len(gains)
     m = zeros(n + 1, n + 1)
@@ -35,11 +43,19 @@ def spring_matrix(gains: Sequence[float]) -> Matrix:
 def spring_torques(
     k: Sequence[float], B: Sequence[float], theta: Sequence[float], omega: Sequence[float]
 ) -> list[float]:
-    """Torques ``τ_1 … τ_n`` (N·m) carried by the springs.
+    """Torques ``τ_1 … τ_n`` carried by the springs.
 
-    Args:
-        k, B: per-spring stiffness (N·m/rad) and damping (N·m·s/rad), length n.
-        theta, omega: angles (rad) and velocities (rad/s) of bodies 0 … n.
+    Parameters
+    ----------
+    k, B : Sequence[float]
+        Per-spring stiffness (N·m/rad) and damping (N·m·s/rad), shape ``(n,)`` each.
+    theta, omega : Sequence[float]
+        Angles (rad) and velocities (rad/s) of bodies 0 … n, shape ``(n + 1,)`` each.
+
+    Returns
+    -------
+    list of float
+        The spring torques (N·m), shape ``(n,)``.
     """
     return [
         k[i] * (theta[i] - theta[i + 1]) + B[i] * (omega[i] - omega[i + 1]) for i in range(len(k))

@@ -9,6 +9,8 @@ and the offline tools (identification, scenarios, benchmarks) read them from her
 
 from __future__ import annotations
 
+from .codes import Estimator, Mode
+
 # -- the plant: the paper's bench ---------------------------------------------------
 J_M = 2.09e-5  #: motor inertia (kg·m²)
 K_T = 0.0406  #: torque constant (N·m/A)
@@ -29,6 +31,27 @@ G_LPF = 100.0  #: bandwidth of the filter on the recursion's later stages (rad/s
 #: Offline, the motor velocity is the angle's derivative smoothed without lag at this
 #: many times g_dist (G(s) has removed most of what it cuts there).
 VELOCITY_SMOOTHING = 4.0
+MODE = Mode.STATE_ESTIMATION  #: what the observer FMU runs unless told otherwise
+ESTIMATOR = Estimator.RECURSION  #: mode 2's estimator: the paper's recursion
+KAPPA_CORRECTION = True  #: mode 1 applies the multi-mass correction κ
+OMEGA_MIN = 5.0  #: mode 0: speed below which the motor counts as stopped (rad/s)
+G_ID = 30.0  #: mode 0: bandwidth of the extra low-pass on the fit (rad/s; 0 = none)
+TORQUE_NOISE_STD = 1e-4  #: model-based observer: unmodelled torque on each mass (N·m)
+TAU_NOISE_STD = 1.5e-3  #: model-based observer: white noise on τ̂_reac (N·m)
+LOAD_MASS = 0  #: the load mass whose external torque is estimated (0 = none)
+#: Bandwidth ω_L of the load torque estimate (rad/s). Measured on the bench (README,
+#: "Sensorless load torque"): 5 rad/s keeps a step's settled error within 1 % with
+#: realistic sensors and within 10 % with inertias 1 % off, with a 0.47 s lag at 2 rad/s;
+#: 10 rad/s cuts the lag to 0.34 s but quadruples what a 1 % model error leaks in (a
+#: model error at a frequency inside the bandwidth looks like a load torque).
+LOAD_TORQUE_BANDWIDTH = 5.0
+
+# -- the excitation source: the rigid maneuver of mode 1 ---------------------------------
+#: Peak current (A): well above f_c / k_t ≈ 0.05 A (``waveforms.rigid_maneuver``).
+RIGID_AMPLITUDE = 3.0
+RIGID_FREQUENCY = 2.1  #: about an eighth of the bench's first mode (rad/s)
+RIGID_PERIODS = 8  #: the maneuver's length in periods, ramps included (a count)
+RIGID_RAMP_PERIODS = 3  #: each raised-cosine ramp's length in periods (a count)
 
 # -- the co-simulation ----------------------------------------------------------------
 STEP = 1e-3  #: communication step (s)

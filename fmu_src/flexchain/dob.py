@@ -88,25 +88,40 @@ def clamp(x: float, bound: float) -> float:
 class ReactionObserver:
     """DOB and reaction torque observer on one filter bank ``G(s) = g/(s+g)``.
 
-    Args:
-        actuator: nominal and identified actuator terms.
-        g: observer bandwidth ``g_dist`` (rad/s).
-        theta0: motor angle at start (rad).
-        omega0: motor velocity at start (rad/s).
+    Parameters
+    ----------
+    actuator : Actuator
+        Nominal and identified actuator terms.
+    g : float
+        Observer bandwidth ``g_dist`` (rad/s).
+    theta0 : float
+        Motor angle at start (rad).
+    omega0 : float
+        Motor velocity at start (rad/s).
 
-    Attributes (after :meth:`step`):
-        d_hat: disturbance estimate (N·m).
-        tau_reac_hat: reaction torque estimate (N·m).
-        alpha_hat: low-passed motor acceleration (rad/s²).
-        accel: unfiltered velocity change over the last step / h (rad/s²).
-        velocity: mean velocity over the last step (rad/s).
-        friction_sign: mean of sgn θ̇ over the last step (:func:`mean_sign`).
-        sticking: the motor stood still at one end of the last step, so static
-            friction (unknown within ±f_c) may have acted during it.
-        torque: the unfiltered reaction torque of the last step (N·m).
-        drive: the torque on the motor other than Coulomb friction over the last
-            step, ``k_t i − J_m α − D v`` (N·m): the reaction torque is
-            ``drive − f_c · friction_sign`` when the motor moved throughout.
+    Attributes
+    ----------
+    d_hat : float
+        After :meth:`step`: disturbance estimate (N·m).
+    tau_reac_hat : float
+        Reaction torque estimate (N·m).
+    alpha_hat : float
+        Low-passed motor acceleration (rad/s²).
+    accel : float
+        Unfiltered velocity change over the last step / h (rad/s²).
+    velocity : float
+        Mean velocity over the last step (rad/s).
+    friction_sign : float
+        Mean of sgn θ̇ over the last step, −1 … 1 (:func:`mean_sign`; dimensionless).
+    sticking : bool
+        The motor stood still at one end of the last step, so static friction
+        (unknown within ±f_c) may have acted during it.
+    torque : float
+        The unfiltered reaction torque of the last step (N·m).
+    drive : float
+        The torque on the motor other than Coulomb friction over the last step,
+        ``k_t i − J_m α − D v`` (N·m): the reaction torque is
+        ``drive − f_c · friction_sign`` when the motor moved throughout.
     """
 
     def __init__(self, actuator: Actuator, g: float, theta0: float, omega0: float) -> None:
@@ -132,13 +147,18 @@ class ReactionObserver:
         self._a = 1.0  # e^{−g h}
 
     def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
-        """Take the sample (i_a, ω, θ) that ends a step of ``h`` seconds.
+        """Take the sample (i_a, ω, θ) that ends a step.
 
-        Args:
-            h: time since the previous sample (s), > 0.
-            i_a: current that acted over the step (A).
-            omega: motor velocity at the sample (rad/s).
-            theta: motor angle at the sample (rad).
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        i_a : float
+            Current that acted over the step (A).
+        omega : float
+            Motor velocity at the sample (rad/s).
+        theta : float
+            Motor angle at the sample (rad).
         """
         if h != self._h:
             self._h = h

@@ -34,12 +34,18 @@ def continuous_matrices(
 ) -> tuple[Matrix, Matrix]:
     """``ẋ = A x + E [θ_m, θ̇_m]`` for the load state ``x = [θ_1…θ_n, ω_1…ω_n]``.
 
-    Args:
-        J: load inertias (kg·m²), length n.
-        k, B: stiffness (N·m/rad) and damping (N·m·s/rad) of springs 1 … n.
+    Parameters
+    ----------
+    J : Sequence[float]
+        Load inertias (kg·m²), shape ``(n,)``.
+    k, B : Sequence[float]
+        Stiffness (N·m/rad) and damping (N·m·s/rad) of springs 1 … n, shape ``(n,)``
+        each.
 
-    Returns:
-        ``A`` (2n × 2n) and ``E`` (2n × 2).
+    Returns
+    -------
+    tuple of Matrix
+        ``A``, shape ``(2n, 2n)``, and ``E``, shape ``(2n, 2)`` (SI units: 1/s, 1/s²).
     """
     n = len(J)
     A = linalg.zeros(2 * n, 2 * n)
@@ -69,11 +75,16 @@ def continuous_matrices(
 class DiscreteChain:
     """The chain over one step of ``h`` s (see the module docstring).
 
-    Attributes:
-        h: step (s).
-        J: load inertias (kg·m²).
-        Ad: state transition, 2n × 2n.
-        Bd: input matrix for ``[θ_m,k−1, v_k]``, 2n × 2.
+    Parameters
+    ----------
+    h : float
+        Step (s).
+    J : tuple of float
+        Load inertias (kg·m²), shape ``(n,)``.
+    Ad : Matrix
+        State transition, shape ``(2n, 2n)``.
+    Bd : Matrix
+        Input matrix for ``[θ_m,k−1, v_k]`` (rad, rad/s), shape ``(2n, 2)``.
     """
 
     h: float
@@ -87,7 +98,13 @@ class DiscreteChain:
         return len(self.J)
 
     def torque_row(self) -> tuple[list[float], list[float]]:
-        """``τ̄_k = c · x_{k−1} + d · [θ_m,k−1, v_k]``: the rows ``c`` (2n) and ``d`` (2)."""
+        """The step's mean reaction torque ``τ̄_k = c · x_{k−1} + d · [θ_m,k−1, v_k]`` (N·m).
+
+        Returns
+        -------
+        tuple of (list of float, list of float)
+            The rows ``c``, shape ``(2n,)``, and ``d``, shape ``(2,)``.
+        """
         n, h = self.n, self.h
         c = [0.0] * (2 * n)
         d = [0.0, 0.0]
@@ -111,6 +128,22 @@ def discretize(
 
     The augmented state ``[x, θ_m, v]`` has ``d/dt θ_m = v``, ``d/dt v = 0``; one
     matrix exponential of size 2n + 2 gives ``Ad`` and ``Bd``.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape
+        ``(n,)`` each.
+    h : float
+        Step (s).
+    expm : callable
+        The matrix exponential (:func:`~arcosim.fmu.flexchain.linalg.expm`, or scipy's
+        offline).
+
+    Returns
+    -------
+    DiscreteChain
+        ``Ad`` and ``Bd`` for this step.
     """
     A, E = continuous_matrices(J, k, B)
     m = len(A)

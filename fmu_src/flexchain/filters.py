@@ -14,21 +14,40 @@ import math
 
 
 def lowpass_pole(g: float, h: float) -> float:
-    """``e^{−g h}``: the pole of ``G(s) = g / (s + g)`` over a step of ``h`` (s) with the
-    input held, g in rad/s. The one discretization of G(s) in the project: the DOB, the
-    observers and the offline fits all take it from here."""
+    """``e^{−g h}``: the pole of ``G(s) = g / (s + g)`` over a step with the input held.
+
+    The one discretization of G(s) in the project: the DOB, the observers and the
+    offline fits all take it from here.
+
+    Parameters
+    ----------
+    g : float
+        Bandwidth (rad/s).
+    h : float
+        Step (s).
+
+    Returns
+    -------
+    float
+        The pole, in (0, 1] for g ≥ 0 (dimensionless).
+    """
     return math.exp(-g * h)
 
 
 class LowPassBank:
     """Several filters with one corner frequency, advanced together.
 
-    Args:
-        g: corner frequency (rad/s), > 0.
-        size: number of channels.
+    Parameters
+    ----------
+    g : float
+        Corner frequency (rad/s), > 0.
+    size : int
+        Number of channels (a count).
 
-    Attributes:
-        y: outputs, one per channel.
+    Attributes
+    ----------
+    y : list of float
+        Outputs, one per channel, shape ``(size,)``.
     """
 
     __slots__ = ("g", "y")
@@ -38,7 +57,20 @@ class LowPassBank:
         self.y = [0.0] * size
 
     def step(self, h: float, u: list[float]) -> list[float]:
-        """Advance every channel by ``h`` (s) with inputs ``u``; return the outputs."""
+        """Advance every channel by one step.
+
+        Parameters
+        ----------
+        h : float
+            Step (s).
+        u : list of float
+            Inputs held over the step, shape ``(size,)``.
+
+        Returns
+        -------
+        list of float
+            The outputs :attr:`y`, shape ``(size,)``.
+        """
         a = lowpass_pole(self.g, h)
         b = 1.0 - a
         self.y = [a * y + b * x for y, x in zip(self.y, u)]

@@ -15,13 +15,17 @@ from .linalg import solve
 #: Below this reciprocal condition number (of the normal matrix scaled to unit
 #: diagonal) a fit is called ill-conditioned.
 RCOND_MIN = 1e-10
+#: Fewest rows of a fit called valid (a count).
+MIN_ROWS = 40
 
 
 class NormalEquations:
     """Accumulated ``XᵀX`` and ``Xᵀy`` of a linear regression ``y ≈ X β``.
 
-    Args:
-        p: number of regressors.
+    Parameters
+    ----------
+    p : int
+        Number of regressors (a count).
     """
 
     def __init__(self, p: int) -> None:
@@ -31,7 +35,17 @@ class NormalEquations:
         self.count = 0
 
     def add(self, x: Sequence[float], y: float, weight: float = 1.0) -> None:
-        """Add one row ``x`` (length p) with target ``y``."""
+        """Add one row.
+
+        Parameters
+        ----------
+        x : Sequence[float]
+            The regressors, shape ``(p,)``.
+        y : float
+            The target.
+        weight : float
+            The row's weight (dimensionless).
+        """
         for r, xr in enumerate(x):
             if xr != 0.0:
                 wxr = weight * xr
@@ -42,12 +56,21 @@ class NormalEquations:
         self.count += 1
 
     def solve(self, columns: Sequence[int] | None = None) -> tuple[list[float], float]:
-        """Least-squares coefficients over ``columns`` (default all), others fixed at 0.
+        """Least-squares coefficients over ``columns``, the others fixed at 0.
 
-        Returns:
-            ``(beta, rcond)``: coefficients of length p (0 for columns left out, and
-            all 0 when the system is singular), and the reciprocal condition number
-            of the normal matrix scaled to unit diagonal (0 when singular).
+        Parameters
+        ----------
+        columns : Sequence[int], optional
+            The regressors fitted (indices); None: all.
+
+        Returns
+        -------
+        beta : list of float
+            Coefficients, shape ``(p,)``: 0 for columns left out, and all 0 when the
+            system is singular.
+        rcond : float
+            The reciprocal condition number of the normal matrix scaled to unit
+            diagonal (dimensionless; 0 when singular).
         """
         cols = list(range(self.p)) if columns is None else list(columns)
         beta = [0.0] * self.p
@@ -66,7 +89,18 @@ class NormalEquations:
 
 
 def reciprocal_condition(a: list[list[float]]) -> float:
-    """1-norm reciprocal condition number of a small symmetric matrix (exact inverse)."""
+    """1-norm reciprocal condition number of a small symmetric matrix (exact inverse).
+
+    Parameters
+    ----------
+    a : list of list of float
+        The matrix, shape ``(p, p)``.
+
+    Returns
+    -------
+    float
+        ``1 / (‖a‖₁ ‖a⁻¹‖₁)`` (dimensionless), 0 when ``a`` is singular.
+    """
     n = len(a)
     try:
         inv = solve(a, [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)])
@@ -80,7 +114,23 @@ def reciprocal_condition(a: list[list[float]]) -> float:
 
 
 def solve_normal(xtx: list[list[float]], xty: list[float]) -> tuple[list[float], float]:
-    """Solve small normal equations; return ``(beta, rcond)`` (zeros and 0 when singular)."""
+    """Solve small normal equations, scaled to unit diagonal.
+
+    Parameters
+    ----------
+    xtx : list of list of float
+        ``XᵀX``, shape ``(p, p)``.
+    xty : list of float
+        ``Xᵀy``, shape ``(p,)``.
+
+    Returns
+    -------
+    beta : list of float
+        The coefficients, shape ``(p,)`` (zeros when singular).
+    rcond : float
+        The scaled matrix's reciprocal condition number (dimensionless; 0 when
+        singular).
+    """
     p = len(xty)
     diag = [xtx[i][i] for i in range(p)]
     if min(diag) <= 0.0:

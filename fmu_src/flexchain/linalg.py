@@ -60,12 +60,40 @@ def norm_inf(a: Matrix) -> float:
 def solve(a: Matrix, b: Matrix) -> Matrix:
     """Solve ``a @ x = b`` by Gaussian elimination with partial pivoting.
 
-    Raises:
-        ValueError: if ``a`` is singular to working precision.
+    Parameters
+    ----------
+    a : Matrix
+        Shape ``(n, n)``.
+    b : Matrix
+        Right-hand sides, shape ``(n, m)``.
+
+    Returns
+    -------
+    Matrix
+        ``x``, shape ``(n, m)``.
+
+    Raises
+    ------
+    ValueError
+        If ``a`` is singular to working precision.
     """
-    n = len(a)
     lu = [row[:] for row in a]
     x = [row[:] for row in b]
+    _eliminate(lu, x)
+    _substitute_back(lu, x)
+    return x
+
+
+def _eliminate(lu: Matrix, x: Matrix) -> None:
+    """Forward elimination with partial pivoting, in place: ``lu`` becomes upper
+    triangular and ``x`` the right-hand sides that go with it.
+
+    Raises
+    ------
+    ValueError
+        If ``lu`` is singular to working precision.
+    """
+    n = len(lu)
     for col in range(n):
         pivot = max(range(col, n), key=lambda r: abs(lu[r][col]))
         if lu[pivot][col] == 0.0 or not math.isfinite(lu[pivot][col]):
@@ -83,6 +111,12 @@ def solve(a: Matrix, b: Matrix) -> Matrix:
                 xr, xc = x[r], x[col]
                 for c in range(len(xr)):
                     xr[c] -= f * xc[c]
+
+
+def _substitute_back(lu: Matrix, x: Matrix) -> None:
+    """Back substitution in place: ``x`` becomes the solution of the upper triangular
+    ``lu @ x = x``."""
+    n = len(lu)
     for col in range(n - 1, -1, -1):
         inv = 1.0 / lu[col][col]
         xc = x[col]
@@ -94,7 +128,6 @@ def solve(a: Matrix, b: Matrix) -> Matrix:
                 xr = x[r]
                 for c in range(len(xr)):
                     xr[c] -= f * xc[c]
-    return x
 
 
 def expm(a: Matrix) -> Matrix:
@@ -102,6 +135,21 @@ def expm(a: Matrix) -> Matrix:
 
     Golub & Van Loan, *Matrix Computations*, Algorithm 11.3.1: scale so that
     ``‖a‖∞ / 2^s ≤ 1/2``, where the approximant's relative error is below 1e-16.
+
+    Parameters
+    ----------
+    a : Matrix
+        Shape ``(n, n)``, finite (dimensionless: a time step is already in it).
+
+    Returns
+    -------
+    Matrix
+        ``e^a``, shape ``(n, n)``.
+
+    Raises
+    ------
+    ValueError
+        If ``a`` has a non-finite entry.
     """
     n = len(a)
     norm = norm_inf(a)

@@ -67,7 +67,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from . import linalg
+from . import defaults, linalg
 from .driven_chain import continuous_matrices, discretize
 from .filters import lowpass_pole
 from .linalg import Matrix
@@ -80,12 +80,6 @@ from .model_observer import (
     steady_state_gain,
 )
 
-#: Default bandwidth ω_L of the load torque estimate (rad/s). Measured on the bench
-#: (README, "Sensorless load torque"): 5 rad/s keeps a step's settled error within 1 %
-#: with realistic sensors and within 10 % with inertias 1 % off, with a 0.47 s lag at
-#: 2 rad/s; 10 rad/s cuts the lag to 0.34 s but quadruples what a 1 % model error leaks
-#: in (a model error at a frequency inside the bandwidth looks like a load torque).
-LOAD_TORQUE_BANDWIDTH = 5.0
 #: The output's low-pass sits at this multiple of ω_L (see the module doc).
 SMOOTHING_RATIO = 2.0
 
@@ -93,12 +87,26 @@ SMOOTHING_RATIO = 2.0
 def load_column(
     J: Sequence[float], k: Sequence[float], B: Sequence[float], h: float, load_mass: int
 ) -> list[float]:
-    """``b_d``: the change of the load state ``x = [θ_1…θ_n, ω_1…ω_n]`` over a step of
-    ``h`` s caused by a unit torque (N·m) on load mass ``load_mass`` (1-based), held
-    over the step, starting from rest (rad/N·m and rad/s/N·m), length 2n.
+    """``b_d``: the change of the load state ``x = [θ_1…θ_n, ω_1…ω_n]`` over a step
+    caused by a unit torque on one load mass, held over the step, starting from rest.
 
     ``∫_0^h e^{A s} ds · e_L / J_L``, from the matrix exponential of ``[[A h, e_L h / J_L],
     [0, 0]]``.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), spring stiffnesses (N·m/rad) and dampings (N·m·s/rad),
+        shape ``(n,)`` each.
+    h : float
+        Step (s).
+    load_mass : int
+        The mass the torque acts on, 1 … n (an index).
+
+    Returns
+    -------
+    list of float
+        ``b_d``, shape ``(2n,)``: angles (rad per N·m) then velocities (rad/s per N·m).
     """
     A, _ = continuous_matrices(J, k, B)
     m = len(A)
@@ -121,8 +129,21 @@ class LoadStepModel(StepModel):
 
 
 def smoothing_filter(bandwidth: float, h: float) -> tuple[Matrix, list[float]]:
-    """Second-order Butterworth low-pass at ``bandwidth`` rad/s over a step of ``h`` s,
-    its input held over the step: ``Φ`` (2 × 2) and ``φ`` (2) with z = [value, rate]."""
+    """Second-order Butterworth low-pass over one step, its input held over the step.
+
+    Parameters
+    ----------
+    bandwidth : float
+        Corner frequency (rad/s).
+    h : float
+        Step (s).
+
+    Returns
+    -------
+    tuple of (list of list of float, list of float)
+        ``Φ``, shape ``(2, 2)``, and ``φ``, shape ``(2,)``: ``z ← Φ z + φ u`` for the
+        state z = [value, rate] and the input u held over the step.
+    """
     w = bandwidth
     M = [
         [0.0, h, 0.0],
@@ -134,10 +155,21 @@ def smoothing_filter(bandwidth: float, h: float) -> tuple[Matrix, list[float]]:
 
 
 def check_load_settings(n: int, load_mass: int, bandwidth: float) -> None:
-    """Refuse a ``load_mass`` outside 1 … n or a bandwidth ω_L (rad/s) that is not > 0.
+    """Refuse a ``load_mass`` outside 1 … n or a bandwidth ω_L that is not > 0.
 
-    Raises:
-        ValueError: naming the setting.
+    Parameters
+    ----------
+    n : int
+        Number of load masses (a count).
+    load_mass : int
+        The mass the torque acts on (an index).
+    bandwidth : float
+        ω_L (rad/s).
+
+    Raises
+    ------
+    ValueError
+        Naming the setting.
     """
     if not 1 <= load_mass <= n:
         raise ValueError(f"load_mass = {load_mass}: use a load mass 1 … {n}")
@@ -157,17 +189,32 @@ def load_step_model(
 ) -> StepModel:
     """Discrete model with the load torque and the DOB's filter, and its Kalman gain.
 
-    Args:
-        J, k, B: load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad).
-        g_dist: DOB bandwidth (rad/s).
-        noise: the chain's noise model (:class:`~arcosim.fmu.flexchain.model_observer.NoiseModel`).
-        h: step (s).
-        load_mass: the mass the torque acts on, 1 … n.
-        bandwidth: ω_L (rad/s), > 0: sets the random walk's increments (module doc).
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape
+        ``(n,)`` each.
+    g_dist : float
+        DOB bandwidth (rad/s).
+    noise : NoiseModel
+        The chain's noise model (:class:`~arcosim.fmu.flexchain.model_observer.NoiseModel`).
+    h : float
+        Step (s).
+    load_mass : int
+        The mass the torque acts on, 1 … n (an index).
+    bandwidth : float
+        ω_L (rad/s), > 0: sets the random walk's increments (module doc).
 
-    Returns:
-        ``F`` (m × m, m = 2n + 2), ``Γ`` (m × 2), the gain ``K`` (m) and the output
-        low-pass at ``SMOOTHING_RATIO · bandwidth``.
+    Returns
+    -------
+    LoadStepModel
+        ``F``, shape ``(m, m)`` with m = 2n + 2, ``Γ``, shape ``(m, 2)``, the gain ``K``,
+        shape ``(m,)``, and the output low-pass at ``SMOOTHING_RATIO · bandwidth``.
+
+    Raises
+    ------
+    ValueError
+        For a ``load_mass`` outside 1 … n or a bandwidth ≤ 0.
     """
     n = len(J)
     check_load_settings(n, load_mass, bandwidth)
@@ -201,20 +248,28 @@ def load_step_model(
 class LoadTorqueObserver(ModelObserver):
     """Load angles and velocities, and the external torque on one load mass.
 
-    Args:
-        J, k, B, g_dist, noise, theta0: as
-        :class:`~arcosim.fmu.flexchain.model_observer.ModelObserver`.
-        load_mass: the mass the torque acts on (1 … n).
-        bandwidth: ω_L (rad/s), > 0 (module doc).
+    Parameters
+    ----------
+    J, k, B, g_dist, noise, theta0
+        As :class:`~arcosim.fmu.flexchain.model_observer.ModelObserver`.
+    load_mass : int
+        The mass the torque acts on, 1 … n (an index).
+    bandwidth : float
+        ω_L (rad/s), > 0 (module doc).
 
-    Attributes (after :meth:`step`), besides ModelObserver's:
-        tau_load: estimated torque on ``load_mass`` (N·m; positive accelerates the
-            mass, as the plant's ``tau_ext``): the Kalman estimate of the torque over
-            the last step, smoothed (module doc).
-        smoothing: the low-pass's state [value (N·m), rate (N·m/s)].
+    Attributes
+    ----------
+    tau_load : float
+        After :meth:`step`, besides ModelObserver's: the estimated torque on
+        ``load_mass`` (N·m; positive accelerates the mass, as the plant's ``tau_ext``),
+        the Kalman estimate of the torque over the last step, smoothed (module doc).
+    smoothing : list of float
+        The low-pass's state [value (N·m), rate (N·m/s)], shape ``(2,)``.
 
-    Raises:
-        ValueError: for a ``load_mass`` outside 1 … n or a bandwidth ≤ 0.
+    Raises
+    ------
+    ValueError
+        For a ``load_mass`` outside 1 … n or a bandwidth ≤ 0.
     """
 
     def __init__(
@@ -226,7 +281,7 @@ class LoadTorqueObserver(ModelObserver):
         noise: NoiseModel,
         theta0: float,
         load_mass: int,
-        bandwidth: float = LOAD_TORQUE_BANDWIDTH,
+        bandwidth: float = defaults.LOAD_TORQUE_BANDWIDTH,
     ) -> None:
         n = len(J)
         check_load_settings(n, load_mass, bandwidth)
@@ -238,13 +293,23 @@ class LoadTorqueObserver(ModelObserver):
         self.smoothing = [0.0, 0.0]
 
     def design(self, h: float) -> LoadStepModel:
-        """The step model for ``h`` (:func:`load_step_model`)."""
+        """The step model for a step of ``h`` (s): :func:`load_step_model`."""
         return load_step_model(
             self.J, self.k, self.B, self.g_dist, self.noise, h, self.load_mass, self.bandwidth
         )
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
-        """Take the sample that ends a step of ``h`` s (τ̂_reac in N·m, θ_m in rad)."""
+        """Take the sample that ends a step.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        tau_reac_hat : float
+            The reaction torque observer's estimate τ̂_reac (N·m).
+        theta_m : float
+            The measured motor angle (rad).
+        """
         super().step(h, tau_reac_hat, theta_m)
         sm = self._models[h]
         d = self.s[2 * self.n]

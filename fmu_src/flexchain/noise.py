@@ -21,7 +21,20 @@ def _splitmix64(z: int) -> int:
 
 
 def uniform(seed: int, k: int) -> float:
-    """Uniform sample number ``k`` of stream ``seed``, in [0, 1)."""
+    """Uniform sample number ``k`` of stream ``seed``.
+
+    Parameters
+    ----------
+    seed : int
+        Stream identifier (any integer).
+    k : int
+        Sample number (a count, ≥ 0).
+
+    Returns
+    -------
+    float
+        A sample in [0, 1) (dimensionless), 53 random bits.
+    """
     base = _splitmix64((seed & _MASK) ^ 0x2545F4914F6CDD1D)
     return (_splitmix64((base + k) & _MASK) >> 11) * 2.0**-53
 
@@ -29,9 +42,17 @@ def uniform(seed: int, k: int) -> float:
 def gaussian(seed: int, k: int) -> float:
     """Standard normal sample number ``k`` of stream ``seed`` (Box–Muller).
 
-    Args:
-        seed: stream identifier (any integer).
-        k: sample number (≥ 0).
+    Parameters
+    ----------
+    seed : int
+        Stream identifier (any integer).
+    k : int
+        Sample number (a count, ≥ 0).
+
+    Returns
+    -------
+    float
+        A sample of the standard normal distribution (dimensionless).
     """
     base = _splitmix64((seed & _MASK) ^ 0x5DEECE66D)
     a = _splitmix64((base + 2 * k) & _MASK)
@@ -42,11 +63,19 @@ def gaussian(seed: int, k: int) -> float:
 
 
 def quantize(theta: float, counts_per_rev: int) -> float:
-    """Angle (rad) as an incremental encoder reports it: whole counts, floored.
+    """The angle as an incremental encoder reports it: whole counts, floored.
 
-    Args:
-        theta: true angle (rad) relative to the angle at start.
-        counts_per_rev: counts per revolution after quadrature; 0 = ideal encoder.
+    Parameters
+    ----------
+    theta : float
+        True angle (rad) relative to the angle at start.
+    counts_per_rev : int
+        Counts per revolution after quadrature (a count); 0 = ideal encoder.
+
+    Returns
+    -------
+    float
+        The reported angle (rad).
     """
     if counts_per_rev <= 0:
         return theta

@@ -1,5 +1,5 @@
 """The action-reaction observer: DOB and reaction torque observer, plus one of
-three modes, advanced one sample at a time.
+three modes (:class:`~arcosim.fmu.flexchain.codes.Mode`), advanced one sample at a time.
 
 * mode 0 — actuator self-identification, load detached
   (:mod:`~arcosim.fmu.flexchain.self_identification`)
@@ -7,6 +7,10 @@ three modes, advanced one sample at a time.
   (:mod:`~arcosim.fmu.flexchain.rigid_identification`)
 * mode 2 — state estimation: the paper's recursion (:mod:`~arcosim.fmu.flexchain.recursion`)
   or the model-based observer (:mod:`~arcosim.fmu.flexchain.model_observer`)
+
+:class:`ObserverSettings` holds the configuration and states its rules
+(:meth:`ObserverSettings.problems`), for the FMU, the CLI and the library alike; the
+defaults are :mod:`~arcosim.fmu.flexchain.defaults`'.
 """
 
 from __future__ import annotations
@@ -14,15 +18,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from . import defaults
+from .codes import ESTIMATOR_NAMES, MODE_NAMES, Estimator, Mode, choice_problem
 from .dob import Actuator, ReactionObserver
-from .load_observer import LOAD_TORQUE_BANDWIDTH, LoadTorqueObserver
-from .model_observer import ModelObserver, NoiseModel
+from .load_observer import LoadTorqueObserver
+from .model_observer import NOISE_RANGE, NOISE_RATIO, ModelObserver, NoiseModel
 from .recursion import ChainRecursion
 from .rigid_identification import RigidChainIdentifier
 from .self_identification import ActuatorIdentifier
 
-SELF_IDENTIFICATION, RIGID_IDENTIFICATION, STATE_ESTIMATION = 0, 1, 2
-RECURSION, MODEL_BASED = 0, 1
+# The names callers outside fmu_src still import (cosim/cli/identify.py,
+# cosim/identification/load_torque.py): the enum members themselves, no second
+# definition; to be replaced by Mode.* and Estimator.* there, then removed.
+SELF_IDENTIFICATION = Mode.SELF_IDENTIFICATION
+RIGID_IDENTIFICATION = Mode.RIGID_IDENTIFICATION
+STATE_ESTIMATION = Mode.STATE_ESTIMATION
+RECURSION = Estimator.RECURSION
+MODEL_BASED = Estimator.MODEL_BASED
 
 
 @dataclass(frozen=True)
@@ -32,7 +44,8 @@ class ObserverSettings:
     Parameters
     ----------
     mode : int
-        0, 1 or 2, an index (see the module doc); 2 estimates the states.
+        A :class:`~arcosim.fmu.flexchain.codes.Mode` (an index 0, 1 or 2, see the module
+        doc); 2 estimates the states.
     actuator : Actuator
         Nominal and identified actuator terms (J_mo, k_to, Δk_t, ΔJ, D_m, f_c).
     g_dist : float
@@ -45,14 +58,16 @@ class ObserverSettings:
     kappa_correction : bool
         Mode 1: apply the multi-mass correction κ.
     estimator : int
-        Mode 2, an index: 0 = the paper's recursion (eq. 22–26); 1 = the model-based
-        observer (use it: the recursion diverges from the second mass on).
+        Mode 2, an :class:`~arcosim.fmu.flexchain.codes.Estimator` (an index): 0 = the
+        paper's recursion (eq. 22–26); 1 = the model-based observer (use it: the
+        recursion diverges from the second mass on).
     omega_min : float
         Speed below which mode 0 treats the motor as stopped (rad/s).
     g_id : float
         Bandwidth of mode 0's extra filter on target and regressors (rad/s); 0 = none.
     encoder_cpr : int
-        Counts per revolution of the motor encoder (a count; 0: not quantized). Mode 2
+        Counts per revolution of the motor encoder (a count; 0, the default here: not
+        quantized; the FMU's default is the plant's encoder). Mode 2
         takes the motor angle at the middle of its count (an encoder that reports
         whole counts reads half a count low on average), and the model-based observer
         takes its quantization noise, 2π/cpr/√12 rad, into its gain.
@@ -82,57 +97,193 @@ class ObserverSettings:
     J: tuple[float, ...]
     k: tuple[float, ...]
     B: tuple[float, ...]
-    kappa_correction: bool = True
-    estimator: int = RECURSION
-    omega_min: float = 5.0
-    g_id: float = 30.0
+    kappa_correction: bool = defaults.KAPPA_CORRECTION
+    estimator: int = defaults.ESTIMATOR
+    omega_min: float = defaults.OMEGA_MIN
+    g_id: float = defaults.G_ID
     encoder_cpr: int = 0
-    torque_noise_std: float = 1e-4
-    tau_noise_std: float = 1.5e-3
-    load_mass: int = 0
-    load_torque_bandwidth: float = LOAD_TORQUE_BANDWIDTH
+    torque_noise_std: float = defaults.TORQUE_NOISE_STD
+    tau_noise_std: float = defaults.TAU_NOISE_STD
+    load_mass: int = defaults.LOAD_MASS
+    load_torque_bandwidth: float = defaults.LOAD_TORQUE_BANDWIDTH
 
     def angle_offset(self) -> float:
-        """Half a count of the encoder (rad), 0 when the angle is not quantized."""
+        """Half a count of the encoder.
+
+        Returns
+        -------
+        float
+            π / ``encoder_cpr`` (rad), 0 when the angle is not quantized.
+        """
         return math.pi / self.encoder_cpr if self.encoder_cpr > 0 else 0.0
 
     def noise(self) -> NoiseModel:
-        """The model-based observer's noise model."""
+        """The model-based observer's noise model.
+
+        Returns
+        -------
+        NoiseModel
+            The encoder's quantization noise 2π/cpr/√12 (rad) and the two noise levels
+            (N·m).
+        """
         quantum = 2.0 * math.pi / self.encoder_cpr if self.encoder_cpr > 0 else 0.0
         return NoiseModel(quantum / math.sqrt(12.0), self.torque_noise_std, self.tau_noise_std)
+
+    @property
+    def model_based(self) -> bool:
+        """Whether the settings run the model-based observer (mode 2, estimator 1)."""
+        return self.mode == Mode.STATE_ESTIMATION and self.estimator == Estimator.MODEL_BASED
+
+    def problems(self, noise: bool = True) -> list[str]:
+        """What the observer cannot run with these settings, one sentence each.
+
+        The rules of the settings as a whole, in this order: ``mode`` and ``estimator``
+        are codes of :mod:`~arcosim.fmu.flexchain.codes`; the model-based observer's
+        noise levels lie where its Kalman design is known to work
+        (:func:`noise_problem`); ``load_mass`` names a load mass and only with the
+        model-based observer (:func:`load_mass_problem`). Each number is taken to be in
+        its range already (finite; > 0 or ≥ 0): the FMU checks those first, by name.
+
+        Parameters
+        ----------
+        noise : bool
+            Check the noise levels too; the FMU passes False when it has refused a
+            number already.
+
+        Returns
+        -------
+        list of str
+            One line per problem, naming the parameters and the fix; empty when the
+            settings can run.
+
+        Examples
+        --------
+        >>> actuator = arcosim.Actuator(J_mo=2.09e-5, k_to=0.0406)
+        >>> settings = arcosim.ObserverSettings(mode=2, actuator=actuator, g_dist=100.0,
+        ...                                     g_lpf=100.0, J=(1e-3,), k=(0.5,), B=(1e-4,))
+        >>> settings.problems()
+        []
+        >>> import dataclasses
+        >>> dataclasses.replace(settings, load_mass=1).problems()  # doctest: +ELLIPSIS
+        ['parameter load_mass = 1 needs mode = 2 and estimator = 1 (the model-based ...']
+        """
+        found = [
+            choice_problem("mode", self.mode, MODE_NAMES),
+            choice_problem("estimator", self.estimator, ESTIMATOR_NAMES),
+        ]
+        if noise and self.model_based:
+            found.append(noise_problem(self.torque_noise_std, self.tau_noise_std))
+        found.append(load_mass_problem(self.load_mass, len(self.J), self.model_based))
+        return [problem for problem in found if problem is not None]
+
+
+def noise_problem(torque_noise_std: float, tau_noise_std: float) -> str | None:
+    """A sentence if the model-based observer cannot design its Kalman gain for these
+    noise levels (outside :data:`~arcosim.fmu.flexchain.model_observer.NOISE_RANGE`, or
+    one more than :data:`~arcosim.fmu.flexchain.model_observer.NOISE_RATIO` times the
+    other).
+
+    Parameters
+    ----------
+    torque_noise_std, tau_noise_std : float
+        Unmodelled torque on each mass and noise on τ̂_reac (N·m).
+
+    Returns
+    -------
+    str or None
+        The sentence, naming both parameters, the envelope and the defaults; None when
+        the levels are inside the envelope.
+    """
+    torque, tau = torque_noise_std, tau_noise_std
+    low, high = NOISE_RANGE
+    inside = low <= torque <= high and low <= tau <= high
+    if inside and max(torque / tau, tau / torque) <= NOISE_RATIO:
+        return None
+    return (
+        f"parameters torque_noise_std = {torque!r} and tau_noise_std = {tau!r} N.m: "
+        f"the model-based observer (mode {int(Mode.STATE_ESTIMATION)}, estimator "
+        f"{int(Estimator.MODEL_BASED)}) designs its Kalman gain for noise on both; give each "
+        f"from {low:g} to {high:g} N.m, neither more than {NOISE_RATIO:g} times the other "
+        f"(defaults {_short(defaults.TORQUE_NOISE_STD)} and {_short(defaults.TAU_NOISE_STD)})"
+    )
+
+
+def load_mass_problem(load_mass: int, n: int, model_based: bool) -> str | None:
+    """A sentence if ``load_mass`` names no load mass, or is set where the observer cannot
+    estimate a load torque (anything but mode 2 with estimator 1).
+
+    Parameters
+    ----------
+    load_mass : int
+        0 (off) or the index of a load mass, 1 … n.
+    n : int
+        Number of load masses (a count).
+    model_based : bool
+        Whether the observer runs the model-based observer
+        (:attr:`ObserverSettings.model_based`).
+
+    Returns
+    -------
+    str or None
+        The sentence, naming the fix; None when ``load_mass`` can run.
+    """
+    if not 0 <= load_mass <= n:
+        return (
+            f"parameter load_mass = {load_mass} is not allowed (use 0 = off, or a load "
+            f"mass 1 to {n})"
+        )
+    if load_mass and not model_based:
+        return (
+            f"parameter load_mass = {load_mass} needs mode = {int(Mode.STATE_ESTIMATION)} and "
+            f"estimator = {int(Estimator.MODEL_BASED)} (the model-based observer); set "
+            "load_mass = 0 otherwise"
+        )
+    return None
+
+
+def _short(x: float) -> str:
+    """``x`` in the shortest scientific notation: 1e-4, 1.5e-3."""
+    mantissa, exponent = f"{x:e}".split("e")
+    return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
 
 
 class Observer:
     """DOB + reaction torque observer + the configured mode.
 
-    Args:
-        settings: configuration.
-        theta0, omega0: motor angle (rad) and velocity (rad/s) at start.
-
     The estimates are attributes of :attr:`dob` and of :attr:`identifier` or
     :attr:`estimator` (whichever the mode runs); identification estimates are
     refreshed by :meth:`estimate`.
+
+    Parameters
+    ----------
+    settings : ObserverSettings
+        The configuration.
+    theta0, omega0 : float
+        Motor angle (rad) and velocity (rad/s) at start.
+
+    Raises
+    ------
+    ValueError
+        If ``settings.load_mass`` cannot run (:func:`load_mass_problem`).
     """
 
     def __init__(self, settings: ObserverSettings, theta0: float, omega0: float) -> None:
         self.settings = settings
         s = settings
-        if s.load_mass and not (s.mode == STATE_ESTIMATION and s.estimator == MODEL_BASED):
-            raise ValueError(
-                f"load_mass = {s.load_mass} needs mode 2 and estimator 1 (the model-based "
-                "observer); use load_mass = 0 otherwise"
-            )
+        problem = load_mass_problem(s.load_mass, len(s.J), s.model_based)
+        if problem is not None:
+            raise ValueError(problem)
         self.dob = ReactionObserver(s.actuator, s.g_dist, theta0, omega0)
         self.identifier: ActuatorIdentifier | RigidChainIdentifier | None = None
         self.estimator: ChainRecursion | ModelObserver | LoadTorqueObserver | None = None
-        self.offset = s.angle_offset() if s.mode == STATE_ESTIMATION else 0.0
-        if s.mode == SELF_IDENTIFICATION:
+        self.offset = s.angle_offset() if s.mode == Mode.STATE_ESTIMATION else 0.0
+        if s.mode == Mode.SELF_IDENTIFICATION:
             self.identifier = ActuatorIdentifier(s.g_dist, s.omega_min, s.actuator.k_to, s.g_id)
-        elif s.mode == RIGID_IDENTIFICATION:
+        elif s.mode == Mode.RIGID_IDENTIFICATION:
             self.identifier = RigidChainIdentifier(
                 s.J, s.g_dist, s.kappa_correction, theta0, s.actuator.f_c
             )
-        elif s.estimator == MODEL_BASED and s.load_mass > 0:
+        elif s.estimator == Estimator.MODEL_BASED and s.load_mass > 0:
             self.estimator = LoadTorqueObserver(
                 s.J,
                 s.k,
@@ -143,19 +294,29 @@ class Observer:
                 s.load_mass,
                 s.load_torque_bandwidth,
             )
-        elif s.estimator == MODEL_BASED:
+        elif s.estimator == Estimator.MODEL_BASED:
             self.estimator = ModelObserver(s.J, s.k, s.B, s.g_dist, s.noise(), theta0 + self.offset)
         else:
             self.estimator = ChainRecursion(s.J, s.k, s.B, s.g_dist, s.g_lpf, theta0 + self.offset)
 
     def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
-        """Take the sample (i_a, ω, θ) that ends a step of ``h`` s (A, rad/s, rad)."""
+        """Take the sample that ends a step.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        i_a : float
+            Current that acted over the step (A).
+        omega, theta : float
+            Motor velocity (rad/s) and angle (rad) at the sample.
+        """
         dob = self.dob
         dob.step(h, i_a, omega, theta)
         estimator = self.estimator
         if estimator is not None:  # mode 2, the one that runs in control loops: test it first
             estimator.step(h, dob.tau_reac_hat, theta + self.offset)
-        elif self.settings.mode == SELF_IDENTIFICATION:
+        elif self.settings.mode == Mode.SELF_IDENTIFICATION:
             self.identifier.step(h, i_a, dob.velocity, dob.accel, dob.friction_sign, dob.d_hat)
         else:
             self.identifier.step(h, dob.drive, dob.friction_sign, omega, theta, dob.sticking)

@@ -26,16 +26,24 @@ Coefficients = tuple[float, float, list[tuple[int, float, float, float]]]
 class ChainRecursion:
     """Angles and velocities of the n load masses from τ̂_reac and θ_m.
 
-    Args:
-        J, k, B: per mass / spring inertia (kg·m²), stiffness (N·m/rad, > 0) and
-            damping (N·m·s/rad, ≥ 0), length n.
-        g_dist: DOB bandwidth (rad/s), for ``G[θ_m]``.
-        g_lpf: bandwidth of the filter on later stages (rad/s).
-        theta0: motor angle at start (rad); the chain starts at rest, aligned.
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Per mass / spring inertia (kg·m²), stiffness (N·m/rad, > 0) and damping
+        (N·m·s/rad, ≥ 0), shape ``(n,)`` each.
+    g_dist : float
+        DOB bandwidth (rad/s), for ``G[θ_m]``.
+    g_lpf : float
+        Bandwidth of the filter on later stages (rad/s).
+    theta0 : float
+        Motor angle at start (rad); the chain starts at rest, aligned.
 
-    Attributes (after :meth:`step`):
-        theta: estimated angles θ̂_1 … θ̂_n (rad).
-        omega: estimated velocities (rad/s), backward differences of ``theta``.
+    Attributes
+    ----------
+    theta : list of float
+        After :meth:`step`: estimated angles θ̂_1 … θ̂_n (rad), shape ``(n,)``.
+    omega : list of float
+        Estimated velocities (rad/s), backward differences of ``theta``, shape ``(n,)``.
     """
 
     def __init__(
@@ -71,7 +79,17 @@ class ChainRecursion:
         return self._coefficients
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
-        """Take the sample that ends a step of ``h`` s."""
+        """Take the sample that ends a step.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        tau_reac_hat : float
+            The reaction torque observer's estimate τ̂_reac (N·m).
+        theta_m : float
+            The measured motor angle (rad).
+        """
         a0, a, stages = self._coefficients if h == self._h else self._coefficients_for(h)
         self.theta_m_filtered = angle_before = a0 * self.theta_m_filtered + (1.0 - a0) * theta_m
         b = 1.0 - a

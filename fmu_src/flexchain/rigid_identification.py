@@ -38,7 +38,7 @@ from collections.abc import Sequence
 
 from .dob import sign
 from .filters import LowPassBank
-from .least_squares import RCOND_MIN, NormalEquations
+from .least_squares import MIN_ROWS, RCOND_MIN, NormalEquations
 
 #: Rows start this many filter time constants (1/g) after the start.
 SETTLE = 10.0
@@ -47,7 +47,18 @@ MAX_HELD = 20000
 
 
 def kappa(J: Sequence[float]) -> float:
-    """κ = Σ S_i² / S_1² for load inertias ``J_1 … J_n`` (kg·m²); 1 for one mass."""
+    """The multi-mass correction κ = Σ S_i² / S_1², ``S_i = Σ_{j≥i} J_j``.
+
+    Parameters
+    ----------
+    J : Sequence[float]
+        Load inertias ``J_1 … J_n`` (kg·m²), shape ``(n,)``.
+
+    Returns
+    -------
+    float
+        κ ≥ 1 (dimensionless); 1 for one mass.
+    """
     tails = [sum(J[i:]) for i in range(len(J))]
     return sum(s * s for s in tails) / (tails[0] * tails[0])
 
@@ -55,19 +66,31 @@ def kappa(J: Sequence[float]) -> float:
 class RigidChainIdentifier:
     """Online least squares for (k, B) from the reaction torque of a rigid maneuver.
 
-    Args:
-        J: load inertias ``J_1 … J_n`` (kg·m²).
-        g: ``g_dist`` (rad/s).
-        correct: apply κ (True) or give the literal eq. 21 (False).
-        theta0: motor angle at start (rad).
-        f_c: the motor's Coulomb friction (N·m) that the observer removes.
+    Parameters
+    ----------
+    J : Sequence[float]
+        Load inertias ``J_1 … J_n`` (kg·m²), shape ``(n,)``.
+    g : float
+        ``g_dist`` (rad/s).
+    correct : bool
+        Apply κ (True) or give the literal eq. 21 (False).
+    theta0 : float
+        Motor angle at start (rad).
+    f_c : float
+        The motor's Coulomb friction (N·m) that the observer removes.
 
-    Attributes (after :meth:`estimate`):
-        k, B: stiffness (N·m/rad) and damping (N·m·s/rad) estimates.
-        theta_rigid: rigid-motion estimate Θ̂ (rad), through G(s), at the last sample
-            processed (samples of a stuck interval are processed when it ends).
-        valid: at least 40 rows, a well-conditioned fit and k > 0.
-        rows: rows used so far.
+    Attributes
+    ----------
+    k, B : float
+        After :meth:`estimate`: stiffness (N·m/rad) and damping (N·m·s/rad) estimates.
+    theta_rigid : float
+        Rigid-motion estimate Θ̂ (rad), through G(s), at the last sample processed
+        (samples of a stuck interval are processed when it ends).
+    valid : bool
+        At least :data:`~arcosim.fmu.flexchain.least_squares.MIN_ROWS` rows, a
+        well-conditioned fit and k > 0.
+    rows : int
+        Rows used so far (a count).
     """
 
     def __init__(
@@ -99,14 +122,20 @@ class RigidChainIdentifier:
         theta: float,
         sticking: bool,
     ) -> None:
-        """Add the sample that ends a step of ``h`` s.
+        """Add the sample that ends a step.
 
-        Args:
-            h: step (s).
-            drive: torque on the motor other than Coulomb friction over the step (N·m).
-            friction_sign: mean sign of the velocity over the step (−1 … 1).
-            omega, theta: measured motor velocity (rad/s) and angle (rad).
-            sticking: the motor was at rest at one end of the step (friction unknown).
+        Parameters
+        ----------
+        h : float
+            Step (s).
+        drive : float
+            Torque on the motor other than Coulomb friction over the step (N·m).
+        friction_sign : float
+            Mean sign of the velocity over the step, −1 … 1 (dimensionless).
+        omega, theta : float
+            Measured motor velocity (rad/s) and angle (rad).
+        sticking : bool
+            The motor was at rest at one end of the step (friction unknown).
         """
         if sticking and self.f_c > 0.0:
             if len(self.held) >= MAX_HELD:
@@ -173,7 +202,7 @@ class RigidChainIdentifier:
     def estimate(self) -> None:
         """Solve the accumulated normal equations; update k, B and Θ̂."""
         beta, rcond = self.equations.solve()
-        self.valid = rcond >= RCOND_MIN and self.rows >= 40 and beta[0] > 0.0
+        self.valid = rcond >= RCOND_MIN and self.rows >= MIN_ROWS and beta[0] > 0.0
         if not self.valid:
             self.k = self.B = self.theta_rigid = 0.0
             return

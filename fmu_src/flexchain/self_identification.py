@@ -25,14 +25,19 @@ noise sits in the target too (errors in variables: on the bench with a
 most of it (same bench, g_id = 30 rad/s: both within 1 %); ``g_id = 0`` turns it off.
 
 Rows are used only while the motor has kept moving (|v| > ``omega_min``) for the
-last ``5 / g + 5 / g_id`` seconds: a stuck motor's friction is not ``f_c sgn θ̇``.
+last ``SETTLE / g + SETTLE / g_id`` seconds (:data:`SETTLE` = 5): a stuck motor's
+friction is not ``f_c sgn θ̇``.
 """
 
 from __future__ import annotations
 
+from . import defaults
 from .filters import LowPassBank
-from .least_squares import RCOND_MIN, NormalEquations
+from .least_squares import MIN_ROWS, RCOND_MIN, NormalEquations
 
+#: Rows start once the motor has moved for this many time constants of each filter,
+#: 1/g and 1/g_id (a count).
+SETTLE = 5.0
 #: A four-regressor fit this close to singular is taken as the rank deficiency
 #: that the free motor's equation of motion implies.
 RANK_RCOND = 1e-6
@@ -41,26 +46,38 @@ RANK_RCOND = 1e-6
 class ActuatorIdentifier:
     """Online least squares for (Δk_t, D, ΔJ, f_c).
 
-    Args:
-        g: ``g_dist`` (rad/s), the DOB's bandwidth.
-        k_to: nominal torque constant (N·m/A).
-        g_id: bandwidth of the extra filter F(s) (rad/s); 0 = none.
-        omega_min: speed below which the motor counts as stopped (rad/s).
+    Parameters
+    ----------
+    g : float
+        ``g_dist`` (rad/s), the DOB's bandwidth.
+    omega_min : float
+        Speed below which the motor counts as stopped (rad/s).
+    k_to : float
+        Nominal torque constant (N·m/A).
+    g_id : float
+        Bandwidth of the extra filter F(s) (rad/s); 0 = none.
 
-    Attributes (after :meth:`estimate`):
-        dkt, D_m, dJm, f_c: estimates (N·m/A, N·m·s/rad, kg·m², N·m).
-        rank_deficient: the full fit was singular and k_t was fixed to k_to.
-        valid: enough rows and a well-conditioned (reduced) fit.
+    Attributes
+    ----------
+    dkt, D_m, dJm, f_c : float
+        After :meth:`estimate`: the estimates (N·m/A, N·m·s/rad, kg·m², N·m).
+    rank_deficient : bool
+        The full fit was singular and k_t was fixed to k_to.
+    valid : bool
+        At least :data:`~arcosim.fmu.flexchain.least_squares.MIN_ROWS` rows and a
+        well-conditioned (reduced) fit.
     """
 
-    def __init__(self, g: float, omega_min: float, k_to: float, g_id: float = 30.0) -> None:
+    def __init__(
+        self, g: float, omega_min: float, k_to: float, g_id: float = defaults.G_ID
+    ) -> None:
         self.g = g
         self.g_id = g_id
         self.k_to = k_to
         self.omega_min = omega_min
         self.filtered = LowPassBank(g, 4)  # G[i], G[v], G[α], G[sgn]
         self.smoothed = LowPassBank(g_id, 5) if g_id > 0.0 else None  # F[G[…]], F[d̂]
-        self.settle = 5.0 / g + (5.0 / g_id if g_id > 0.0 else 0.0)
+        self.settle = SETTLE / g + (SETTLE / g_id if g_id > 0.0 else 0.0)
         self.moving_time = 0.0
         self.equations = NormalEquations(4)
         self.dkt = self.D_m = self.dJm = self.f_c = 0.0
@@ -76,15 +93,22 @@ class ActuatorIdentifier:
         friction_sign: float,
         d_hat: float,
     ) -> None:
-        """Add the sample that ends a step of ``h`` s (DOB pairing, see module doc).
+        """Add the sample that ends a step (DOB pairing, see module doc).
 
-        Args:
-            h: step (s).
-            i_a: current over the step (A).
-            velocity: mean velocity over the step (rad/s).
-            accel: velocity change over the step / h (rad/s²).
-            friction_sign: mean of sgn θ̇ over the step.
-            d_hat: the DOB's estimate after this sample (N·m).
+        Parameters
+        ----------
+        h : float
+            Step (s).
+        i_a : float
+            Current over the step (A).
+        velocity : float
+            Mean velocity over the step (rad/s).
+        accel : float
+            Velocity change over the step / h (rad/s²).
+        friction_sign : float
+            Mean of sgn θ̇ over the step, −1 … 1 (dimensionless).
+        d_hat : float
+            The DOB's estimate after this sample (N·m).
         """
         row = self.filtered.step(h, [i_a, velocity, accel, friction_sign])
         target = d_hat
@@ -102,7 +126,7 @@ class ActuatorIdentifier:
         self.rank_deficient = rcond < RANK_RCOND or not plausible
         if self.rank_deficient:
             beta, rcond = self.equations.solve(columns=(1, 2, 3))
-        self.valid = rcond >= RCOND_MIN and self.equations.count >= 40
+        self.valid = rcond >= RCOND_MIN and self.equations.count >= MIN_ROWS
         if not self.valid:
             beta = [0.0] * 4
         self.dkt, self.D_m, self.dJm, self.f_c = -beta[0], beta[1], beta[2], beta[3]

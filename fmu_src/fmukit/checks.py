@@ -30,11 +30,22 @@ def range_problems(
 ) -> list[str]:
     """Sentences for every parameter outside its allowed range.
 
-    Args:
-        value: looks a parameter's value up by name.
-        positive: names that must be finite and > 0.
-        non_negative: names that must be finite and ≥ 0.
-        finite: names that must be finite numbers.
+    Parameters
+    ----------
+    value : callable
+        Looks a parameter's value up by name.
+    positive : Iterable[str]
+        Names that must be finite and > 0.
+    non_negative : Iterable[str]
+        Names that must be finite and ≥ 0.
+    finite : Iterable[str]
+        Names that must be finite numbers.
+
+    Returns
+    -------
+    list of str
+        One sentence per parameter out of range, in the order given (positive, then
+        non-negative, then finite).
     """
     problems = []
     for names, test, text in (
@@ -52,7 +63,20 @@ def range_problems(
 
 
 def number_problem(name: str, x: float) -> str | None:
-    """A sentence if the Real parameter ``name`` is not a finite number within ±LARGEST."""
+    """A sentence if a Real parameter is not a finite number within ±:data:`LARGEST`.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name.
+    x : float
+        Its value (SI units).
+
+    Returns
+    -------
+    str or None
+        The sentence, or None when ``x`` is fine.
+    """
     if not math.isfinite(x):
         return f"parameter {name} = {x!r} is not a finite number"
     if abs(x) > LARGEST:
@@ -78,6 +102,20 @@ def chain_rate_problems(
     ω² ≤ max_i 2 (k_i + k_{i+1}) / J_i (and every decay rate ≤ the same with the B_i),
     so a chain within the bound is one the models integrate. Called after the ranges
     are checked (every value finite and > 0 or ≥ 0).
+
+    Parameters
+    ----------
+    value : callable
+        Looks a parameter's value up by name.
+    motor : str or None
+        Name of the motor inertia; None when the motor is held still.
+    inertias, springs, dampers : Sequence[str]
+        Names of ``J_1 … J_n``, ``k_1 … k_n`` and ``B_1 … B_n``, shape ``(n,)`` each.
+
+    Returns
+    -------
+    list of str
+        One sentence per body whose bound exceeds :data:`FASTEST_RATE`.
     """
     names = ([motor] if motor else []) + list(inertias)
     first = 0 if motor else 1  # the body of names[0]
@@ -100,11 +138,3 @@ def chain_rate_problems(
                     "(soften or lighten the chain, or add inertia)"
                 )
     return problems
-
-
-def choice_problem(name: str, value: int, allowed: dict[int, str]) -> str | None:
-    """A sentence if ``value`` is not one of ``allowed`` (value → meaning), else None."""
-    if value in allowed:
-        return None
-    options = ", ".join(f"{k} = {v}" for k, v in allowed.items())
-    return f"parameter {name} = {value} is not allowed (use {options})"

@@ -40,11 +40,16 @@ COSIMULATION_DEFAULTS = {
 class ModelInfo:
     """What the ``<fmiModelDescription>`` element says about the model.
 
-    Attributes:
-        identifier: model identifier (also the binary's name), e.g. ``MotorChainPlant_n3``.
-        description: one paragraph for the user.
-        version: project version that generated the FMU.
-        experiment: DefaultExperiment ``(start, stop, step)`` in s.
+    Parameters
+    ----------
+    identifier : str
+        Model identifier (also the binary's name), e.g. ``MotorChainPlant_n3``.
+    description : str
+        One paragraph for the user.
+    version : str
+        Project version that generated the FMU.
+    experiment : tuple of float
+        DefaultExperiment ``(start, stop, step)`` (s), shape ``(3,)``.
     """
 
     identifier: str
@@ -65,12 +70,18 @@ def model_description(
     ``doStep`` only, so they declare ``dependencies=""`` (no direct feedthrough) and
     are listed as ``<InitialUnknowns>`` (their ``initial`` is ``calculated``).
 
-    Args:
-        info: model-level attributes.
-        variables: every variable, in value-reference order.
-        cosimulation: overrides of the ``<CoSimulation>`` capability flags.
+    Parameters
+    ----------
+    info : ModelInfo
+        Model-level attributes.
+    variables : Sequence[Variable]
+        Every variable, in value-reference order.
+    cosimulation : Mapping[str, str], optional
+        Overrides of the ``<CoSimulation>`` capability flags.
 
-    Returns:
+    Returns
+    -------
+    Element
         The root element, ready for ``ElementTree.tostring``.
     """
     root = Element(

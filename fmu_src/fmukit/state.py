@@ -20,7 +20,23 @@ _OWN = __package__.rpartition(".")[0] + "."
 
 
 def snapshot(value: Any) -> Any:
-    """A JSON-able deep copy of ``value`` (see module doc for what it may contain)."""
+    """A JSON-able deep copy.
+
+    Parameters
+    ----------
+    value : Any
+        A tree of algorithm objects (see the module doc for what it may contain).
+
+    Returns
+    -------
+    Any
+        Lists, dicts, strings, numbers, Booleans and None only.
+
+    Raises
+    ------
+    TypeError
+        For a dict whose keys are not all strings.
+    """
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     if isinstance(value, list):
@@ -44,8 +60,20 @@ def snapshot(value: Any) -> Any:
 def restore(data: Any) -> Any:
     """New objects from a :func:`snapshot`.
 
-    Raises:
-        ValueError: the data names a class outside this FMU's own package.
+    Parameters
+    ----------
+    data : Any
+        What :func:`snapshot` returned (possibly through JSON).
+
+    Returns
+    -------
+    Any
+        New objects equal to the ones snapshotted.
+
+    Raises
+    ------
+    ValueError
+        If the data names a class outside this FMU's own package.
     """
     if data is None or isinstance(data, (bool, int, float, str)):
         return data

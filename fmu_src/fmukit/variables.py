@@ -22,16 +22,29 @@ Value = Union[float, int, bool, str]  # noqa: UP007
 class Variable:
     """One FMI 2.0 scalar variable.
 
-    Attributes:
-        name: FMI structured name, e.g. ``"k[2]"``.
-        type: ``"Real"``, ``"Integer"``, ``"Boolean"`` or ``"String"``.
-        causality: ``"parameter"`` (fixed after initialization), ``"input"`` or
-            ``"output"`` (computed by ``doStep``, depending on no input directly).
-        description: one line for the user, with what the value means.
-        unit: unit name from :data:`arcosim.fmu.fmukit.units.UNITS` (Real only; ``"1"`` when
-            dimensionless).
-        start: start value (parameters and inputs); outputs start at ``start`` or 0
-            until the first step.
+    Parameters
+    ----------
+    name : str
+        FMI structured name, e.g. ``"k[2]"``.
+    type : str
+        ``"Real"``, ``"Integer"``, ``"Boolean"`` or ``"String"``.
+    causality : str
+        ``"parameter"`` (fixed after initialization), ``"input"`` or ``"output"``
+        (computed by ``doStep``, depending on no input directly).
+    description : str
+        One line for the user, with what the value means.
+    unit : str
+        Unit name from :data:`arcosim.fmu.fmukit.units.UNITS` (Real only; ``"1"`` when
+        dimensionless).
+    start : float, int, bool, str or None
+        Start value (parameters and inputs, in ``unit``); outputs start at ``start`` or
+        0 until the first step.
+
+    Raises
+    ------
+    ValueError
+        For an unknown unit, a unit on a non-Real variable, a parameter or input without
+        a start value, or an empty description.
     """
 
     name: str
@@ -90,9 +103,24 @@ def array(
 ) -> list[Variable]:
     """Variables ``name[1] … name[n]`` made by ``kind`` (:func:`par`, :func:`inp`, :func:`out`).
 
-    Args:
-        starts: start values, one per element (parameters and inputs), or n (outputs).
-        describe: description of element i (1-based).
+    Parameters
+    ----------
+    kind : callable
+        :func:`par`, :func:`inp` or :func:`out`.
+    name : str
+        The array's name.
+    starts : Sequence or int
+        Start values, one per element (parameters and inputs, in ``unit``), shape
+        ``(n,)``; or n (outputs, a count).
+    unit : str
+        The elements' unit.
+    describe : callable
+        Description of element i (1-based).
+
+    Returns
+    -------
+    list of Variable
+        The n variables, in order.
     """
     if isinstance(starts, int):
         return [kind(f"{name}[{i}]", unit, describe(i)) for i in range(1, starts + 1)]

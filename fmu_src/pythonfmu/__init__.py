@@ -1,4 +1,5 @@
-"""Stand-in, in the source tree, for the pythonfmu runtime each FMU bundles.
+"""``fmu_src/pythonfmu/`` installed as ``arcosim.fmu.pythonfmu``: a stand-in, in the source
+tree, for the pythonfmu runtime each FMU bundles.
 
 Inside an FMU, ``<bundle>/pythonfmu/`` is pythonfmu's own runtime, copied there by
 :mod:`arcosim.build.portable`, and :mod:`..fmukit.slave` imports it relatively, so

@@ -36,17 +36,27 @@ class PlantPhysics:
     ``_cache`` (discretized matrices by step size) is derived data, left out of the
     FMU state and rebuilt on demand.
 
-    Args:
-        J_m: motor inertia (kg·m²), > 0.
-        k_t: torque constant (N·m/A).
-        D_m: motor viscous friction (N·m·s/rad), ≥ 0.
-        f_c: motor Coulomb friction (N·m), ≥ 0; the motor sticks while the drive
-            torque on it stays within ±f_c.
-        J: load inertias ``J_1 … J_n`` (kg·m²), each > 0.
-        k: spring stiffnesses ``k_1 … k_n`` (N·m/rad), each ≥ 0.
-        B: spring dampings ``B_1 … B_n`` (N·m·s/rad), each ≥ 0.
-        attached: False decouples spring 1, so the motor runs free.
-        current_bandwidth: current-loop bandwidth (rad/s); 0 = ideal (i = i_ref).
+    Parameters
+    ----------
+    J_m : float
+        Motor inertia (kg·m²), > 0.
+    k_t : float
+        Torque constant (N·m/A).
+    D_m : float
+        Motor viscous friction (N·m·s/rad), ≥ 0.
+    f_c : float
+        Motor Coulomb friction (N·m), ≥ 0; the motor sticks while the drive torque on
+        it stays within ±f_c.
+    J : Sequence[float]
+        Load inertias ``J_1 … J_n`` (kg·m²), each > 0, shape ``(n,)``.
+    k : Sequence[float]
+        Spring stiffnesses ``k_1 … k_n`` (N·m/rad), each ≥ 0, shape ``(n,)``.
+    B : Sequence[float]
+        Spring dampings ``B_1 … B_n`` (N·m·s/rad), each ≥ 0, shape ``(n,)``.
+    attached : bool
+        False decouples spring 1, so the motor runs free.
+    current_bandwidth : float
+        Current-loop bandwidth (rad/s); 0 = ideal (i = i_ref).
     """
 
     _transient = ("_cache",)
@@ -88,12 +98,16 @@ class PlantPhysics:
     # -- public --------------------------------------------------------------------
 
     def advance(self, h: float, i_ref: float, tau_ext: Sequence[float]) -> None:
-        """Integrate the plant from t to t + h (s) with the inputs held constant.
+        """Integrate the plant from t to t + h with the inputs held constant.
 
-        Args:
-            h: step (s), > 0.
-            i_ref: current command (A).
-            tau_ext: external torques on masses 1 … n (N·m).
+        Parameters
+        ----------
+        h : float
+            Step (s), > 0.
+        i_ref : float
+            Current command (A).
+        tau_ext : Sequence[float]
+            External torques on masses 1 … n (N·m), shape ``(n,)``.
         """
         x = self.x
         if self.ideal_current:

@@ -1,4 +1,5 @@
-"""Current commands (A) as functions of time: the scenarios' excitations.
+"""Waveforms of the current command (A) as functions of time: the rigid maneuver, the
+multi-sine, the chirp and filtered noise, one sample at a time.
 
 Standard library only: the ExcitationSource FMU bundles this module, and
 ``arcosim.experiments.excitation`` evaluates the same functions over arrays, so an FMU run and
@@ -10,13 +11,31 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from . import defaults
 from .noise import gaussian, uniform
 
 
 def raised_cosine_window(t: float, duration: float, ramp: float, derivative: int = 0) -> float:
     """Window rising over ``ramp`` s as a raised cosine, 1 in the middle, falling over
-    the last ``ramp`` s of ``duration``, 0 outside; ``derivative`` 1 or 2 gives its
-    time derivatives (1/s, 1/s²)."""
+    the last ``ramp`` s of ``duration``, 0 outside.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    duration : float
+        The window's length (s).
+    ramp : float
+        Length of each ramp (s), at most ``duration / 2``.
+    derivative : int
+        0 for the window (dimensionless), 1 or 2 for its first or second time
+        derivative (1/s, 1/s²).
+
+    Returns
+    -------
+    float
+        The window or its derivative at ``t``.
+    """
     if t < 0.0 or t > duration:
         return 0.0
     k = math.pi / ramp
@@ -32,10 +51,10 @@ def raised_cosine_window(t: float, duration: float, ramp: float, derivative: int
 
 def rigid_maneuver(
     t: float,
-    amplitude: float = 3.0,
-    frequency: float = 2.1,
-    periods: int = 8,
-    ramp_periods: int = 3,
+    amplitude: float = defaults.RIGID_AMPLITUDE,
+    frequency: float = defaults.RIGID_FREQUENCY,
+    periods: int = defaults.RIGID_PERIODS,
+    ramp_periods: int = defaults.RIGID_RAMP_PERIODS,
 ) -> float:
     """Back-and-forth maneuver far below the first mode, without drift or ringing.
 
@@ -54,12 +73,23 @@ def rigid_maneuver(
     bench 0.5 A gave k̂ 90 % low, 1 A 2–8 %, 2 A 1.3–3.5 % and 3 A (the default)
     0.8–1.0 % (ideal to realistic sensors).
 
-    Args:
-        t: time (s).
-        amplitude: peak current (A), reached in the middle part.
-        frequency: maneuver frequency ω (rad/s).
-        periods: total length in periods (ramps included).
-        ramp_periods: length of each ramp in periods.
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    amplitude : float
+        Peak current (A), reached in the middle part.
+    frequency : float
+        Maneuver frequency ω (rad/s).
+    periods : int
+        Total length in periods, ramps included (a count).
+    ramp_periods : int
+        Length of each ramp in periods (a count).
+
+    Returns
+    -------
+    float
+        The current command at ``t`` (A); 0 outside the maneuver.
     """
     period = 2.0 * math.pi / frequency
     duration, ramp = periods * period, ramp_periods * period
@@ -71,21 +101,64 @@ def rigid_maneuver(
 
 
 def multisine_phases(lines: int, seed: int) -> list[float]:
-    """Random phases (rad) for ``lines`` sines, reproducible for ``seed``."""
+    """Random phases for ``lines`` sines, reproducible for ``seed``.
+
+    Parameters
+    ----------
+    lines : int
+        Number of sines (a count).
+    seed : int
+        Noise stream (:func:`~arcosim.fmu.flexchain.noise.uniform`).
+
+    Returns
+    -------
+    list of float
+        Phases in [0, 2π) (rad), shape ``(lines,)``.
+    """
     return [2.0 * math.pi * uniform(seed, j) for j in range(lines)]
 
 
 def multisine(
     t: float, amplitude: float, frequencies: Sequence[float], phases: Sequence[float]
 ) -> float:
-    """Sum of sines at ``frequencies`` (rad/s), each ``amplitude / len(frequencies)`` (A),
-    so the peak never exceeds ``amplitude``."""
+    """Sum of sines, each of ``amplitude / len(frequencies)``, so the peak never exceeds
+    ``amplitude``.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    amplitude : float
+        Bound of the sum (A).
+    frequencies : Sequence[float]
+        The lines (rad/s), shape ``(m,)``.
+    phases : Sequence[float]
+        Their phases (rad), shape ``(m,)`` (:func:`multisine_phases`).
+
+    Returns
+    -------
+    float
+        The current command at ``t`` (A).
+    """
     total = sum(math.sin(w * t + p) for w, p in zip(frequencies, phases))
     return amplitude * total / len(frequencies)
 
 
 def log_spaced(low: float, high: float, lines: int) -> list[float]:
-    """``lines`` frequencies from ``low`` to ``high`` (rad/s), evenly on a log scale."""
+    """Frequencies evenly spaced on a log scale.
+
+    Parameters
+    ----------
+    low, high : float
+        The first and last frequency (rad/s), > 0.
+    lines : int
+        How many (a count), ≥ 1; one line is ``low``.
+
+    Returns
+    -------
+    list of float
+        The frequencies (rad/s), shape ``(lines,)``, ascending when ``high > low``.
+    """
     if lines == 1:
         return [low]
     ratio = (high / low) ** (1.0 / (lines - 1))
@@ -93,7 +166,24 @@ def log_spaced(low: float, high: float, lines: int) -> list[float]:
 
 
 def chirp(t: float, amplitude: float, w0: float, w1: float, duration: float) -> float:
-    """Linear chirp from ``w0`` to ``w1`` rad/s over ``duration`` s, then 0 (A)."""
+    """Linear chirp, then 0.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    amplitude : float
+        Peak current (A).
+    w0, w1 : float
+        Instantaneous frequency at the start and at the end (rad/s).
+    duration : float
+        Length of the sweep (s), > 0.
+
+    Returns
+    -------
+    float
+        The current command at ``t`` (A); 0 after ``duration``.
+    """
     if t > duration:
         return 0.0
     rate = (w1 - w0) / duration
@@ -106,10 +196,14 @@ class FilteredNoise:
     sample k of ``seed``; the filter is discretized (bilinear, pre-warped) for the
     step actually taken.
 
-    Args:
-        amplitude: rms of the output (A).
-        cutoff: corner frequency (rad/s), below the Nyquist frequency π/h.
-        seed: noise stream.
+    Parameters
+    ----------
+    amplitude : float
+        Rms of the output (A).
+    cutoff : float
+        Corner frequency (rad/s), below the Nyquist frequency π/h.
+    seed : int
+        Noise stream (:func:`~arcosim.fmu.flexchain.noise.gaussian`).
     """
 
     def __init__(self, amplitude: float, cutoff: float, seed: int) -> None:
@@ -123,7 +217,18 @@ class FilteredNoise:
         self.gain = 0.0
 
     def next(self, h: float) -> float:
-        """The next sample, one step of ``h`` s after the previous one (A)."""
+        """The next sample.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0; a new step size redesigns the filter.
+
+        Returns
+        -------
+        float
+            The current command (A).
+        """
         if abs(h - self.h) > 1e-9 * h:  # a new step size, not rounding of the same one
             self._design(h)
         x = self.gain * gaussian(self.seed, self.k)
