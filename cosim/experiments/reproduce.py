@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.builder import ensure_built, fmu_variables
+from arcosim.experiments.load_scores import score_profile, step_truth
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import (
@@ -54,7 +55,6 @@ from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, Observ
 from arcosim.host.master import Recording
 from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.load_torque import score_profile, step_truth
 from arcosim.identification.offline_observer import estimate_states
 from arcosim.identification.output_error import motor_record, through_g
 from arcosim.identification.whole_chain import Choice, identify_whole_chain
