@@ -11,7 +11,7 @@ then run again on the recorded logs, offline, in every configuration (the same
 ``flexchain`` code the FMU bundles), so one pair of runs scores every method:
 
 * identification: literal eq. 21 and eq. 21 with κ (rigid maneuver, mode 1) and
-  output error (broadband, ``cosim/identification/output_error.py``); k̂ and B̂
+  output error (broadband, ``cosim/identification/uniform_fit.py``); k̂ and B̂
   against the truth (the mean of the springs for the non-uniform case);
 * state estimation on the broadband run: the paper's recursion (eq. 22–26), the
   model-based observer, and the naive ``θ̂_i = θ_m``; score per mass
@@ -49,7 +49,9 @@ from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.codes import Estimator, Mode
 from arcosim.identification.offline_observer import estimate_states, replay
-from arcosim.identification.output_error import Fit, MotorRecord, motor_record, uniform_chain
+from arcosim.identification.output_error import ParameterFit
+from arcosim.identification.records import MotorRecord, motor_record
+from arcosim.identification.uniform_fit import uniform_chain
 from benchmarks import chain_accuracy, field_accuracy, load_accuracy
 from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
@@ -124,7 +126,7 @@ def broadband_fit(
     seed: int,
     duration: float = BROADBAND_DURATION,
     amplitude: float = BROADBAND_AMPLITUDE,
-) -> tuple[dict[str, np.ndarray], Fit]:
+) -> tuple[dict[str, np.ndarray], ParameterFit]:
     """:func:`broadband` and its uniform output-error fit, once per argument set: the
     table, B's check and the record lengths share the bench's runs (seeds 1 … 5 at
     10 s would otherwise be simulated and fitted up to three times). Read-only."""
@@ -156,7 +158,7 @@ def score_case(case: Case, seeds: Sequence[int], progress: Callable[[str], None]
 
 
 def score_broadband(
-    case: Case, log: dict[str, np.ndarray], oe: Fit, result: CaseResult, suffix: str
+    case: Case, log: dict[str, np.ndarray], oe: ParameterFit, result: CaseResult, suffix: str
 ) -> None:
     """Output error (``oe``, fitted on ``log``), then the state estimators with its
     k̂, B̂, on one broadband log; method names get ``suffix``."""

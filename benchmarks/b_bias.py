@@ -27,7 +27,8 @@ import numpy as np
 from arcosim.experiments import excitation
 from arcosim.experiments.scenarios import Scenario
 from arcosim.fmu.flexchain.waveforms import log_spaced
-from arcosim.identification.output_error import MotorRecord, motor_record, uniform_chain
+from arcosim.identification.records import MotorRecord, motor_record
+from arcosim.identification.uniform_fit import uniform_chain
 from benchmarks.accuracy import ACTUATOR, CASES, G_DIST, run_case
 
 BENCH = CASES[0]

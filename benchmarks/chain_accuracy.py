@@ -18,8 +18,7 @@ import numpy as np
 from arcosim.experiments.metrics import percent_error
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import SCENARIOS
-from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.output_error import motor_record
+from arcosim.identification.records import encoder_record, motor_record
 from arcosim.identification.whole_chain import identify_whole_chain, split
 from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.identification.chain_excitation import design_excitation
+from arcosim.identification.excitation_design import design_excitation
 from benchmarks import field_sim
 
 OUT = Path(__file__).resolve().parents[1] / "examples" / "data" / "belt_drive.csv"

@@ -10,20 +10,14 @@ import scipy.linalg
 
 from arcosim.fmu.flexchain import defaults, waveforms
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.chain_excitation import ExcitationError, design_excitation
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.drive import identify_drive
-from arcosim.identification.encoder_fit import (
-    Drive,
-    _discrete,
-    encoder_record,
-    filter_riccati,
-    mean_sign,
-    output_recursion,
-)
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.excitation_design import ExcitationError, design_excitation
+from arcosim.identification.kalman import Drive, discrete_drive, filter_riccati
 from arcosim.identification.log_check import check_log
-from arcosim.identification.output_error import linear_recursion
+from arcosim.identification.modal_recursion import linear_recursion, output_recursion
+from arcosim.identification.records import encoder_record, mean_sign
 from arcosim.identification.whole_chain import split
 from benchmarks import field_sim
 
@@ -117,7 +111,7 @@ def test_fast_recursions_match_the_reference_ones() -> None:
     i_a = field_sim.multisine(LINES, 3.0)(t)
     actuator = Actuator(d.J_m, d.k_t, 0.0, 0.0, d.D_m, d.f_c)
     record = encoder_record(t, i_a, np.sin(t), actuator, 2000)
-    A, Bd = _discrete(record, Drive(np.array(d.J), np.array(d.k), np.array(d.B), d.D_m, d.f_c))
+    A, Bd = discrete_drive(record, Drive(np.array(d.J), np.array(d.k), np.array(d.B), d.D_m, d.f_c))
     Q = np.outer(Bd[:, 0], Bd[:, 0]) * record.torque_std**2
     R = record.count**2 / 12
     H = np.zeros((len(A), 1))

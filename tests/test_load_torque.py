@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from arcosim.experiments.load_scores import score, step_truth
 from arcosim.experiments.scenarios import LoadProfile, recording_columns, run_scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.load_observer import LoadTorqueObserver
 from arcosim.fmu.flexchain.model_observer import NoiseModel
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import cosimulate
-from arcosim.identification.load_torque import score, step_truth
 from arcosim.logs import write_csv
 from tests.test_load_observer import predicted_error
 

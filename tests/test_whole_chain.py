@@ -1,5 +1,5 @@
 """Whole-chain identification (cosim/identification/whole_chain.py, modal_start.py,
-chain_modes.py): every J_i, k_i, B_i from the motor side alone."""
+chain_modes.py, encoder_fit.py, kalman.py): every J_i, k_i, B_i from the motor side alone."""
 
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ import pytest
 from arcosim.cli import main
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification import encoder_fit
+from arcosim.identification import encoder_fit, kalman
 from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
-from arcosim.identification.encoder_fit import EncoderRecord, encoder_record
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.output_error import Fit, MotorRecord, predict
+from arcosim.identification.output_error import ParameterFit, predict
+from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_record
 from arcosim.identification.whole_chain import fit_chain, identify_whole_chain, names, split
 
 H = 1e-3
@@ -170,8 +170,8 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     exact = EncoderRecord(
         H, defaults.K_T * current, zeros, zeros, count, defaults.J_M, defaults.D_M, 0.0, 1e-4
     )
-    truth_drive = encoder_fit.Drive(np.array(J), np.array(K), np.array(B), defaults.D_M, 0.0)
-    A, Bd = encoder_fit._discrete(exact, truth_drive)
+    truth_drive = kalman.Drive(np.array(J), np.array(K), np.array(B), defaults.D_M, 0.0)
+    A, Bd = kalman.discrete_drive(exact, truth_drive)
     x = np.zeros(len(A))
     theta, velocity = np.empty_like(t), np.empty_like(t)
     for step, torque in enumerate(exact.torque):
@@ -181,7 +181,7 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     counts = np.floor(theta / count) * count
     record = encoder_record(t, current, counts, actuator, 2000)
     start_values = np.array([*J, *K, *B]) * np.array([1.01, 0.99, 1.01, 0.99, 1.3, 0.7])
-    start = Fit(names(2), start_values, start_values * 0, start_values, "test", 0, 0, 1, 0)
+    start = ParameterFit(names(2), start_values, start_values * 0, start_values, "test", 0, 0, 1, 0)
     motor = MotorRecord(H, counts, np.zeros_like(t), 100.0)
     refined = encoder_fit.refine(record, motor, start, 2)
     truth = np.array([*J, *K, *B])
@@ -190,7 +190,7 @@ def test_the_prediction_error_fit_takes_the_encoder_counts_for_what_they_are() -
     assert refined.extra["start_fit"]["B[1]"] == start_values[4]
     assert 0.8 < refined.extra["innovation_variance"] < 1.2  # the counts' q²/12, as assumed
     # the smoother's motor velocity (the friction's sign) beats the smoothed derivative
-    smoothed = encoder_fit._Kalman.of(record, truth_drive).smoothed(record, truth_drive)
+    smoothed = kalman.Kalman.of(record, truth_drive).smoothed(record, truth_drive)
     assert smoothed.shape == (len(t), 6)
     derivative_error = np.sqrt(np.mean((record.velocity - velocity) ** 2))
     smoother_error = np.sqrt(np.mean((smoothed[:, 3] - velocity) ** 2))

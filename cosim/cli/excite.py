@@ -17,7 +17,7 @@ import json
 from pathlib import Path
 
 from arcosim.cli.options import force_option, number, step_option, whole_number
-from arcosim.identification.chain_excitation import DURATION, LINES, design_excitation
+from arcosim.identification.excitation_design import DURATION, LINES, design_excitation
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
 

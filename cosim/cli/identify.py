@@ -20,7 +20,7 @@ Contract (scripts rely on it)::
   existing file is replaced only with ``--force``; the log itself never.
 * ``--method output-error``: instead of replaying the observer FMU, fit the uniform
   chain's k and B (``--fit-inertia-scale``: and a common scale on the J_i) to τ̂_reac
-  from any excitation rich enough to ring the chain (``arcosim.identification.output_error``). The
+  from any excitation rich enough to ring the chain (``arcosim.identification.uniform_fit``). The
   observer's parameters (``--set``: J_mo, k_to, dkt, dJm, D_m, f_c, g_dist, J[i]) say
   what is known; ``--json`` prints ``k_hat``, ``B_hat`` (and ``J_scale``), their
   standard errors under ``std``, and the evidence (start, residual, velocity used).
@@ -86,13 +86,9 @@ from arcosim.host.overrides import parse_assignment
 from arcosim.host.replay import final_values, observer_parameters, parameter_sets, replay_log
 from arcosim.identification import load_torque
 from arcosim.identification.drive import identify_drive
-from arcosim.identification.output_error import (
-    Fit,
-    MotorRecord,
-    clamped_frequencies,
-    motor_record,
-    uniform_chain,
-)
+from arcosim.identification.output_error import ParameterFit
+from arcosim.identification.records import MotorRecord, motor_record
+from arcosim.identification.uniform_fit import clamped_frequencies, uniform_chain
 from arcosim.logs import DriveLog, parse_scales, read_log, read_text_file, write_csv
 from arcosim.outputs import check_output, write_text
 
@@ -530,7 +526,7 @@ def defaults_note(values: Mapping[str, float], names: Sequence[str], given: set[
     )
 
 
-def evidence(result: Fit, record: MotorRecord) -> dict[str, object]:
+def evidence(result: ParameterFit, record: MotorRecord) -> dict[str, object]:
     """What an output-error fit rests on, for the JSON report."""
     return {
         "method": "output-error",

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.builder import ensure_built, fmu_variables
+from arcosim.experiments.load_scores import score_profile, step_truth
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import (
@@ -53,11 +54,10 @@ from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
 from arcosim.host.master import Recording
 from arcosim.identification.chain_modes import driving_point_response
-from arcosim.identification.encoder_fit import encoder_record
-from arcosim.identification.load_torque import score_profile, step_truth
 from arcosim.identification.offline_observer import estimate_states
-from arcosim.identification.output_error import motor_record, through_g
-from arcosim.identification.whole_chain import Choice, identify_whole_chain
+from arcosim.identification.output_error import through_g
+from arcosim.identification.records import encoder_record, motor_record
+from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, write_text
 from arcosim.version import __version__
@@ -281,7 +281,7 @@ def _terms(actuator: dict[str, float]) -> Actuator:
     )
 
 
-def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> Choice:
+def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> ChainChoice:
     """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
     terms = _terms(actuator)
     signals = [identification[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]

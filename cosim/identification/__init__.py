@@ -1,0 +1,52 @@
+"""``cosim/identification/`` installed as ``arcosim.identification``: identifying a flexible
+drive offline from its log, on numpy and scipy alone (no FMU, no FMI host).
+
+The modules in pipeline order: the records a log gives, the modes they show, the fits,
+the whole job on a drive; then the log's check before any fit, and the excitation to
+record. The public entry points are importable from ``arcosim`` directly.
+
+Records
+-------
+records           -- the two records every fit reads: MotorRecord (θ_m, τ̂_reac) and
+                     EncoderRecord (k_t·i_a in, encoder counts out); their openings
+
+Modes
+-----
+band              -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band)
+subspace          -- PO-MOESP subspace identification, one input and one output
+modal_start       -- the record's modes (stabilization diagram, residues) and the
+                     chain's start from them (Modes, DetectedModes, detect_modes)
+chain_modes       -- a chain and its driving-point modes, both ways (the Lanczos inverse)
+
+Fit
+---
+newey_west        -- standard errors of a fit whose residuals are coloured
+modal_recursion   -- linear recursions over a whole record in modal coordinates
+output_error      -- the output-error fit every chain fit shares: predict τ̂_reac, fit
+                     it, on growing openings (ParameterFit, fit, continued_fit)
+uniform_fit       -- the paper's uniform chain: one k and one B (uniform_chain)
+kalman            -- motor and chain as one linear model; its Kalman predictor, smoother
+encoder_fit       -- the prediction-error fit from the current to the encoder (refine)
+motor_friction    -- the motor's friction when only k_t and J_m are given: its start
+whole_chain       -- every J_i, k_i, B_i and n from the motor alone (identify_whole_chain,
+                     ChainChoice)
+
+Drive
+-----
+drive             -- the whole job from a log (identify_drive, DriveIdentification)
+load_torque       -- the torque on a load mass over a log (estimate_load_torque)
+offline_observer  -- the observer FMU's algorithms run over a log
+
+Checks
+------
+log_check         -- can a log support identification? (check_log, CheckReport)
+
+Excitation
+----------
+excitation_design -- the multi-sine to play on a drive (design_excitation, LINE_T)
+
+Support
+-------
+blas              -- one BLAS thread inside the fits
+errors            -- IdentificationError
+"""

@@ -39,11 +39,24 @@ def driving_point_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndar
 
 
 def chain_from_modes(p: Sequence[float], r: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """The chain ``(J, k)`` (kg·m², N·m/rad; shape (n,) each) with clamped frequencies
-    ``p`` (rad/s, distinct, > 0) and residues ``r`` (> 0).
+    """The chain with the given clamped frequencies and residues (the Lanczos inverse).
 
-    Raises:
-        ValueError: for non-positive or repeated frequencies, or non-positive residues.
+    Parameters
+    ----------
+    p : sequence of float
+        Clamped frequencies (rad/s), distinct, > 0, length n.
+    r : sequence of float
+        Residues (N·m/rad·s⁻²), > 0, length n.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(J, k)``: inertias (kg·m²) and stiffnesses (N·m/rad), shape ``(n,)`` each.
+
+    Raises
+    ------
+    ValueError
+        For non-positive or repeated frequencies, or non-positive residues.
     """
     p = np.asarray(p, dtype=float)
     r = np.asarray(r, dtype=float)

@@ -3,8 +3,8 @@ motor's current and encoder alone, with only the motor's datasheet values known.
 
 :func:`identify_drive` is the one call for the whole job (what ``arcosim identify LOG
 --method whole-chain`` runs): it builds the records the fits need from the log
-(:func:`~arcosim.identification.output_error.motor_record`,
-:func:`~arcosim.identification.encoder_fit.encoder_record`), runs
+(:func:`~arcosim.identification.records.motor_record`,
+:func:`~arcosim.identification.records.encoder_record`), runs
 :func:`~arcosim.identification.whole_chain.identify_whole_chain`, and returns the result with what
 it rests on.
 """
@@ -18,10 +18,9 @@ import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.encoder_fit import LOADS, encoder_record
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.output_error import MotorRecord, motor_record
-from arcosim.identification.whole_chain import Choice, identify_whole_chain
+from arcosim.identification.records import LOADS, MotorRecord, encoder_record, motor_record
+from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 
 
 @dataclass(frozen=True)
@@ -43,7 +42,7 @@ class DriveIdentification:
         friction given or fitted, the load model), one sentence each.
     warnings : list of str
         What may limit the result (a weakly determined mode), one sentence each.
-    choice : Choice
+    choice : ChainChoice
         The whole-chain fit's evidence (modes, criterion per n, refusals).
     record : MotorRecord
         The reaction-torque record the fit started from.
@@ -65,7 +64,7 @@ class DriveIdentification:
     std: dict[str, float]
     assumptions: dict[str, str]
     warnings: list[str] = field(default_factory=list)
-    choice: Choice | None = None
+    choice: ChainChoice | None = None
     record: MotorRecord | None = None
     friction: dict[str, float] = field(default_factory=dict)
 

@@ -1,19 +1,16 @@
-"""Sensorless load torque offline: the observer FMU's estimator run over a log, and the
-scores of an estimate against a known torque.
+"""Sensorless load torque offline: the observer FMU's estimator run over a log.
 
-:func:`estimate` runs :class:`arcosim.fmu.flexchain.observer.Observer` (the same standard-library
-code the observer FMU bundles: DOB, reaction torque observer and the load torque
-observer of :mod:`arcosim.fmu.flexchain.load_observer`) over a drive log, one sample at a time,
-with the step each row takes. ``arcosim identify LOG.csv --method load-torque`` is its
-command line; ``arcosim reproduce`` (experiment 5) and ``arcosim bench accuracy`` score
-it with :func:`score`.
+:func:`estimate_load_torque` runs :class:`arcosim.fmu.flexchain.observer.Observer` (the
+same standard-library code the observer FMU bundles: DOB, reaction torque observer and
+the load torque observer of :mod:`arcosim.fmu.flexchain.load_observer`) over a drive log,
+one sample at a time, with the step each row takes. ``arcosim identify LOG.csv --method
+load-torque`` is its command line; ``arcosim reproduce`` (experiment 5) and ``arcosim
+bench accuracy`` score it (:mod:`arcosim.experiments.load_scores`).
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -21,20 +18,23 @@ from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, Observ
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.offline_observer import replay
 
-#: A step counts as settled once the estimate stays within this fraction of its size.
-SETTLED_WITHIN = 0.05
-
 
 @dataclass(frozen=True)
 class LoadEstimate:
     """The estimator's outputs at every log row.
 
-    Attributes:
-        time: s, shape (N,).
-        tau_load: estimated torque on the load mass (N·m), (N,).
-        tau_reac: the reaction torque observer's τ̂_reac (N·m), (N,).
-        theta, omega: estimated load angles (rad) and velocities (rad/s), (N, n).
-        innovation: τ̂_reac minus the model's prediction (N·m), (N,).
+    Attributes
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    tau_load : ndarray
+        Estimated torque on the load mass (N·m), shape ``(N,)``.
+    tau_reac : ndarray
+        The reaction torque observer's τ̂_reac (N·m), shape ``(N,)``.
+    theta, omega : ndarray
+        Estimated load angles (rad) and velocities (rad/s), shape ``(N, n)``.
+    innovation : ndarray
+        τ̂_reac minus the model's prediction (N·m), shape ``(N,)``.
     """
 
     time: np.ndarray
@@ -129,103 +129,3 @@ def estimate_load_torque(
 
     replay(settings, {"time": t, "i_a": i_a, "omega_m": omega_m, "theta_m": theta_m}, keep)
     return LoadEstimate(t.copy(), tau_load, tau_reac, theta, omega, innovation)
-
-
-@dataclass(frozen=True)
-class LoadScore:
-    """How an estimate of the load scenario's torque compares with the truth.
-
-    Attributes:
-        size: the step (N·m).
-        settling_s: time from the step until the estimate stays within
-            :data:`SETTLED_WITHIN` of the size up to the sine's start (s; NaN: never).
-        settled_mean_percent: mean error over the step's settled window, % of the size.
-        settled_max_percent: largest |error| over it, % of the size.
-        settled_rms_percent: rms error over it, % of the size (the flexible motion's).
-        sine_amplitude_ratio: amplitude of the estimate at the sine's frequency over the
-            truth's (least-squares fits over the sine's window).
-        sine_lag_s: the estimate's lag behind the truth (phase difference / frequency, s).
-        sine_rms_percent: rms error during the sine, % of the size.
-    """
-
-    size: float
-    settling_s: float
-    settled_mean_percent: float
-    settled_max_percent: float
-    settled_rms_percent: float
-    sine_amplitude_ratio: float
-    sine_lag_s: float
-    sine_rms_percent: float
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
-
-
-def score(
-    time: np.ndarray,
-    estimate: np.ndarray,
-    truth: np.ndarray,
-    step_time: float,
-    sine_time: float,
-    frequency: float,
-    settled_from: float,
-    sine_settled_from: float,
-) -> LoadScore:
-    """Score an estimate of a step then a sine (:class:`arcosim.experiments.scenarios.LoadProfile`).
-
-    Args:
-        time: sample times (s), (N,).
-        estimate: estimated torque at each sample (N·m), (N,).
-        truth: the torque over the step ending at each sample (N·m), (N,).
-        step_time, sine_time: when the step and the sine start (s).
-        frequency: of the sine (rad/s).
-        settled_from: start of the step's settled window (s), before ``sine_time``.
-        sine_settled_from: start of the sine's scoring window (s).
-    """
-    size = float(np.max(np.abs(truth)))
-    error = estimate - truth
-    step = (time >= step_time) & (time < sine_time)
-    outside = np.nonzero(np.abs(error[step]) > SETTLED_WITHIN * size)[0]
-    settling = math.nan
-    if not len(outside) or outside[-1] + 1 < step.sum():
-        last = time[step][outside[-1]] if len(outside) else step_time
-        settling = float(last - step_time)
-    settled = (time >= settled_from) & (time < sine_time)
-    e = error[settled]
-    sine = time >= sine_settled_from
-    phase = frequency * (time[sine] - sine_time)
-    basis = np.column_stack([np.sin(phase), np.cos(phase), np.ones(sine.sum())])
-    fit = np.linalg.lstsq(basis, np.column_stack([estimate[sine], truth[sine]]), rcond=None)[0]
-    (s, c), (s_true, c_true) = fit[:2, 0], fit[:2, 1]
-    return LoadScore(
-        size=size,
-        settling_s=settling,
-        settled_mean_percent=100.0 * float(np.mean(e)) / size,
-        settled_max_percent=100.0 * float(np.max(np.abs(e))) / size,
-        settled_rms_percent=100.0 * float(np.sqrt(np.mean(e**2))) / size,
-        sine_amplitude_ratio=float(math.hypot(s, c) / math.hypot(s_true, c_true)),
-        sine_lag_s=float(math.atan2(s, c) - math.atan2(s_true, c_true)) / frequency,
-        sine_rms_percent=100.0 * float(np.sqrt(np.mean(error[sine] ** 2))) / size,
-    )
-
-
-def score_profile(time: np.ndarray, estimate: np.ndarray, profile) -> LoadScore:
-    """:func:`score` for a run of ``profile`` (a
-    :class:`arcosim.experiments.scenarios.LoadProfile`)."""
-    truth = step_truth(time, profile.torque(time))
-    return score(
-        time,
-        estimate,
-        truth,
-        profile.step_time,
-        profile.sine_time,
-        profile.frequency,
-        profile.settled_from,
-        profile.sine_from,
-    )
-
-
-def step_truth(time: np.ndarray, torque_at_start: Sequence[float]) -> np.ndarray:
-    """The torque over the step ending at each sample, from the torque held over the
-    step starting at each sample (the plant input's timing): shifted by one, 0 first."""
-    return np.concatenate([[0.0], np.asarray(torque_at_start, dtype=float)[:-1]])

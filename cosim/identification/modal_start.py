@@ -5,19 +5,26 @@ The output-error cost of a lightly damped chain has local minima spaced by about
 frequency to a fraction of a rad/s before it starts. Three linear steps get there
 with no search:
 
-1. subspace identification (PO-MOESP; Verhaegen, *Automatica* 30, 1994) of the
-   response from the motor angle, passed through the DOB's G(s), to τ̂_reac: its poles
-   are the clamped modes p_i and their damping ratios;
+1. subspace identification (PO-MOESP; Verhaegen, *Automatica* 30, 1994;
+   :mod:`arcosim.identification.subspace`) of the response from the motor angle,
+   passed through the DOB's G(s), to τ̂_reac: its poles are the clamped modes p_i and
+   their damping ratios;
 2. the residues r_i of ``τ/θ_m = k_1 − Σ r_i / (s² + 2ζ_i p_i s + p_i²)`` by
    non-negative least squares on the record, the p_i held;
 3. the chain (J_i, k_i) with those modes
-(:func:`arcosim.identification.chain_modes.chain_from_modes`).
+   (:func:`arcosim.identification.chain_modes.chain_from_modes`), and spring dampers
+   B_i with their damping ratios (:func:`modal_damping`).
+
+:func:`detect_modes` reads the modes from a stabilization diagram (which of them count,
+and the weak ones: :class:`DetectedModes`); :func:`record_modes` takes n modes as asked
+(:class:`Modes`, the chain's start).
 
 What the record must have (measured on the accuracy benchmark's chains, README):
 a broadband excitation with many lines (a multi-sine of 40 log-spaced lines 3–150
 rad/s rings all five modes of the five-mass chain; 11 lines do not, the subspace
-then takes excitation lines for modes) and modes below 3 g_dist, where G(s) still
-passes a third of the torque.
+then takes excitation lines for modes) and modes below min(3·g_dist, 0.3/h)
+(:func:`arcosim.identification.band.search_band`), where G(s) still passes a third of
+the torque and the sample rate follows.
 """
 
 from __future__ import annotations
@@ -27,33 +34,36 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
-from arcosim.identification.chain_modes import chain_from_modes
+from arcosim.identification.band import search_band
+from arcosim.identification.chain_modes import chain_from_modes, clamped_modes
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.output_error import (
-    MotorRecord,
-    newey_west_covariance,
-    newey_west_lag,
-    through_g,
-)
+from arcosim.identification.newey_west import newey_west_covariance, newey_west_lag
+from arcosim.identification.output_error import through_g
+from arcosim.identification.records import MotorRecord
+from arcosim.identification.subspace import moesp, observability_matrix
 
 #: Block rows of the subspace method's Hankel matrices (decimated samples).
 ROWS = 60
-#: Highest clamped frequency sought, in units of g_dist (rad/s).
-BAND_PER_G = 3.0
 #: Damping ratios a clamped mode may show in the subspace model.
 DAMPING_RANGE = (-0.05, 0.3)
 
 
 @dataclass(frozen=True)
 class Modes:
-    """Clamped modes seen in a record.
+    """Clamped modes seen in a record: the whole-chain fit's start.
 
-    Attributes:
-        frequency: undamped frequencies p_i (rad/s), ascending, shape (n,).
-        damping: damping ratios ζ_i, shape (n,).
-        residue: residues r_i (N·m/rad·s⁻²), shape (n,).
-        singular_values: of the subspace step, relative to the first (evidence for n).
-        band: highest frequency sought (rad/s).
+    Attributes
+    ----------
+    frequency : ndarray
+        Undamped frequencies p_i (rad/s), ascending, shape ``(n,)``.
+    damping : ndarray
+        Damping ratios ζ_i (dimensionless), shape ``(n,)``.
+    residue : ndarray
+        Residues r_i (N·m/rad·s⁻²), shape ``(n,)``.
+    singular_values : ndarray
+        Of the subspace step, relative to the first (dimensionless; evidence for n).
+    band : float
+        Highest frequency sought (rad/s).
     """
 
     frequency: np.ndarray
@@ -70,8 +80,24 @@ class Modes:
 def record_modes(record: MotorRecord, n: int) -> Modes:
     """The n clamped modes of the chain in ``record`` and their residues.
 
-    Raises:
-        IdentificationError: when the record is too short, or shows fewer than n modes.
+    Parameters
+    ----------
+    record : MotorRecord
+        The motor angle (rad) and τ̂_reac (N·m).
+    n : int
+        Number of modes (load masses) asked for, a count.
+
+    Returns
+    -------
+    Modes
+        The n least damped modes below the band (rad/s), their damping ratios and
+        residues.
+
+    Raises
+    ------
+    IdentificationError
+        When the record is too short, shows fewer than n modes, or a mode carries no
+        reaction torque.
     """
     band = _band(record)
     u, y, step = _decimated(record, band)
@@ -111,23 +137,33 @@ DAMPING_TOLERANCE = 0.01
 STABLE_ORDERS = 4
 #: A mode's residue must exceed this many of its standard errors to count as excited.
 RESIDUE_T = 4.0
-#: An excitation line stands this many times above the current spectrum's median.
-LINE_PROMINENCE = 30.0
 
 
 @dataclass(frozen=True)
-class Detected:
+class DetectedModes:
     """The record's modes, read from a stabilization diagram (see :func:`detect_modes`).
 
-    Attributes:
-        frequency: clamped frequencies p_i of the modes that count (rad/s), ascending.
-        damping: their damping ratios.
-        residue: their residues (N·m/rad·s⁻²).
-        t_value: residue / its standard error, per mode that counts.
-        weak: modes found stable but too weakly excited: (frequency, t value) pairs.
-        orders: per mode that counts, the number of model orders it was found at.
-        band: highest frequency sought (rad/s).
-        singular_values: of the subspace step, relative to the first.
+    Attributes
+    ----------
+    frequency : ndarray
+        Clamped frequencies p_i of the modes that count (rad/s), ascending, shape
+        ``(n,)``.
+    damping : ndarray
+        Their damping ratios (dimensionless), shape ``(n,)``.
+    residue : ndarray
+        Their residues (N·m/rad·s⁻²), shape ``(n,)``.
+    t_value : ndarray
+        Residue / its standard error, per mode that counts (dimensionless), shape
+        ``(n,)``.
+    weak : list of tuple of float
+        Modes found stable but too weakly excited: (frequency rad/s, t value) pairs.
+    orders : ndarray
+        Per mode that counts, the number of model orders it was found at (a count),
+        shape ``(n,)``.
+    band : float
+        Highest frequency sought (rad/s).
+    singular_values : ndarray
+        Of the subspace step, relative to the first (dimensionless).
     """
 
     frequency: np.ndarray
@@ -141,6 +177,7 @@ class Detected:
 
     @property
     def n(self) -> int:
+        """Number of modes that count."""
         return len(self.frequency)
 
     def modes(self, n: int | None = None) -> Modes:
@@ -151,26 +188,7 @@ class Detected:
         )
 
 
-def excitation_lines(current: np.ndarray, h: float) -> np.ndarray:
-    """Frequencies (rad/s) of the lines of a multi-sine in ``current`` (any unit):
-    spectral peaks :data:`LINE_PROMINENCE` times above the median, shape (L,)."""
-    x = np.asarray(current, dtype=float)
-    x = (x - x.mean()) * np.hanning(len(x))
-    power = np.abs(np.fft.rfft(x)) ** 2
-    frequency = 2.0 * np.pi * np.fft.rfftfreq(len(x), h)
-    floor = max(float(np.median(power[1:])), 1e-300)
-    peak = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
-    strong = power[1:-1] > LINE_PROMINENCE * floor
-    j = np.flatnonzero(peak & strong) + 1
-    # parabolic interpolation of the log power: the line between the bins
-    left, mid, right = (np.log(power[j + d]) for d in (-1, 0, 1))
-    shift = (
-        0.5 * (left - right) / np.where(left - 2 * mid + right == 0, -1.0, left - 2 * mid + right)
-    )
-    return frequency[j] + np.clip(shift, -0.5, 0.5) * (frequency[1] - frequency[0])
-
-
-def detect_modes(record: MotorRecord, largest: int) -> Detected:
+def detect_modes(record: MotorRecord, largest: int) -> DetectedModes:
     """The clamped modes a record shows, and which of them it excites enough.
 
     One PO-MOESP decomposition (:func:`moesp`) gives models of every even order
@@ -180,11 +198,26 @@ def detect_modes(record: MotorRecord, largest: int) -> Detected:
     :data:`STABLE_ORDERS` orders or more. The residues of all such modes are then
     fitted together by least squares (modes held); a mode whose residue is below
     :data:`RESIDUE_T` standard errors (Newey–West) is too weakly excited to count.
-    Nothing here depends on the
-    spacing of the modes or the size of their residues.
+    Nothing here depends on the spacing of the modes or the size of their residues.
 
-    Raises:
-        IdentificationError: when the record is too short.
+    Parameters
+    ----------
+    record : MotorRecord
+        The motor angle (rad) and τ̂_reac (N·m).
+    largest : int
+        The largest chain sought (a count): the diagram runs to order
+        2·(``largest`` + :data:`EXTRA_PAIRS`).
+
+    Returns
+    -------
+    DetectedModes
+        The modes that count (rad/s), their damping, residues and t values, and the
+        weak ones.
+
+    Raises
+    ------
+    IdentificationError
+        When the record is too short.
     """
     band = _band(record)
     u, y, step = _decimated(record, band)
@@ -195,7 +228,7 @@ def detect_modes(record: MotorRecord, largest: int) -> Detected:
             f"the record ({record.duration:g} s) is too short to show its modes below "
             f"{band:.0f} rad/s; record at least {8 * (top // 2 + 4) * step:.1f} s (20 s advised)"
         )
-    observability, singular = _observability(u, y, rows)
+    observability, singular = observability_matrix(u, y, rows)
     per_order = []
     for order in range(2, top + 1, 2):
         A = np.linalg.lstsq(observability[:-1, :order], observability[1:, :order], rcond=None)[0]
@@ -208,7 +241,7 @@ def detect_modes(record: MotorRecord, largest: int) -> Detected:
     clusters = _stable_clusters(per_order)
     if not clusters:
         empty = np.empty(0)
-        return Detected(
+        return DetectedModes(
             empty, empty, empty, empty, [], np.empty(0, int), band, singular / singular[0]
         )
     frequency = np.array([c[0] for c in clusters])
@@ -231,7 +264,7 @@ def detect_modes(record: MotorRecord, largest: int) -> Detected:
             for w, t in zip(frequency[counts & ~still], t_value[counts & ~still])
         ]
         counts &= still
-    return Detected(
+    return DetectedModes(
         frequency[counts],
         damping[counts],
         residue[counts],
@@ -293,14 +326,8 @@ def _stable_clusters(per_order: list[np.ndarray]) -> list[tuple[float, float, in
     return merged
 
 
-def search_band(g_dist: float, h: float) -> float:
-    """Highest clamped frequency sought (rad/s): :data:`BAND_PER_G` · ``g_dist`` (rad/s),
-    at most 0.3/``h`` (the band the sample step ``h``, s, leaves)."""
-    return min(BAND_PER_G * g_dist, 0.3 / h)
-
-
 def _band(record: MotorRecord) -> float:
-    """:func:`search_band` of the record."""
+    """:func:`~arcosim.identification.band.search_band` of the record (rad/s)."""
     return search_band(record.g_dist, record.h)
 
 
@@ -345,31 +372,6 @@ def _modes(
         if len(chosen) == n:
             break
     return best[0], best[1], singular
-
-
-def moesp(u: np.ndarray, y: np.ndarray, order: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
-    """PO-MOESP for one input, one output: the eigenvalues of the order-``order``
-    state matrix (discrete time) and the singular values of the projected output
-    Hankel matrix (shape (rows,)); past inputs and outputs are the instruments."""
-    observability, singular = _observability(u, y, rows)
-    A = np.linalg.lstsq(observability[:-1, :order], observability[1:, :order], rcond=None)[0]
-    return np.linalg.eigvals(A), singular
-
-
-def _observability(u: np.ndarray, y: np.ndarray, rows: int) -> tuple[np.ndarray, np.ndarray]:
-    """PO-MOESP's extended observability matrix (every order; its first ``order``
-    columns are the order-``order`` model's, shape (rows, rows)) and singular values."""
-    columns = len(u) - 2 * rows + 1
-    past_u, future_u = _hankel(u, rows, columns), _hankel(u[rows:], rows, columns)
-    past_y, future_y = _hankel(y, rows, columns), _hankel(y[rows:], rows, columns)
-    L = np.linalg.qr(np.vstack([future_u, past_u, past_y, future_y]).T, mode="r").T
-    projected = L[3 * rows : 4 * rows, rows : 3 * rows]
-    left, singular, _ = np.linalg.svd(projected)
-    return left * np.sqrt(singular), singular
-
-
-def _hankel(x: np.ndarray, rows: int, columns: int) -> np.ndarray:
-    return np.lib.stride_tricks.sliding_window_view(x, columns)[:rows]
 
 
 def residues(record: MotorRecord, frequency: np.ndarray, damping: np.ndarray) -> np.ndarray:
@@ -417,3 +419,16 @@ def _residues_of(regressors: np.ndarray, record: MotorRecord) -> tuple[np.ndarra
     cov = newey_west_covariance(X, residual, newey_west_lag(residual, record))
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return r / norms, std / norms
+
+
+def modal_damping(J: np.ndarray, k: np.ndarray, modes: Modes) -> np.ndarray:
+    """Spring dampers B_i ≥ 0 whose clamped modal damping matches the modes' (first
+    order in the damping: 2 ζ_i p_i = Σ_j B_j (φ_ji − φ_(j−1)i)², φ the mass-normalized
+    clamped mode shapes, φ_0 = 0), shape (n,); a floor of 1e-3 of their mean."""
+    n = len(J)
+    eigenvalues, phi = clamped_modes(J, k)
+    stretch = np.diff(np.vstack([np.zeros(n), phi]), axis=0) ** 2  # (spring j, mode i)
+    target = 2.0 * np.clip(modes.damping, 1e-4, 0.2) * np.sqrt(eigenvalues)
+    B, _ = optimize.nnls(stretch.T, target)
+    floor = 1e-3 * max(float(np.mean(B)), 1e-12)
+    return np.maximum(B, floor)

@@ -2,15 +2,17 @@
 
 A chain of masses and springs is fixed by its driving-point response (motor angle in,
 reaction torque out; :mod:`arcosim.identification.chain_modes`), so a motor-side
-record carries every inertia, stiffness and damping. :func:`identify` reads the
-record's modes from a stabilization diagram of the subspace step
+record carries every inertia, stiffness and damping. :func:`identify_whole_chain` reads
+the record's modes from a stabilization diagram of the subspace step
 (:func:`arcosim.identification.modal_start.detect_modes`: a mode counts when it comes
 back at several model orders and its residue stands above its standard error), starts
 the chain from those modes and residues with no search (the Lanczos inverse), and fits
 every parameter: by the prediction-error fit from the current to the encoder
 (:mod:`arcosim.identification.encoder_fit`, with the motor's friction and a load
 torque when asked for) when the encoder's counts are known, else by the output-error
-fit to τ̂_reac (:mod:`arcosim.identification.output_error`).
+fit to τ̂_reac (:mod:`arcosim.identification.output_error`). A friction not given is
+first estimated and taken out of τ̂ (:mod:`arcosim.identification.motor_friction`).
+The result is a :class:`ChainChoice`: the chosen n, its fit and the evidence for n.
 
 ``masses="auto"`` takes n = the modes that count, confirmed by the data: the fits
 without the weakest modes are compared by their information criterion, one weak mode
@@ -23,24 +25,32 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
 
 from arcosim.identification.blas import single_threaded
-from arcosim.identification.chain_modes import clamped_modes
-from arcosim.identification.encoder_fit import EncoderRecord, refine, with_friction
-from arcosim.identification.encoder_fit import opening as encoder_opening
+from arcosim.identification.encoder_fit import refine
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.modal_start import Detected, Modes, chain_of, detect_modes, record_modes
+from arcosim.identification.modal_start import (
+    DetectedModes,
+    Modes,
+    chain_of,
+    detect_modes,
+    modal_damping,
+    record_modes,
+)
+from arcosim.identification.motor_friction import friction_cleaned, without_friction
 from arcosim.identification.output_error import (
-    Fit,
-    MotorRecord,
+    ParameterFit,
     check_excited,
     continued_fit,
-    predict,
-    through_g,
+)
+from arcosim.identification.records import (
+    EncoderRecord,
+    MotorRecord,
+    encoder_opening,
+    with_friction,
 )
 
 #: Largest chain ``masses="auto"`` tries.
@@ -68,16 +78,31 @@ def _lower(n: int) -> Callable[[np.ndarray], np.ndarray]:
     return lambda p: np.concatenate([1e-3 * p[: 2 * n], np.zeros(n)])
 
 
-def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Fit:
-    """Fit every J_i, k_i, B_i of an n-mass chain to ``record`` (steps in the module doc).
+def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> ParameterFit:
+    """Fit every J_i, k_i, B_i of an n-mass chain to ``record`` by output error, from
+    the modal start (steps in the module doc).
 
-    Returns:
-        The fit; ``extra`` holds the modes the start came from (``modes_rad_s``,
+    Parameters
+    ----------
+    record : MotorRecord
+        The motor angle (rad) and τ̂_reac (N·m).
+    n : int
+        Number of load masses (a count), ≥ 1.
+    modes : Modes, optional
+        The modes to start from (default: :func:`record_modes` of the record).
+
+    Returns
+    -------
+    ParameterFit
+        ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad) with standard
+        errors; ``extra`` holds the modes the start came from (``modes_rad_s``,
         ``damping_ratios``) and the subspace singular values (``singular_values``).
 
-    Raises:
-        IdentificationError: for n < 1, or a record that shows no motion, no reaction torque or
-            fewer than n modes.
+    Raises
+    ------
+    IdentificationError
+        For n < 1, or a record that shows no motion, no reaction torque or fewer than n
+        modes.
     """
     if n < 1:
         raise IdentificationError(f"the chain needs at least one load mass, got {n}")
@@ -102,9 +127,12 @@ def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Fit:
     return result
 
 
-def information_criterion(result: Fit, record: MotorRecord, lag: int | None = None) -> float:
-    """BIC with the effective sample count N / lag (lag: the Newey–West bandwidth,
-    ``result``'s own unless given; compare fits with one lag)."""
+def information_criterion(
+    result: ParameterFit, record: MotorRecord, lag: int | None = None
+) -> float:
+    """BIC (dimensionless) of ``result`` on ``record`` with the effective sample count
+    N / lag (lag: the Newey–West bandwidth in samples, ``result``'s own unless given;
+    compare fits with one lag)."""
     count = len(record.theta_m)
     effective = max(count / max(lag or result.lag, 1), 2.0)
     rss = result.rms_residual**2
@@ -112,22 +140,31 @@ def information_criterion(result: Fit, record: MotorRecord, lag: int | None = No
 
 
 @dataclass
-class Choice:
-    """Result of :func:`identify`: the chosen fit and the evidence for n.
+class ChainChoice:
+    """The chosen chain and the evidence for its number of masses: the result of
+    :func:`identify_whole_chain`.
 
-    Attributes:
-        n: load masses chosen.
-        fit: the fit with n masses.
-        criterion: BIC per n tried (lower is better).
-        rms_residual: rms residual per n tried (N·m).
-        refused: per n the record could not support, why.
-        seen: with ``"auto"``, the n the subspace singular values show (the largest
-            drop comes after the 2n-th; each mode adds a pair).
-        singular_values: those singular values, relative to the first.
+    Attributes
+    ----------
+    n : int
+        Load masses chosen (a count).
+    fit : ParameterFit
+        The fit with n masses.
+    criterion : dict of int to float
+        BIC per n tried (dimensionless; lower is better).
+    rms_residual : dict of int to float
+        Rms residual per n tried (N·m).
+    refused : dict of int to str
+        Per n the record could not support, why.
+    seen : int or None
+        The modes the record shows that count (a count; the stabilization diagram's,
+        :func:`~arcosim.identification.modal_start.detect_modes`).
+    singular_values : ndarray or None
+        The subspace step's singular values, relative to the first (dimensionless).
     """
 
     n: int
-    fit: Fit
+    fit: ParameterFit
     criterion: dict[int, float]
     rms_residual: dict[int, float]
     refused: dict[int, str] = field(default_factory=dict)
@@ -138,7 +175,7 @@ class Choice:
 @single_threaded
 def identify_whole_chain(
     record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
-) -> Choice:
+) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
     The record's modes come from a stabilization diagram of the subspace step
@@ -166,7 +203,7 @@ def identify_whole_chain(
 
     Returns
     -------
-    Choice
+    ChainChoice
         ``n``, the fit (``J[i]`` kg·m², ``k[i]`` N·m/rad, ``B[i]`` N·m·s/rad with
         standard errors, and the evidence), the criterion per n tried, refusals.
 
@@ -228,7 +265,7 @@ def identify_whole_chain(
     refused = {}
     if detected.weak:
         refused[n + 1] = missing_modes(detected, n + 1, record)
-    return Choice(
+    return ChainChoice(
         n,
         result,
         criterion,
@@ -239,7 +276,9 @@ def identify_whole_chain(
     )
 
 
-def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes: Modes) -> Fit:
+def _prediction_error(
+    record: MotorRecord | None, encoder: EncoderRecord, modes: Modes
+) -> ParameterFit:
     """The prediction-error fit of the chain with ``modes`` (:func:`refine`) from the
     modal start (:meth:`Modes.chain`, dampers from the modal damping)."""
     n = len(modes.frequency)
@@ -251,7 +290,7 @@ def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes:
         + ", ".join(f"{w:.4g}" for w in modes.frequency)
         + " rad/s (subspace stabilization diagram) and their residues"
     )
-    first = Fit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
+    first = ParameterFit(names(n), start, np.zeros_like(start), start, note, 0.0, 0.0, 1, 0)
     first.extra.update(_mode_evidence(modes))
     result = refine(encoder, record, first, n)
     if record is not None:
@@ -259,7 +298,7 @@ def _prediction_error(record: MotorRecord | None, encoder: EncoderRecord, modes:
     return result
 
 
-def _same_modes(a: Detected, b: Detected, tolerance: float = 5e-3) -> bool:
+def _same_modes(a: DetectedModes, b: DetectedModes, tolerance: float = 5e-3) -> bool:
     """Two mode readings agree: as many modes, each within ``tolerance`` (relative)."""
     if a.n != b.n:
         return False
@@ -269,10 +308,10 @@ def _same_modes(a: Detected, b: Detected, tolerance: float = 5e-3) -> bool:
 def _choose_and_fit(
     record: MotorRecord,
     encoder: EncoderRecord | None,
-    detected: Detected,
+    detected: DetectedModes,
     auto: bool,
     n_asked: int | None,
-) -> tuple[int, Fit, dict[int, float]]:
+) -> tuple[int, ParameterFit, dict[int, float]]:
     """n (read, or asked and checked), the fit, and the criterion per n tried."""
     n = detected.n if auto else n_asked
     if n < 1 or detected.n < n:
@@ -311,7 +350,7 @@ def _choose_and_fit(
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
 
 
-def _strongest(detected: Detected, n: int) -> Modes:
+def _strongest(detected: DetectedModes, n: int) -> Modes:
     """The n modes with the largest residue t values, by frequency."""
     if detected.n == n:
         return detected.modes()
@@ -331,63 +370,6 @@ def _mode_evidence(modes: Modes) -> dict:
         "damping_ratios": [float(z) for z in modes.damping],
         "singular_values": [float(x) for x in modes.singular_values[:20]],
     }
-
-
-def modal_damping(J: np.ndarray, k: np.ndarray, modes: Modes) -> np.ndarray:
-    """Spring dampers B_i ≥ 0 whose clamped modal damping matches the modes' (first
-    order in the damping: 2 ζ_i p_i = Σ_j B_j (φ_ji − φ_(j−1)i)², φ the mass-normalized
-    clamped mode shapes, φ_0 = 0), shape (n,); a floor of 1e-3 of their mean."""
-    n = len(J)
-    eigenvalues, phi = clamped_modes(J, k)
-    stretch = np.diff(np.vstack([np.zeros(n), phi]), axis=0) ** 2  # (spring j, mode i)
-    target = 2.0 * np.clip(modes.damping, 1e-4, 0.2) * np.sqrt(eigenvalues)
-    B, _ = optimize.nnls(stretch.T, target)
-    floor = 1e-3 * max(float(np.mean(B)), 1e-12)
-    return np.maximum(B, floor)
-
-
-def friction_cleaned(
-    record: MotorRecord, encoder: EncoderRecord, modes: Modes, largest: int
-) -> tuple[MotorRecord, float, float, Detected]:
-    """For a record whose τ̂_reac was computed without friction: the friction's start
-    (:func:`friction_start`) from the chain of ``modes``, the record with it taken out
-    of τ̂ (:func:`without_friction`), ``D_m`` (N·m·s/rad), ``f_c`` (N·m), and the modes
-    that record shows (:func:`~arcosim.identification.modal_start.detect_modes`, up to
-    ``largest`` masses)."""
-    J0, k0 = modes.chain()
-    D_m, f_c = friction_start(record, encoder, J0, k0, modal_damping(J0, k0, modes))
-    cleaned = without_friction(record, encoder, D_m, f_c)
-    return cleaned, D_m, f_c, detect_modes(cleaned, largest)
-
-
-def friction_start(
-    record: MotorRecord, encoder: EncoderRecord, J: np.ndarray, k: np.ndarray, B: np.ndarray
-) -> tuple[float, float]:
-    """Start values ``(D_m, f_c)`` (N·m·s/rad, N·m) for a record whose τ̂_reac was
-    computed without friction: what the start chain leaves of τ̂ is
-    ``G[D_m ω + f_c sgn ω]``, linear in both (least squares; each at least a small
-    positive value)."""
-
-    def G(x: np.ndarray) -> np.ndarray:
-        return through_g(x, record.g_dist, record.h)
-
-    left = record.tau_hat - predict(record, J, k, B)
-    omega = encoder.velocity
-    X = np.column_stack([G(omega), G(np.sign(omega))])
-    coef = np.linalg.lstsq(X[1:], left[1:], rcond=None)[0]
-    torque = float(np.sqrt(np.mean(encoder.drive**2)))
-    return max(float(coef[0]), 1e-9), max(float(coef[1]), 1e-3 * torque)
-
-
-def without_friction(
-    record: MotorRecord, encoder: EncoderRecord, D_m: float, f_c: float
-) -> MotorRecord:
-    """``record`` with ``G[D_m ω + f_c s]`` taken out of τ̂_reac (ω, s: the encoder
-    record's velocity and friction sign)."""
-    friction = D_m * encoder.velocity + f_c * encoder.sign
-    friction[0] = 0.0
-    tau = record.tau_hat - through_g(friction, record.g_dist, record.h)
-    return replace(record, tau_hat=tau)
 
 
 def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
@@ -416,7 +398,7 @@ def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
     return out
 
 
-def missing_modes(detected: Detected, n: int | None, record: MotorRecord) -> str:
+def missing_modes(detected: DetectedModes, n: int | None, record: MotorRecord) -> str:
     """Why the record cannot support n masses (n None: not even one), and what to do."""
     found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
     text = (
