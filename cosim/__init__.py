@@ -13,6 +13,7 @@ Drive logs
 read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
+read_chain          -- the chain (J_i, k_i, B_i) of a whole-chain report file
 
 Identifying the drive from a log (numpy/scipy, no FMU needed)
 -------------------------------------------------------------
@@ -58,6 +59,7 @@ ArcosimError        -- base of every error arcosim raises for a user to fix
 UserError           -- a bad argument, file or datum
 BuildError          -- an FMU could not be built
 IdentificationError -- a record or setting the identification cannot work with
+ChainFileError      -- a chain file read_chain cannot read
 
 The paper's experiments and the report are the command ``arcosim reproduce``
 (:func:`arcosim.experiments.reproduce.reproduce`).
@@ -85,6 +87,7 @@ _API = {
     "read_log": "arcosim.logs",
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
+    "read_chain": "arcosim.chainfile",
     "identify_drive": "arcosim.identification.drive",
     "DriveIdentification": "arcosim.identification.drive",
     "check_log": "arcosim.identification.log_check",
@@ -115,6 +118,7 @@ _API = {
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",
     "IdentificationError": "arcosim.identification.errors",
+    "ChainFileError": "arcosim.chainfile",
 }
 __all__ = ["__version__", *_API]
 
