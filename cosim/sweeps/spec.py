@@ -103,80 +103,39 @@ def load_spec(path: Path) -> SweepSpec:
     (``runs = 2.5`` and ``runs = "ten"`` are refused), numbers are finite, the name is
     a plain folder name (it names ``sweeps/<name>``: no ``/``, no ``..``), and a spec
     asks for 1 to :data:`MAX_RUNS` runs of 1 to :data:`MAX_STEPS` steps each.
+
+    Parameters
+    ----------
+    path : Path
+        The TOML file (format in the module's docstring).
+
+    Returns
+    -------
+    SweepSpec
+        The checked specification, defaults filled in.
+
+    Raises
+    ------
+    UserError
+        The first mistake found, naming the file and the key.
     """
     from arcosim.experiments.scenarios import SCENARIOS
-    from arcosim.logs import read_text_file
 
     path = Path(path)
-    text = read_text_file(path, "sweep spec")
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise UserError(f"{path}: not valid TOML ({_one_line(str(error))})") from None
+    raw = _read_toml(path)
     where = f"{path}:"
-    unknown = set(raw) - KEYS
-    if unknown:
-        raise UserError(
-            f"{where} unknown key {', '.join(sorted(_key(k) for k in unknown))} "
-            f"(known: {', '.join(sorted(KEYS))})"
-        )
-    name = _text(where, "name", raw.get("name", path.stem))
-    if not NAME.fullmatch(name) or name in (".", ".."):
-        raise UserError(
-            f"{where} name = {_shown(name)}: use letters, digits, '.', '_' and '-' only (it "
-            "names the folder sweeps/<name>), at most 100 characters, not '.' or '..'"
-        )
+    _check_keys(where, raw)
+    name = _name(where, raw.get("name", path.stem))
     scenario = _text(where, "scenario", raw.get("scenario", "rigid"))
     if scenario not in SCENARIOS:
         raise UserError(f"{where} scenario {_shown(scenario)} is not one of {', '.join(SCENARIOS)}")
-    metrics = raw.get("metrics", ["k_error", "B_error", "runtime"])
-    if not isinstance(metrics, list) or not metrics:
-        raise UserError(f'{where} metrics: write a list, e.g. metrics = ["k_error", "runtime"]')
-    for metric in metrics:
-        if not isinstance(metric, str) or metric not in METRICS:
-            raise UserError(f"{where} metric {_shown(metric)} is not one of {', '.join(METRICS)}")
-    metrics = tuple(dict.fromkeys(metrics))
-    fixed = _table(where, "fixed", raw.get("fixed", {}))
-    vary = _table(where, "vary", raw.get("vary", {}))
-    for qualified in [*vary, *fixed]:
-        if qualified.split(".", 1)[0] not in ("plant", "observer") or "." not in qualified:
-            raise UserError(
-                f"{where} {_key(qualified)!r}: name the FMU first (plant.NAME or observer.NAME)"
-            )
-    both = sorted(set(vary) & set(fixed))
-    if both:
-        raise UserError(f"{where} {both[0]} is both fixed and varied; keep one")
-    for qualified, value in fixed.items():
-        _scalar(where, qualified, value)
-    for qualified, dist in vary.items():
-        _check_distribution(path, qualified, dist)
-    grids = [n for n, d in vary.items() if d["distribution"] == "grid"]
-    if grids and len(grids) != len(vary):
-        raise UserError(
-            f"{where} a grid cannot be mixed with random distributions "
-            f"({', '.join(grids)} are grids)"
-        )
-    if grids:
-        runs = math.prod(len(vary[n]["values"]) for n in grids)
-        if runs > MAX_RUNS:
-            raise UserError(f"{where} the grid has {runs:,} runs, more than {MAX_RUNS:,}")
-        if "runs" in raw:  # a grid's size comes from the grid; runs is checked, not used
-            _integer(where, "runs", raw["runs"], 1, MAX_RUNS)
-    else:
-        runs = _integer(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
+    metrics = _metrics(where, raw.get("metrics", ["k_error", "B_error", "runtime"]))
+    fixed, vary = _parameters(path, raw)
+    runs = _runs(where, raw, vary)
     masses = _integer(where, "masses", raw.get("masses", 3), MIN_MASSES, MAX_MASSES)
     seed = _integer(where, "seed", raw.get("seed", 0), 0, 2**63 - 1)
     step = _real(where, "step", raw.get("step", 1e-3), MIN_STEP, MAX_TIME)
-    duration = raw.get("duration")
-    length = SCENARIOS[scenario].duration
-    if duration is not None:
-        duration = length = _real(where, "duration", duration, 0.0, MAX_TIME, low_open=True)
-    steps = round(length / step)
-    if not 1 <= steps <= MAX_STEPS:
-        raise UserError(
-            f"{where} step = {step:g} s gives {steps:.3g} steps in {length:g} s; "
-            f"a run takes 1 to {MAX_STEPS:,} steps"
-        )
+    duration = _duration(where, raw.get("duration"), step, SCENARIOS[scenario].duration)
     ideal = raw.get("ideal", False)
     if not isinstance(ideal, bool):
         raise UserError(f"{where} ideal = {_shown(ideal)}: write true or false")
@@ -195,7 +154,104 @@ def load_spec(path: Path) -> SweepSpec:
     )
 
 
+def _read_toml(path: Path) -> dict:
+    """The TOML table of a UTF-8 file."""
+    from arcosim.logs import read_text_file
+
+    text = read_text_file(path, "sweep spec")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise UserError(f"{path}: not valid TOML ({_one_line(str(error))})") from None
+
+
+def _check_keys(where: str, raw: dict) -> None:
+    """Refuse a key that is not one of :data:`KEYS`."""
+    unknown = set(raw) - KEYS
+    if unknown:
+        raise UserError(
+            f"{where} unknown key {', '.join(sorted(_key(k) for k in unknown))} "
+            f"(known: {', '.join(sorted(KEYS))})"
+        )
+
+
+def _name(where: str, value: object) -> str:
+    """The sweep's name: a plain folder name (:data:`NAME`)."""
+    name = _text(where, "name", value)
+    if not NAME.fullmatch(name) or name in (".", ".."):
+        raise UserError(
+            f"{where} name = {_shown(name)}: use letters, digits, '.', '_' and '-' only (it "
+            "names the folder sweeps/<name>), at most 100 characters, not '.' or '..'"
+        )
+    return name
+
+
+def _metrics(where: str, metrics: object) -> tuple[str, ...]:
+    """A non-empty list of :data:`METRICS`, each kept once in its first place."""
+    if not isinstance(metrics, list) or not metrics:
+        raise UserError(f'{where} metrics: write a list, e.g. metrics = ["k_error", "runtime"]')
+    for metric in metrics:
+        if not isinstance(metric, str) or metric not in METRICS:
+            raise UserError(f"{where} metric {_shown(metric)} is not one of {', '.join(METRICS)}")
+    return tuple(dict.fromkeys(metrics))
+
+
+def _parameters(path: Path, raw: dict) -> tuple[dict, dict]:
+    """The ``[fixed]`` and ``[vary]`` tables: FMU-qualified names, each in one table,
+    fixed values that are scalars, distributions that are complete."""
+    where = f"{path}:"
+    fixed = _table(where, "fixed", raw.get("fixed", {}))
+    vary = _table(where, "vary", raw.get("vary", {}))
+    for qualified in [*vary, *fixed]:
+        if qualified.split(".", 1)[0] not in ("plant", "observer") or "." not in qualified:
+            raise UserError(
+                f"{where} {_key(qualified)!r}: name the FMU first (plant.NAME or observer.NAME)"
+            )
+    both = sorted(set(vary) & set(fixed))
+    if both:
+        raise UserError(f"{where} {both[0]} is both fixed and varied; keep one")
+    for qualified, value in fixed.items():
+        _scalar(where, qualified, value)
+    for qualified, dist in vary.items():
+        _check_distribution(path, qualified, dist)
+    return fixed, vary
+
+
+def _runs(where: str, raw: dict, vary: dict) -> int:
+    """The number of runs: the grid's size when every varied parameter is a grid (a
+    ``runs`` given beside it is checked, not used), else ``runs``."""
+    grids = [n for n, d in vary.items() if d["distribution"] == "grid"]
+    if grids and len(grids) != len(vary):
+        raise UserError(
+            f"{where} a grid cannot be mixed with random distributions "
+            f"({', '.join(grids)} are grids)"
+        )
+    if not grids:
+        return _integer(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
+    runs = math.prod(len(vary[n]["values"]) for n in grids)
+    if runs > MAX_RUNS:
+        raise UserError(f"{where} the grid has {runs:,} runs, more than {MAX_RUNS:,}")
+    if "runs" in raw:
+        _integer(where, "runs", raw["runs"], 1, MAX_RUNS)
+    return runs
+
+
+def _duration(where: str, duration: object, step: float, length: float) -> float | None:
+    """The run's length (s) if the spec shortens the scenario's ``length`` (s); refuse a
+    ``step`` (s) that gives no step or more than :data:`MAX_STEPS`."""
+    if duration is not None:
+        duration = length = _real(where, "duration", duration, 0.0, MAX_TIME, low_open=True)
+    steps = round(length / step)
+    if not 1 <= steps <= MAX_STEPS:
+        raise UserError(
+            f"{where} step = {step:g} s gives {steps:.3g} steps in {length:g} s; "
+            f"a run takes 1 to {MAX_STEPS:,} steps"
+        )
+    return duration
+
+
 def _check_distribution(path: Path, name: str, dist: object) -> None:
+    """A ``[vary]`` entry: a known distribution with exactly its keys, each valid."""
     where = f"{path}: {name}:"
     if not isinstance(dist, dict) or "distribution" not in dist:
         raise UserError(f'{where} write {{ distribution = "uniform", low = …, high = … }}')
@@ -211,19 +267,32 @@ def _check_distribution(path: Path, name: str, dist: object) -> None:
     if extra:
         raise UserError(f"{where} a {kind} distribution takes no {', '.join(extra)}")
     if kind in ("choice", "grid"):
-        values = dist["values"]
-        if not isinstance(values, list) or not values:
-            raise UserError(f"{where} values must be a non-empty list")
-        if len(values) > MAX_RUNS:
-            raise UserError(f"{where} at most {MAX_RUNS:,} values")
-        for value in values:
-            _scalar(f"{path}:", f"{name} value", value)
-        return
+        _check_values(path, name, dist["values"])
+    else:
+        _check_bounds(path, name, kind, dist)
+
+
+def _check_values(path: Path, name: str, values: object) -> None:
+    """A ``choice`` or ``grid``'s values: a non-empty list of at most :data:`MAX_RUNS`
+    scalars."""
+    where = f"{path}: {name}:"
+    if not isinstance(values, list) or not values:
+        raise UserError(f"{where} values must be a non-empty list")
+    if len(values) > MAX_RUNS:
+        raise UserError(f"{where} at most {MAX_RUNS:,} values")
+    for value in values:
+        _scalar(f"{path}:", f"{name} value", value)
+
+
+def _check_bounds(path: Path, name: str, kind: str, dist: dict) -> None:
+    """A random distribution's numbers: integers for ``randint``, finite numbers else;
+    low below high, a positive low for ``loguniform``, a positive std for ``normal``."""
+    where = f"{path}: {name}:"
     for key in DISTRIBUTIONS[kind]:
         if kind == "randint":
-            _integer(f"{path}: {name}:", key, dist[key], -(2**63), 2**63 - 1)
+            _integer(where, key, dist[key], -(2**63), 2**63 - 1)
         else:
-            _real(f"{path}: {name}:", key, dist[key], -1e300, 1e300)
+            _real(where, key, dist[key], -1e300, 1e300)
     if kind in ("uniform", "loguniform", "randint") and not dist["low"] < dist["high"]:
         raise UserError(f"{where} low = {dist['low']} must be below high = {dist['high']}")
     if kind == "loguniform" and not dist["low"] > 0:
