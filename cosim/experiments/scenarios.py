@@ -19,7 +19,7 @@ import numpy as np
 
 from arcosim.build.builder import ensure_built
 from arcosim.build.recipes import OBSERVER, PLANT
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
@@ -87,7 +87,9 @@ def _self_identification_current(t: np.ndarray) -> np.ndarray:
 
 def _flexible_current(t: np.ndarray) -> np.ndarray:
     """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s, 0.48 A."""
-    return excitation.multisine(t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1)
+    return current_commands.multisine(
+        t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1
+    )
 
 
 #: Lines of the whole-chain identification multi-sine (rad/s): 40, log-spaced over 3 … 150.
@@ -102,7 +104,7 @@ IDENTIFICATION_DURATION = 20.0
 
 def identification_current(t: np.ndarray) -> np.ndarray:
     """The whole-chain identification multi-sine (A)."""
-    return excitation.multisine(t, IDENTIFICATION_AMPLITUDE, IDENTIFICATION_LINES, 1)
+    return current_commands.multisine(t, IDENTIFICATION_AMPLITUDE, IDENTIFICATION_LINES, 1)
 
 
 #: The maneuver's length: 8 periods at 2.1 rad/s.
@@ -126,13 +128,20 @@ class LoadProfile:
     the samples; at the flexible scenario's 0.48 A in 35 %, and the settled estimate
     comes out 11 % low (README, "Sensorless load torque").
 
-    Attributes:
-        mass: the load mass the torque acts on (1 … n).
-        amplitude: peak current argument of the multi-sine (A).
-        fraction: step size over the drive's peak torque.
-        step_time, sine_time: s.
-        frequency: of the sine (rad/s).
-        duration: s.
+    Parameters
+    ----------
+    mass : int
+        The load mass the torque acts on (1 … n, an index).
+    amplitude : float
+        Peak current argument of the multi-sine (A).
+    fraction : float
+        Step size over the drive's peak torque (dimensionless).
+    step_time, sine_time : float
+        When the step, then the sine, starts (s).
+    frequency : float
+        Frequency of the sine (rad/s).
+    duration : float
+        Length of the run (s).
     """
 
     mass: int = 3
@@ -145,7 +154,7 @@ class LoadProfile:
 
     def current(self, t: np.ndarray) -> np.ndarray:
         """The maneuver's current command (A)."""
-        return excitation.multisine(t, self.amplitude, BROADBAND_LINES, 1)
+        return current_commands.multisine(t, self.amplitude, BROADBAND_LINES, 1)
 
     def size(self) -> float:
         """The step (N·m): ``fraction`` of the bench drive's peak torque over the run."""
@@ -209,7 +218,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "rigid",
             "rigid maneuver: 3 A at 2.1 rad/s under raised-cosine ramps, no drift (mode 1)",
-            lambda t: excitation.rigid_maneuver(t),
+            lambda t: current_commands.rigid_maneuver(t),
             RIGID_DURATION,
             {},
             {"mode": 1},
@@ -234,7 +243,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "chirp",
             "chirp 1 → 150 rad/s over 10 s, 0.2 A (mode 2)",
-            lambda t: excitation.chirp(t, 0.2, 1.0, 150.0, 10.0),
+            lambda t: current_commands.chirp(t, 0.2, 1.0, 150.0, 10.0),
             10.0,
             {},
             {"mode": 2},
@@ -242,7 +251,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "random",
             "filtered random current, 0.15 A rms below 150 rad/s (mode 2)",
-            lambda t: excitation.filtered_random(t, 0.15, 150.0, seed=7),
+            lambda t: current_commands.filtered_random(t, 0.15, 150.0, seed=7),
             10.0,
             {},
             {"mode": 2},

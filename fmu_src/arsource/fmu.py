@@ -1,8 +1,8 @@
 """``ExcitationSource``: the scenarios' current commands as an FMI 2.0 co-simulation FMU.
 
 Feeds the plant's ``i_ref`` in any FMI host (an SSP system, ecos, Simulink) with the
-same signals that ``arcosim.experiments.excitation`` gives offline. After ``doStep(t, h)`` the
-output is the command for the step that starts at ``t + h``.
+same signals that ``arcosim.experiments.current_commands`` gives offline. After
+``doStep(t, h)`` the output is the command for the step that starts at ``t + h``.
 """
 
 from __future__ import annotations

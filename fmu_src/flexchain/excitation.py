@@ -1,8 +1,8 @@
 """Current commands (A) as functions of time: the scenarios' excitations.
 
 Standard library only: the ExcitationSource FMU bundles this module, and
-``arcosim.experiments.excitation`` evaluates the same functions over arrays, so an FMU run and
-an offline run see the same signal.
+``arcosim.experiments.current_commands`` evaluates the same functions over arrays, so an FMU
+run and an offline run see the same signal.
 """
 
 from __future__ import annotations
