@@ -1,4 +1,5 @@
-"""arcosim — sensorless identification and state estimation of flexible drives.
+"""``cosim/`` installed as ``arcosim``: sensorless identification and state estimation of
+flexible drives.
 
 A motor drives a chain of inertias joined by springs (a robot joint, a belt drive,
 a multi-inertia test bench). From the motor's current and encoder alone, arcosim
@@ -68,6 +69,23 @@ Every name above is importable from ``arcosim`` directly (loaded on first use, s
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
 ``arcosim.host``, ``arcosim.build``, ``arcosim.experiments``, ``arcosim.sweeps``,
 ``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
+
+Modules and subpackages, in the order data flows (each subpackage's docstring lists its
+modules):
+
+fmu (``fmu_src/``)        -- the code inside the FMUs: the algorithms and every default
+plant (``plant_models/``) -- the plant: a Python reference and the C sources
+build                     -- the FMUs built into a folder or the per-user cache
+portability               -- what makes an FMU portable, checked on its files
+host                      -- the FMUs run on fmpy: instances, the master, replay, SSP, validation
+logs                      -- drive logs read and checked; recordings written as CSV
+identification            -- the drive identified offline from a log (numpy/scipy, no FMU)
+chainfile                 -- a whole-chain report read back as its chain (``read_chain``)
+experiments               -- the paper's experiments on the simulated bench, the report
+sweeps                    -- Monte Carlo and grid sweeps of co-simulations
+outputs                   -- every file a command writes: checked first, written atomically
+errors, version           -- the errors a user can fix; the installed version
+cli, __main__             -- the ``arcosim`` command (imported by nothing else)
 
 Examples
 --------
