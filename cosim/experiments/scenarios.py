@@ -95,15 +95,16 @@ def _flexible_current(t: np.ndarray) -> np.ndarray:
 #: Lines of the whole-chain identification multi-sine (rad/s): 40, log-spaced over 3 … 150.
 #: The subspace start needs many lines: with 11 it takes excitation lines for modes.
 IDENTIFICATION_LINES = np.geomspace(3.0, 150.0, 40)
-#: Its peak current (A): at 1 A the motor's Coulomb friction and the encoder's counts
-#: bias every J_i and k_i by 1.5–3 % on the five-mass chain; at 3 A by ≤ 1.3 % (README).
+#: Its peak current (A): at 1 A the motor sticks 18 % of the time and the five-mass chain's
+#: J_i, k_i come out 0.4–1.5 % off; at 3 A within 0.1 % (docs/identification.md, "What a
+#: log needs").
 IDENTIFICATION_AMPLITUDE = 3.0
 #: Its length (s).
 IDENTIFICATION_DURATION = 20.0
 
 
 def identification_current(t: np.ndarray) -> np.ndarray:
-    """The whole-chain identification multi-sine (A)."""
+    """The whole-chain identification multi-sine (A) at the step times ``t`` (s), shape ``(N,)``."""
     return current_commands.multisine(t, IDENTIFICATION_AMPLITUDE, IDENTIFICATION_LINES, 1)
 
 
@@ -126,7 +127,7 @@ class LoadProfile:
     the bench with this load: at 1 A the 2000-count encoder sees no new count within a
     step (ω_m = 0, so the DOB knows the reaction torque only to within ±f_c) in 3 % of
     the samples; at the flexible scenario's 0.48 A in 35 %, and the settled estimate
-    comes out 11 % low (README, "Sensorless load torque").
+    comes out 11 % low (docs/identification.md, "Sensorless load torque").
 
     Parameters
     ----------
@@ -153,7 +154,7 @@ class LoadProfile:
     duration: float = 15.0
 
     def current(self, t: np.ndarray) -> np.ndarray:
-        """The maneuver's current command (A)."""
+        """The maneuver's current command (A) at the step times ``t`` (s), shape ``(N,)``."""
         return current_commands.multisine(t, self.amplitude, BROADBAND_LINES, 1)
 
     def size(self) -> float:
@@ -166,7 +167,8 @@ class LoadProfile:
         return self.fraction * defaults.K_T * float(np.max(np.abs(self.current(t))))
 
     def torque(self, t: np.ndarray) -> np.ndarray:
-        """The external torque (N·m) held over the step starting at each of ``t`` (s)."""
+        """The external torque (N·m) held over the step starting at each of ``t`` (s),
+        shape ``(N,)``."""
         size = self.size()
         tau = np.where(t >= self.step_time, size, 0.0)
         sine = size * np.cos(self.frequency * (t - self.sine_time))
@@ -183,7 +185,7 @@ class LoadProfile:
         return self.duration - 2.0 * (2.0 * np.pi / self.frequency)
 
     def inputs(self, t: np.ndarray) -> dict[str, np.ndarray]:
-        """The plant inputs: ``tau_ext[mass]``."""
+        """The plant inputs at the step times ``t`` (s): ``tau_ext[mass]`` (N·m), shape ``(N,)``."""
         return {f"tau_ext[{self.mass}]": self.torque(t)}
 
     def scenario(self, name: str = "load-torque") -> Scenario:

@@ -29,7 +29,21 @@ from arcosim.host.master import MAX_STEPS, Recording
 
 @dataclass
 class SspSystem:
-    """What :func:`read_ssp` found: FMU paths, connections, parameter sets, experiment."""
+    """What :func:`read_ssp` found: FMU paths, connections, parameter sets, experiment.
+
+    Parameters
+    ----------
+    components : dict of str to Path
+        Component name → its FMU, unpacked from the SSP.
+    connections : list of tuple of str
+        ``(start component, start connector, end component, end connector)``.
+    parameter_sets : dict
+        Set name → component → variable → start value (in the variable's unit).
+    start, stop : float
+        The DefaultExperiment's start and stop time (s).
+    folder : TemporaryDirectory, optional
+        Where the SSP is unpacked; the caller cleans it up.
+    """
 
     components: dict[str, Path]
     connections: list[tuple[str, str, str, str]]
@@ -40,7 +54,23 @@ class SspSystem:
 
 
 def read_ssp(path: Path) -> SspSystem:
-    """Unpack an SSP and read its structure (raises :class:`UserError` on bad files)."""
+    """Unpack an SSP and read its structure.
+
+    Parameters
+    ----------
+    path : Path
+        The ``.ssp`` file.
+
+    Returns
+    -------
+    SspSystem
+        Its structure; ``folder`` holds the unpacked files (clean it up when done).
+
+    Raises
+    ------
+    UserError
+        A missing file, or one that is not a readable SSP (the reason named).
+    """
     if not Path(path).is_file():
         raise UserError(f"{path}: no such file")
     folder = tempfile.TemporaryDirectory(prefix="arcosim_ssp_")

@@ -81,7 +81,34 @@ NAME = re.compile(r"[A-Za-z0-9._-]{1,100}")
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """A checked sweep specification (see module doc)."""
+    """A checked sweep specification (the format in the module's docstring).
+
+    Parameters
+    ----------
+    name : str
+        The sweep's name, a plain folder name (``sweeps/<name>``).
+    scenario : str
+        A scenario of :data:`arcosim.SCENARIOS`.
+    masses : int
+        Number of load masses (a count).
+    runs : int
+        Number of runs (a count): the draws, or a grid's size.
+    seed : int
+        Seed every run's values are drawn from (an index).
+    metrics : tuple of str
+        Metrics of :data:`METRICS`, each once.
+    fixed : dict of str to object
+        ``"fmu.name"`` → the value every run takes (in the variable's unit).
+    vary : dict of str to dict
+        ``"fmu.name"`` → its distribution (``{"distribution": "uniform", "low": …,
+        "high": …}``), in the variable's unit.
+    duration : float or None
+        Length of each run (s); None: the scenario's.
+    step : float
+        Communication step (s).
+    ideal : bool
+        Whether the sensors are ideal.
+    """
 
     name: str
     scenario: str
@@ -366,7 +393,22 @@ def _one_line(text: str) -> str:
 
 
 def check_names(spec: SweepSpec, variables: Mapping[str, Mapping[str, object]]) -> None:
-    """Refuse parameter names the FMUs do not have, and values of the wrong type."""
+    """Refuse parameter names the FMUs do not have, and values of the wrong type.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The checked spec.
+    variables : mapping of str to mapping
+        ``"plant"`` and ``"observer"`` → their variables by name (fmpy
+        ``ScalarVariable`` objects, :func:`arcosim.build.builder.fmu_variables`).
+
+    Raises
+    ------
+    UserError
+        A name that is not a variable of its FMU, or not a parameter, or a fixed value
+        of the wrong type.
+    """
     for qualified, value in [*spec.fixed.items(), *((n, None) for n in spec.vary)]:
         fmu, name = qualified.split(".", 1)
         check_name(name, variables[fmu], fmu)
@@ -378,7 +420,19 @@ def check_names(spec: SweepSpec, variables: Mapping[str, Mapping[str, object]]) 
 
 
 def draw_runs(spec: SweepSpec) -> list[dict[str, object]]:
-    """Every run's varied values, drawn from ``spec.seed`` (the same every time)."""
+    """Every run's varied values, drawn from ``spec.seed`` (the same every time).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The checked spec.
+
+    Returns
+    -------
+    list of dict
+        One ``{"fmu.name": value}`` per run (in each variable's unit): the grid's
+        product when every varied parameter is a grid, else ``spec.runs`` draws.
+    """
     names = list(spec.vary)
     if names and all(spec.vary[n]["distribution"] == "grid" for n in names):
         combos = itertools.product(*(spec.vary[n]["values"] for n in names))
