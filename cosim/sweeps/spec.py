@@ -45,6 +45,16 @@ from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.errors import UserError
 from arcosim.host.master import MAX_STEPS, MAX_TIME, MIN_STEP
 from arcosim.host.overrides import check_name, typed_value
+from arcosim.sweeps.toml_values import (
+    check_scalar,
+    integer_value,
+    one_line,
+    real_value,
+    shown,
+    shown_key,
+    table_value,
+    text_value,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -153,19 +163,19 @@ def load_spec(path: Path) -> SweepSpec:
     where = f"{path}:"
     _check_keys(where, raw)
     name = _name(where, raw.get("name", path.stem))
-    scenario = _text(where, "scenario", raw.get("scenario", "rigid"))
+    scenario = text_value(where, "scenario", raw.get("scenario", "rigid"))
     if scenario not in SCENARIOS:
-        raise UserError(f"{where} scenario {_shown(scenario)} is not one of {', '.join(SCENARIOS)}")
+        raise UserError(f"{where} scenario {shown(scenario)} is not one of {', '.join(SCENARIOS)}")
     metrics = _metrics(where, raw.get("metrics", ["k_error", "B_error", "runtime"]))
     fixed, vary = _parameters(path, raw)
     runs = _runs(where, raw, vary)
-    masses = _integer(where, "masses", raw.get("masses", 3), MIN_MASSES, MAX_MASSES)
-    seed = _integer(where, "seed", raw.get("seed", 0), 0, 2**63 - 1)
-    step = _real(where, "step", raw.get("step", 1e-3), MIN_STEP, MAX_TIME)
+    masses = integer_value(where, "masses", raw.get("masses", 3), MIN_MASSES, MAX_MASSES)
+    seed = integer_value(where, "seed", raw.get("seed", 0), 0, 2**63 - 1)
+    step = real_value(where, "step", raw.get("step", 1e-3), MIN_STEP, MAX_TIME)
     duration = _duration(where, raw.get("duration"), step, SCENARIOS[scenario].duration)
     ideal = raw.get("ideal", False)
     if not isinstance(ideal, bool):
-        raise UserError(f"{where} ideal = {_shown(ideal)}: write true or false")
+        raise UserError(f"{where} ideal = {shown(ideal)}: write true or false")
     return SweepSpec(
         name=name,
         scenario=scenario,
@@ -189,7 +199,7 @@ def _read_toml(path: Path) -> dict:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise UserError(f"{path}: not valid TOML ({_one_line(str(error))})") from None
+        raise UserError(f"{path}: not valid TOML ({one_line(str(error))})") from None
 
 
 def _check_keys(where: str, raw: dict) -> None:
@@ -197,17 +207,17 @@ def _check_keys(where: str, raw: dict) -> None:
     unknown = set(raw) - KEYS
     if unknown:
         raise UserError(
-            f"{where} unknown key {', '.join(sorted(_key(k) for k in unknown))} "
+            f"{where} unknown key {', '.join(sorted(shown_key(k) for k in unknown))} "
             f"(known: {', '.join(sorted(KEYS))})"
         )
 
 
 def _name(where: str, value: object) -> str:
     """The sweep's name: a plain folder name (:data:`NAME`)."""
-    name = _text(where, "name", value)
+    name = text_value(where, "name", value)
     if not NAME.fullmatch(name) or name in (".", ".."):
         raise UserError(
-            f"{where} name = {_shown(name)}: use letters, digits, '.', '_' and '-' only (it "
+            f"{where} name = {shown(name)}: use letters, digits, '.', '_' and '-' only (it "
             "names the folder sweeps/<name>), at most 100 characters, not '.' or '..'"
         )
     return name
@@ -219,7 +229,7 @@ def _metrics(where: str, metrics: object) -> tuple[str, ...]:
         raise UserError(f'{where} metrics: write a list, e.g. metrics = ["k_error", "runtime"]')
     for metric in metrics:
         if not isinstance(metric, str) or metric not in METRICS:
-            raise UserError(f"{where} metric {_shown(metric)} is not one of {', '.join(METRICS)}")
+            raise UserError(f"{where} metric {shown(metric)} is not one of {', '.join(METRICS)}")
     return tuple(dict.fromkeys(metrics))
 
 
@@ -227,18 +237,19 @@ def _parameters(path: Path, raw: dict) -> tuple[dict, dict]:
     """The ``[fixed]`` and ``[vary]`` tables: FMU-qualified names, each in one table,
     fixed values that are scalars, distributions that are complete."""
     where = f"{path}:"
-    fixed = _table(where, "fixed", raw.get("fixed", {}))
-    vary = _table(where, "vary", raw.get("vary", {}))
+    fixed = table_value(where, "fixed", raw.get("fixed", {}))
+    vary = table_value(where, "vary", raw.get("vary", {}))
     for qualified in [*vary, *fixed]:
         if qualified.split(".", 1)[0] not in ("plant", "observer") or "." not in qualified:
             raise UserError(
-                f"{where} {_key(qualified)!r}: name the FMU first (plant.NAME or observer.NAME)"
+                f"{where} {shown_key(qualified)!r}: name the FMU first "
+                "(plant.NAME or observer.NAME)"
             )
     both = sorted(set(vary) & set(fixed))
     if both:
         raise UserError(f"{where} {both[0]} is both fixed and varied; keep one")
     for qualified, value in fixed.items():
-        _scalar(where, qualified, value)
+        check_scalar(where, qualified, value)
     for qualified, dist in vary.items():
         _check_distribution(path, qualified, dist)
     return fixed, vary
@@ -254,12 +265,12 @@ def _runs(where: str, raw: dict, vary: dict) -> int:
             f"({', '.join(grids)} are grids)"
         )
     if not grids:
-        return _integer(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
+        return integer_value(where, "runs", raw.get("runs", 1), 1, MAX_RUNS)
     runs = math.prod(len(vary[n]["values"]) for n in grids)
     if runs > MAX_RUNS:
         raise UserError(f"{where} the grid has {runs:,} runs, more than {MAX_RUNS:,}")
     if "runs" in raw:
-        _integer(where, "runs", raw["runs"], 1, MAX_RUNS)
+        integer_value(where, "runs", raw["runs"], 1, MAX_RUNS)
     return runs
 
 
@@ -267,7 +278,7 @@ def _duration(where: str, duration: object, step: float, length: float) -> float
     """The run's length (s) if the spec shortens the scenario's ``length`` (s); refuse a
     ``step`` (s) that gives no step or more than :data:`MAX_STEPS`."""
     if duration is not None:
-        duration = length = _real(where, "duration", duration, 0.0, MAX_TIME, low_open=True)
+        duration = length = real_value(where, "duration", duration, 0.0, MAX_TIME, low_open=True)
     steps = round(length / step)
     if not 1 <= steps <= MAX_STEPS:
         raise UserError(
@@ -285,12 +296,12 @@ def _check_distribution(path: Path, name: str, dist: object) -> None:
     kind = dist["distribution"]
     if not isinstance(kind, str) or kind not in DISTRIBUTIONS:
         raise UserError(
-            f"{where} unknown distribution {_shown(kind)} (use {', '.join(DISTRIBUTIONS)})"
+            f"{where} unknown distribution {shown(kind)} (use {', '.join(DISTRIBUTIONS)})"
         )
     missing = [k for k in DISTRIBUTIONS[kind] if k not in dist]
     if missing:
         raise UserError(f"{where} a {kind} distribution needs {', '.join(missing)}")
-    extra = sorted(_key(k) for k in set(dist) - {"distribution", *DISTRIBUTIONS[kind]})
+    extra = sorted(shown_key(k) for k in set(dist) - {"distribution", *DISTRIBUTIONS[kind]})
     if extra:
         raise UserError(f"{where} a {kind} distribution takes no {', '.join(extra)}")
     if kind in ("choice", "grid"):
@@ -308,7 +319,7 @@ def _check_values(path: Path, name: str, values: object) -> None:
     if len(values) > MAX_RUNS:
         raise UserError(f"{where} at most {MAX_RUNS:,} values")
     for value in values:
-        _scalar(f"{path}:", f"{name} value", value)
+        check_scalar(f"{path}:", f"{name} value", value)
 
 
 def _check_bounds(path: Path, name: str, kind: str, dist: dict) -> None:
@@ -317,79 +328,15 @@ def _check_bounds(path: Path, name: str, kind: str, dist: dict) -> None:
     where = f"{path}: {name}:"
     for key in DISTRIBUTIONS[kind]:
         if kind == "randint":
-            _integer(where, key, dist[key], -(2**63), 2**63 - 1)
+            integer_value(where, key, dist[key], -(2**63), 2**63 - 1)
         else:
-            _real(where, key, dist[key], -1e300, 1e300)
+            real_value(where, key, dist[key], -1e300, 1e300)
     if kind in ("uniform", "loguniform", "randint") and not dist["low"] < dist["high"]:
         raise UserError(f"{where} low = {dist['low']} must be below high = {dist['high']}")
     if kind == "loguniform" and not dist["low"] > 0:
         raise UserError(f"{where} a loguniform distribution needs low > 0")
     if kind == "normal" and not dist["std"] > 0:
         raise UserError(f"{where} std = {dist['std']} must be > 0")
-
-
-def _text(where: str, key: str, value: object) -> str:
-    if not isinstance(value, str):
-        raise UserError(f'{where} {key} = {_shown(value)}: write a text in quotes ({key} = "…")')
-    return value
-
-
-def _table(where: str, key: str, value: object) -> dict:
-    if not isinstance(value, dict):
-        raise UserError(f"{where} {key}: write a table ([{key}], then NAME = VALUE lines)")
-    return value
-
-
-def _integer(where: str, key: str, value: object, low: int, high: int) -> int:
-    """A TOML integer from ``low`` to ``high`` (a float, Boolean or text is refused)."""
-    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-        raise UserError(f"{where} {key} = {_shown(value)}: a whole number from {low} to {high}")
-    return value
-
-
-def _real(
-    where: str, key: str, value: object, low: float, high: float, low_open: bool = False
-) -> float:
-    """A finite TOML number in its range (an integer counts as a number)."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if ok:
-        x = float(value)
-        ok = math.isfinite(x) and (x > low if low_open else x >= low) and x <= high
-    if not ok:
-        bound = ">" if low_open else ">="
-        raise UserError(
-            f"{where} {key} = {_shown(value)}: a finite number {bound} {low:g} and <= {high:g}"
-        )
-    return float(value)
-
-
-def _scalar(where: str, key: str, value: object) -> None:
-    """A parameter value: a finite number, a Boolean or a text."""
-    if isinstance(value, float) and not math.isfinite(value):
-        raise UserError(f"{where} {key} = {_shown(value)}: a finite number")
-    if not isinstance(value, (int, float, str, bool)):
-        raise UserError(f"{where} {key} = {_shown(value)}: a number, true/false or a text")
-
-
-def _shown(value: object) -> str:
-    """A value as a spec writes it, cut to a readable length, control characters escaped."""
-    if isinstance(value, bool):
-        text = "true" if value else "false"
-    elif isinstance(value, str):
-        text = repr(value)
-    else:
-        text = str(value)
-    text = text.encode("unicode_escape").decode("ascii") if not text.isprintable() else text
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _key(key: str) -> str:
-    """A TOML key for a message: control characters escaped, at most 60 characters."""
-    return _shown(key)[1:-1] if _shown(key).startswith(("'", '"')) else _shown(key)
-
-
-def _one_line(text: str) -> str:
-    return " ".join(text.split())
 
 
 def check_names(spec: SweepSpec, variables: Mapping[str, Mapping[str, object]]) -> None:
