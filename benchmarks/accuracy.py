@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.errors import UserError
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
@@ -93,7 +93,7 @@ def broadband(
     scenario = Scenario(
         "broadband",
         "multi-sine 3–150 rad/s",
-        lambda t: excitation.multisine(t, amplitude, LINES, 1),
+        lambda t: current_commands.multisine(t, amplitude, LINES, 1),
         duration,
         {},
         {"mode": 2},
@@ -107,7 +107,7 @@ def rigid(case: Case, seed: int) -> dict[str, np.ndarray]:
     scenario = Scenario(
         "rigid",
         "rigid maneuver",
-        lambda t: excitation.rigid_maneuver(t, frequency=w),
+        lambda t: current_commands.rigid_maneuver(t, frequency=w),
         8 * 2 * math.pi / w,
         {},
         {"mode": 1},

@@ -24,7 +24,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.experiments.scenarios import Scenario
 from arcosim.fmu.flexchain.waveforms import log_spaced
 from arcosim.identification.records import MotorRecord, motor_record
@@ -36,7 +36,7 @@ LINES = np.array(log_spaced(2.0, 300.0, 40))
 ONE_WAY = Scenario(
     "one-way",
     "0.15 A offset + 40-line multi-sine 2–300 rad/s",
-    lambda t: 0.15 + excitation.multisine(t, 0.3, LINES, 101),
+    lambda t: 0.15 + current_commands.multisine(t, 0.3, LINES, 101),
     20.0,
     {},
     {"mode": 2},

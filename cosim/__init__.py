@@ -1,4 +1,5 @@
-"""arcosim — sensorless identification and state estimation of flexible drives.
+"""``cosim/`` installed as ``arcosim``: sensorless identification and state estimation of
+flexible drives.
 
 A motor drives a chain of inertias joined by springs (a robot joint, a belt drive,
 a multi-inertia test bench). From the motor's current and encoder alone, arcosim
@@ -13,6 +14,7 @@ Drive logs
 read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
+read_chain          -- the chain (J_i, k_i, B_i) of a whole-chain report file
 
 Identifying the drive from a log (numpy/scipy, no FMU needed)
 -------------------------------------------------------------
@@ -58,6 +60,7 @@ ArcosimError        -- base of every error arcosim raises for a user to fix
 UserError           -- a bad argument, file or datum
 BuildError          -- an FMU could not be built
 IdentificationError -- a record or setting the identification cannot work with
+ChainFileError      -- a chain file read_chain cannot read
 
 The paper's experiments and the report are the command ``arcosim reproduce``
 (:func:`arcosim.experiments.reproduce.reproduce`).
@@ -66,6 +69,23 @@ Every name above is importable from ``arcosim`` directly (loaded on first use, s
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
 ``arcosim.host``, ``arcosim.build``, ``arcosim.experiments``, ``arcosim.sweeps``,
 ``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
+
+Modules and subpackages, in the order data flows (each subpackage's docstring lists its
+modules):
+
+fmu (``fmu_src/``)        -- the code inside the FMUs: the algorithms and every default
+plant (``plant_models/``) -- the plant: a Python reference and the C sources
+build                     -- the FMUs built into a folder or the per-user cache
+portability               -- what makes an FMU portable, checked on its files
+host                      -- the FMUs run on fmpy: instances, the master, replay, SSP, validation
+logs                      -- drive logs read and checked; recordings written as CSV
+identification            -- the drive identified offline from a log (numpy/scipy, no FMU)
+chainfile                 -- a whole-chain report read back as its chain (``read_chain``)
+experiments               -- the paper's experiments on the simulated bench, the report
+sweeps                    -- Monte Carlo and grid sweeps of co-simulations
+outputs                   -- every file a command writes: checked first, written atomically
+errors, version           -- the errors a user can fix; the installed version
+cli, __main__             -- the ``arcosim`` command (imported by nothing else)
 
 Examples
 --------
@@ -85,6 +105,7 @@ _API = {
     "read_log": "arcosim.logs",
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
+    "read_chain": "arcosim.chainfile",
     "identify_drive": "arcosim.identification.drive",
     "DriveIdentification": "arcosim.identification.drive",
     "check_log": "arcosim.identification.log_check",
@@ -104,10 +125,10 @@ _API = {
     "Recording": "arcosim.host.master",
     "replay_log": "arcosim.host.replay",
     "run_ssp": "arcosim.host.ssp",
-    "multisine": "arcosim.experiments.excitation",
-    "rigid_maneuver": "arcosim.experiments.excitation",
-    "chirp": "arcosim.experiments.excitation",
-    "filtered_random": "arcosim.experiments.excitation",
+    "multisine": "arcosim.experiments.current_commands",
+    "rigid_maneuver": "arcosim.experiments.current_commands",
+    "chirp": "arcosim.experiments.current_commands",
+    "filtered_random": "arcosim.experiments.current_commands",
     "build_all": "arcosim.build.builder",
     "ensure_built": "arcosim.build.builder",
     "validate": "arcosim.host.validate",
@@ -115,6 +136,7 @@ _API = {
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",
     "IdentificationError": "arcosim.identification.errors",
+    "ChainFileError": "arcosim.chainfile",
 }
 __all__ = ["__version__", *_API]
 

@@ -120,39 +120,12 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     text = read_text_file(path, "log")
     reader = csv.reader(io.StringIO(text, newline=""))
     try:
-        header = next(reader, None)
-        if header is None:
-            raise UserError(
-                f"{path}: the file is empty (expected a header row with {', '.join(LOG_COLUMNS)})"
-            )
-        header = [h.strip() for h in header]
-        missing = [c for c in LOG_COLUMNS if c not in header]
-        if missing:
-            shown = ", ".join(repr(h) if not h.isprintable() else h for h in header[:20])
-            raise UserError(
-                f"{path}: missing column {', '.join(missing)} (the header has: {shown})"
-            )
-        index = {c: header.index(c) for c in LOG_COLUMNS}
-        rows = []
-        for line, row in enumerate(reader, start=2):
-            if not row or all(not cell.strip() for cell in row):
-                continue
-            values = []
-            for c in LOG_COLUMNS:
-                i = index[c]
-                cell = row[i].strip() if i < len(row) else ""
-                try:
-                    x = float(cell)
-                except ValueError:
-                    raise UserError(
-                        f"{path}, row {line}, column {c}: {cell[:40]!r} is not a number"
-                    ) from None
-                if not math.isfinite(x):
-                    raise UserError(
-                        f"{path}, row {line}, column {c}: {cell[:40]} is not a finite number"
-                    )
-                values.append(x)
-            rows.append((line, values))
+        index = _column_index(path, next(reader, None))
+        rows = [
+            (line, _row_values(path, line, row, index))
+            for line, row in enumerate(reader, start=2)
+            if row and not all(not cell.strip() for cell in row)
+        ]
     except csv.Error as error:
         raise UserError(f"{path}, row {reader.line_num}: not CSV text ({error})") from None
     if len(rows) < 2:
@@ -177,6 +150,40 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
             f"(previous row: {float(data[bad[0], 0])!r} s)"
         )
     return DriveLog(path, {c: data[:, j] for j, c in enumerate(LOG_COLUMNS)})
+
+
+def _column_index(path: Path, header: list[str] | None) -> dict[str, int]:
+    """Where each of :data:`LOG_COLUMNS` is in the header row; refuse an empty file or a
+    missing column."""
+    if header is None:
+        raise UserError(
+            f"{path}: the file is empty (expected a header row with {', '.join(LOG_COLUMNS)})"
+        )
+    header = [h.strip() for h in header]
+    missing = [c for c in LOG_COLUMNS if c not in header]
+    if missing:
+        shown = ", ".join(repr(h) if not h.isprintable() else h for h in header[:20])
+        raise UserError(f"{path}: missing column {', '.join(missing)} (the header has: {shown})")
+    return {c: header.index(c) for c in LOG_COLUMNS}
+
+
+def _row_values(path: Path, line: int, row: list[str], index: dict[str, int]) -> list[float]:
+    """The values of :data:`LOG_COLUMNS` in one row (line ``line`` of the file); refuse a
+    cell that is not a finite number (a missing cell is an empty one)."""
+    values = []
+    for c in LOG_COLUMNS:
+        i = index[c]
+        cell = row[i].strip() if i < len(row) else ""
+        try:
+            x = float(cell)
+        except ValueError:
+            raise UserError(
+                f"{path}, row {line}, column {c}: {cell[:40]!r} is not a number"
+            ) from None
+        if not math.isfinite(x):
+            raise UserError(f"{path}, row {line}, column {c}: {cell[:40]} is not a finite number")
+        values.append(x)
+    return values
 
 
 def read_text_file(path: Path, what: str = "file") -> str:

@@ -106,36 +106,66 @@ def portability_problems(fmu: Path) -> list[str]:
     shadow its own: absolute or libpython entries in a Linux binary's NEEDED, RPATH or
     RUNPATH; Python code outside one uniquely named bundle; absolute imports of
     anything but the standard library."""
-    problems = []
     with zipfile.ZipFile(fmu) as z:
         names = z.namelist()
-        for name in names:
-            if not (name.startswith("binaries/linux64/") and name.endswith(".so")):
-                continue
-            entries = dynamic_entries(z.read(name))
-            for needed in entries["NEEDED"]:
-                if "/" in needed or needed.startswith("libpython"):
-                    problems.append(f"{name}: NEEDED {needed} ties it to one Python installation")
-            for kind in ("RPATH", "RUNPATH"):
-                for value in entries[kind]:
-                    for part in value.split(":"):
-                        if part and not part.startswith("$ORIGIN"):
-                            problems.append(f"{name}: {kind} {part} is an absolute path")
+        problems = [
+            problem
+            for name in names
+            if name.startswith("binaries/linux64/") and name.endswith(".so")
+            for problem in binary_problems(name, z.read(name))
+        ]
         python = [n for n in names if n.startswith("resources/") and n.endswith(".py")]
-        if not python:
-            return problems
-        if "resources/slavemodule.txt" not in names:
-            return [*problems, "resources/slavemodule.txt is missing"]
-        module = z.read("resources/slavemodule.txt").decode().strip()
-        bundle = module.split(".")[0]
-        if not BUNDLE_PATTERN.fullmatch(bundle):
-            problems.append(
-                f"resources/slavemodule.txt names {module!r}: not in a bundle named "
-                "arcosim_<identifier>_<digest> (a host could have imported it)"
-            )
-        allowed = {"resources/slavemodule.txt", f"resources/{module}.py"}
-        for name in python:
-            if name not in allowed and not name.startswith(f"resources/{bundle}/"):
-                problems.append(f"{name}: Python code outside the bundle {bundle}/")
-        sources = {n: z.read(n).decode("utf-8") for n in python}
+        if python:
+            problems += _bundle_problems(z, python)
+    return problems
+
+
+def binary_problems(name: str, data: bytes) -> list[str]:
+    """What ties one Linux binary to the machine that built it: a NEEDED entry with a
+    path or naming a libpython, an RPATH or RUNPATH part that is not ``$ORIGIN``-relative.
+
+    Parameters
+    ----------
+    name : str
+        The binary's name in the FMU, for the messages.
+    data : bytes
+        The binary (an ELF64 little-endian shared object).
+
+    Returns
+    -------
+    list of str
+        One line per problem (empty when none).
+    """
+    entries = dynamic_entries(data)
+    problems = []
+    for needed in entries["NEEDED"]:
+        if "/" in needed or needed.startswith("libpython"):
+            problems.append(f"{name}: NEEDED {needed} ties it to one Python installation")
+    for kind in ("RPATH", "RUNPATH"):
+        for value in entries[kind]:
+            for part in value.split(":"):
+                if part and not part.startswith("$ORIGIN"):
+                    problems.append(f"{name}: {kind} {part} is an absolute path")
+    return problems
+
+
+def _bundle_problems(z: zipfile.ZipFile, python: list[str]) -> list[str]:
+    """What lets a host's packages shadow the FMU's own Python code (``python``, its
+    files under ``resources/``): no ``slavemodule.txt``, a slave module outside one
+    uniquely named bundle, code outside the bundle, absolute imports."""
+    if "resources/slavemodule.txt" not in z.namelist():
+        return ["resources/slavemodule.txt is missing"]
+    module = z.read("resources/slavemodule.txt").decode().strip()
+    bundle = module.split(".")[0]
+    problems = []
+    if not BUNDLE_PATTERN.fullmatch(bundle):
+        problems.append(
+            f"resources/slavemodule.txt names {module!r}: not in a bundle named "
+            "arcosim_<identifier>_<digest> (a host could have imported it)"
+        )
+    allowed = {"resources/slavemodule.txt", f"resources/{module}.py"}
+    for name in python:
+        if name not in allowed and not name.startswith(f"resources/{bundle}/"):
+            problems.append(f"{name}: Python code outside the bundle {bundle}/")
+    sources = {n: z.read(n).decode("utf-8") for n in python}
     return problems + import_problems(sources)

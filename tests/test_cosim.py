@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.experiments.scenarios import SCENARIOS, run_scenario
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import cosimulate
@@ -99,7 +99,7 @@ def test_a_refused_step_stops_the_run_with_the_fmu_log(build_fmus) -> None:
 def test_rigid_maneuver_stays_far_below_the_first_mode_and_returns_to_rest() -> None:
     h = 1e-3
     t = np.arange(round(SCENARIOS["rigid"].duration / h)) * h
-    i = excitation.rigid_maneuver(t)
+    i = current_commands.rigid_maneuver(t)
     w, power = spectrum(i, h)
     assert power[w > 16.8 / 2].sum() < 1e-6 * power.sum()  # nothing near the first mode
     assert abs(i.sum() * h) < 1e-5 and abs(np.cumsum(i).sum() * h * h) < 1e-4  # ∫i = ∫∫i = 0
@@ -110,7 +110,7 @@ def test_rigid_maneuver_leaves_little_residual_vibration(build_fmus) -> None:
     """Twist left ringing 2 s after the maneuver: under 2 % of the twist it drove."""
     h = 1e-3
     t = np.arange(round(SCENARIOS["rigid"].duration / h)) * h
-    current = np.r_[excitation.rigid_maneuver(t), np.zeros(2000)]
+    current = np.r_[current_commands.rigid_maneuver(t), np.zeros(2000)]
     folder = build_fmus(3)
     with (
         FmuInstance(folder / "MotorChainPlant.fmu", "p") as p,
@@ -126,18 +126,18 @@ def test_multisine_has_energy_only_at_its_frequencies() -> None:
     h, n = 1e-3, 2**14
     t = np.arange(n) * h
     lines = 2 * np.pi * np.array([5, 11, 40]) / (n * h)  # exact FFT bins
-    w, power = spectrum(excitation.multisine(t, 0.3, lines * 50, seed=2), h)
+    w, power = spectrum(current_commands.multisine(t, 0.3, lines * 50, seed=2), h)
     bins = np.argsort(power)[-3:]
     np.testing.assert_allclose(np.sort(w[bins]), np.sort(lines * 50), rtol=1e-9)
     assert power[bins].sum() > 0.999999 * power.sum()
-    peak = np.max(np.abs(excitation.multisine(t, 0.3, lines, seed=2)))
+    peak = np.max(np.abs(current_commands.multisine(t, 0.3, lines, seed=2)))
     assert 0.1 < peak <= 0.3  # each line 0.3 / 3: the peak never exceeds the amplitude
 
 
 def test_chirp_sweeps_its_band_only() -> None:
     h = 1e-3
     t = np.arange(10000) * h
-    w, power = spectrum(excitation.chirp(t, 0.2, 10.0, 100.0, 10.0), h)
+    w, power = spectrum(current_commands.chirp(t, 0.2, 10.0, 100.0, 10.0), h)
     assert power[(w < 5) | (w > 130)].sum() < 0.01 * power.sum()
 
 
@@ -145,12 +145,12 @@ def test_filtered_random_is_below_its_cutoff() -> None:
     """4th-order Butterworth, causal: −24 dB per octave above the cut-off."""
     h = 1e-3
     t = np.arange(20000) * h
-    x = excitation.filtered_random(t, 0.15, 150.0, seed=3)
+    x = current_commands.filtered_random(t, 0.15, 150.0, seed=3)
     w, power = spectrum(x, h, window=True)
     assert power[w > 450].sum() < 1e-3 * power.sum()
     # the rms of one 20 s realization: within 10 % of the set value
     assert np.sqrt(np.mean(x**2)) == pytest.approx(0.15, rel=0.1)
-    np.testing.assert_array_equal(x, excitation.filtered_random(t, 0.15, 150.0, seed=3))
+    np.testing.assert_array_equal(x, current_commands.filtered_random(t, 0.15, 150.0, seed=3))
 
 
 # -- simulate and identify ---------------------------------------------------------

@@ -17,7 +17,7 @@ from fmpy.validation import validate_fmu
 from scipy.signal import lfilter
 
 from arcosim.errors import UserError
-from arcosim.experiments.excitation import multisine, rigid_maneuver
+from arcosim.experiments.current_commands import multisine, rigid_maneuver
 from arcosim.host.instance import FmuInstance, RealPort
 from arcosim.host.master import cosimulate
 from tests.fmu_checks import step_from_resources

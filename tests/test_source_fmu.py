@@ -1,4 +1,5 @@
-"""The ExcitationSource FMU: the same signals as arcosim.experiments.excitation, in any host."""
+"""The ExcitationSource FMU: the same signals as arcosim.experiments.current_commands, in
+any host."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from arcosim.errors import UserError
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.fmu.flexchain.waveforms import log_spaced
 from arcosim.host.instance import FmuInstance
 
@@ -43,13 +44,15 @@ def test_source_validates(source) -> None:
 
 def test_rigid_maneuver_is_the_offline_one(source) -> None:
     t = np.arange(3001) * 1e-3
-    np.testing.assert_allclose(run_source(source, {}, 3000), excitation.rigid_maneuver(t), **SAME)
+    np.testing.assert_allclose(
+        run_source(source, {}, 3000), current_commands.rigid_maneuver(t), **SAME
+    )
 
 
 def test_multisine_is_the_offline_one(source) -> None:
     t = np.arange(2001) * 1e-3
     got = run_source(source, {"signal": 1, "amplitude": 0.3, "lines": 6, "seed": 4}, 2000)
-    want = excitation.multisine(t, 0.3, np.array(log_spaced(2.1, 120.0, 6)), seed=4)
+    want = current_commands.multisine(t, 0.3, np.array(log_spaced(2.1, 120.0, 6)), seed=4)
     np.testing.assert_allclose(got, want, **SAME)
 
 
@@ -67,7 +70,7 @@ def test_chirp_is_the_offline_one_and_stops(source) -> None:
         },
         2000,
     )
-    np.testing.assert_allclose(got, 0.01 + excitation.chirp(t, 0.2, 5.0, 50.0, 1.5), **SAME)
+    np.testing.assert_allclose(got, 0.01 + current_commands.chirp(t, 0.2, 5.0, 50.0, 1.5), **SAME)
     assert np.all(got[t > 1.5] == 0.01)
 
 
@@ -75,7 +78,7 @@ def test_filtered_random_is_the_offline_one(source) -> None:
     got = run_source(
         source, {"signal": 3, "amplitude": 0.15, "frequency_end": 150.0, "seed": 3}, 2000
     )
-    want = excitation.filtered_random(np.arange(1, 2001) * 1e-3, 0.15, 150.0, seed=3)
+    want = current_commands.filtered_random(np.arange(1, 2001) * 1e-3, 0.15, 150.0, seed=3)
     np.testing.assert_allclose(got[1:], want, **SAME)
 
 

@@ -1,12 +1,16 @@
-"""Building the project's FMUs: recipes, the C plant, the loader, the SSP writer.
+"""``cosim/build/`` installed as ``arcosim.build``: building the project's FMUs and their
+SSP system.
 
-- :mod:`~arcosim.build.recipes`: what is built (one :class:`FmuRecipe` per FMU);
-- :mod:`~arcosim.build.builder`: :func:`build_all`, :func:`ensure_built`;
-- :mod:`~arcosim.build.cache`: where FMUs go, their source digest and lock;
-- :mod:`~arcosim.build.cplant`: the plant FMU compiled from C;
-- :mod:`~arcosim.build.portable`, :mod:`~arcosim.build.exit_fix`: the portable layout
-  and the C trampoline in front of pythonfmu's binary, the exit-time fix of that binary;
-- :mod:`~arcosim.build.ssp`: the SSP system of the three FMUs.
+Modules, in the order data flows:
+
+recipes    -- what is built: one ``FmuRecipe`` per FMU, the numbers of masses supported
+cache      -- where FMUs go (per-user cache or a folder), their source digest and lock
+cplant     -- the plant FMU compiled from C (``plant_models/motorchain_c/``)
+exit_fix   -- pythonfmu 0.7's exit-time use-after-free removed from its Linux binary
+portable   -- pythonfmu's FMU rewritten to run anywhere: one bundle, the C trampoline
+ssp        -- the SSP system source → plant → observer (``ActionReaction.ssp``)
+builder    -- all of it, into a folder that is then current (``build_all``, ``ensure_built``)
+native     -- the C sources compiled at build time (``fmu_trampoline.c``)
 
 Imports nothing of :mod:`arcosim.host`, :mod:`arcosim.experiments` or the CLI.
 """

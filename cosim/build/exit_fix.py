@@ -129,9 +129,21 @@ def remove_exit_bug(data: bytes) -> bytes:
     A binary without the bug (already patched, or a pythonfmu that fixed it) comes back
     unchanged.
 
-    Raises:
-        ValueError: the destructor is in ``.fini_array`` but not as its last entry, a
-            layout this fix does not handle (a pythonfmu other than 0.7?).
+    Parameters
+    ----------
+    data : bytes
+        A shared object (any file: one that is not ELF comes back unchanged).
+
+    Returns
+    -------
+    bytes
+        The patched binary, or ``data`` itself when there is nothing to patch.
+
+    Raises
+    ------
+    ValueError
+        The destructor is in ``.fini_array`` but not as its last entry, a layout this
+        fix does not handle (a pythonfmu other than 0.7?).
     """
     if data[:4] != b"\x7fELF":
         return data

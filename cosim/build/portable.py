@@ -72,23 +72,35 @@ def make_portable(
 ) -> str:
     """Rewrite pythonfmu's FMU in place into the portable layout (module docstring).
 
-    Args:
-        fmu: the FMU pythonfmu built (its modelDescription.xml and binaries are kept).
-        packages: name → folder of every package to bundle (``fmukit``, ``flexchain``,
-            ``arobserver``); pythonfmu's runtime is added to them.
-        base: ``package.module:Class`` of the slave class, e.g.
-            ``arobserver.fmu:ReactionTorqueObserver``.
-        n: number of load masses (the generated class's ``n_masses``).
-        version: project version written into the generated class.
-        digest: the source digest (hex) the bundle's name is derived from.
-        headers: folder of the FMI 2.0 headers (``fmi2Functions.h``) for the trampoline.
+    Parameters
+    ----------
+    fmu : Path
+        The FMU pythonfmu built (its modelDescription.xml and binaries are kept).
+    packages : mapping of str to Path
+        Name → folder of every package to bundle (``fmukit``, ``flexchain``,
+        ``arobserver``); pythonfmu's runtime is added to them.
+    base : str
+        ``package.module:Class`` of the slave class, e.g.
+        ``arobserver.fmu:ReactionTorqueObserver``.
+    n : int
+        Number of load masses (the generated class's ``n_masses``, a count).
+    version : str
+        Project version written into the generated class.
+    digest : str
+        The source digest (hex) the bundle's name is derived from.
+    headers : Path
+        Folder of the FMI 2.0 headers (``fmi2Functions.h``) for the trampoline.
 
-    Returns:
+    Returns
+    -------
+    str
         The bundle's package name.
 
-    Raises:
-        BuildError: a bundled module imports something other than the standard library
-            by absolute name, or the C compiler failed (its output included).
+    Raises
+    ------
+    BuildError
+        A bundled module imports something other than the standard library by
+        absolute name, or the C compiler failed (its output included).
     """
     with zipfile.ZipFile(fmu) as z:
         members = {info.filename: z.read(info) for info in z.infolist()}

@@ -1,5 +1,26 @@
-"""The ``arcosim`` command line: one subcommand per module, dispatched through
-``set_defaults(execute=…)``.
+"""``cosim/cli/`` installed as ``arcosim.cli``: the ``arcosim`` command line, one
+subcommand per module (``identify`` in several), dispatched through
+``set_defaults(execute=…)``; nothing but ``arcosim.__main__`` imports it.
+
+Modules, in the order a command runs (then the subcommands, in ``arcosim --help``'s order):
+
+options                -- options several commands share, and the checks of every input
+parameters             -- the observer's parameters ``identify`` and ``check`` know (``--set``)
+build                  -- ``arcosim build``: the FMUs and their SSP into a folder
+simulate               -- ``arcosim simulate``: one scenario, any parameter overridden
+excite                 -- ``arcosim excite``: the excitation to play for identification
+check                  -- ``arcosim check``: can a log support identification?
+identify               -- ``arcosim identify``: its parser, and the method chosen
+identify_options       -- the options every method shares: ``--masses``, ``--out``, the report
+identify_observer      -- ``--method observer``: the observer FMU replayed over the log
+identify_output_error  -- ``--method output-error``: the uniform chain's k and B
+identify_whole_chain   -- ``--method whole-chain``: every J_i, k_i, B_i and n
+identify_load_torque   -- ``--method load-torque``: the torque on a load mass over time
+reproduce              -- ``arcosim reproduce``: the paper's experiments and the report
+sweep                  -- ``arcosim sweep``: Monte Carlo and grid sweeps on Dask
+ssp                    -- ``arcosim ssp``: an SSP system run
+validate               -- ``arcosim validate``: FMUs checked as a strict host would
+bench                  -- ``arcosim bench``: a benchmark of a source checkout
 
 Whatever goes wrong, a user sees one line on stderr, never a Python traceback:
 

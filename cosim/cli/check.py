@@ -16,8 +16,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from arcosim.cli.identify import defaults_note, known_parameters, set_names
 from arcosim.cli.options import log_options
+from arcosim.cli.parameters import defaults_note, known_parameters, set_names
 from arcosim.identification.log_check import check_log
 from arcosim.logs import parse_scales, read_log
 

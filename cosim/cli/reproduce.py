@@ -15,20 +15,20 @@ from pathlib import Path
 
 from arcosim.cli.options import add_fmus_option
 from arcosim.experiments import reproduce as experiments
-from arcosim.experiments.report import text_table
-from arcosim.experiments.reproduce import (
+from arcosim.experiments.findings import (
     LOAD_HEADER,
     TABLE_II_HEADER,
     WHOLE_CHAIN_HEADER,
     actuator_rows,
     load_angle_rows,
     load_rows,
-    reproduce,
     state_rows,
     table_ii_rows,
     whole_chain_rows,
     whole_state_rows,
 )
+from arcosim.experiments.report import text_table
+from arcosim.experiments.reproduce import reproduce
 
 
 def add_parser(

@@ -1,0 +1,15 @@
+"""``cosim/experiments/`` installed as ``arcosim.experiments``: the paper's experiments
+on the simulated bench, and the report of ``arcosim reproduce``.
+
+Modules, in the order data flows:
+
+current_commands -- current commands (A) over arrays of step times: multi-sine, chirp, …
+scenarios        -- a current command, a duration and FMU settings, run as one co-simulation
+paper            -- the paper's own Table II, in SI units
+metrics          -- how estimates are scored against the plant's truth
+reproduce        -- the five experiments, one function each (``reproduce``)
+findings         -- what they found, as tables and as ``report.md``'s text
+report           -- the figures, and tables as Markdown or text
+
+Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
+"""

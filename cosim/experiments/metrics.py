@@ -10,11 +10,36 @@ def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -
 
     The error relative to the flexible part of the motion (the rigid part is easy and
     would hide errors); 0 is perfect, the naive ``θ̂_i = θ_m`` scores 1.
+
+    Parameters
+    ----------
+    estimate, truth : ndarray
+        The estimated and the true angle of the mass (rad), shape ``(N,)``.
+    motor : ndarray
+        The true motor angle (rad), shape ``(N,)``.
+
+    Returns
+    -------
+    float
+        The score (dimensionless).
+
+    Examples
+    --------
+    >>> motor = np.zeros(4)
+    >>> truth = np.array([1.0, -1.0, 1.0, -1.0])
+    >>> flexible_score(motor, truth, motor)
+    1.0
     """
     flexible = max(float(np.mean((truth - motor) ** 2)), 1e-300)
     return float(np.sqrt(np.mean((estimate - truth) ** 2) / flexible))
 
 
 def percent_error(estimate: float, truth: float) -> float:
-    """Relative error of ``estimate`` in percent of ``truth``."""
+    """Relative error of ``estimate`` in percent of ``truth`` (both in one unit).
+
+    Examples
+    --------
+    >>> round(percent_error(1.01, 1.0), 6)
+    1.0
+    """
     return 100.0 * (estimate / truth - 1.0)

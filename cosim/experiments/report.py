@@ -1,4 +1,5 @@
-"""Figures and the markdown report of ``arcosim reproduce``."""
+"""Figures and tables of ``arcosim reproduce``: the PNG figures 4 to 8, the response a
+multi-sine record measures, and tables as Markdown or aligned text."""
 
 from __future__ import annotations
 
@@ -23,7 +24,24 @@ def _pyplot():
 def figure_reaction_torque(
     recording: Recording, reconstructed: np.ndarray, path: Path, k_hat: float, B_hat: float
 ) -> Path:
-    """Fig. 4: τ̂_reac against the torque rebuilt from k̂, B̂ and the load's encoder."""
+    """Fig. 4: τ̂_reac against the torque rebuilt from k̂, B̂ and the load's encoder.
+
+    Parameters
+    ----------
+    recording : Recording
+        A rigid maneuver's run (``observer.tau_reac_hat``, N·m).
+    reconstructed : ndarray
+        The torque rebuilt from k̂ and B̂ through G(s) (N·m), shape ``(N,)``.
+    path : Path
+        The PNG to write (replaced if it exists).
+    k_hat, B_hat : float
+        The identified stiffness (N·m/rad) and damping (N·m·s/rad).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     plt = _pyplot()
     t = recording.time
     fig, (ax, zoom) = plt.subplots(2, 1, figsize=(9, 6.5))
@@ -51,7 +69,22 @@ def figure_reaction_torque(
 
 
 def figure_flexible_response(recording: Recording, n: int, path: Path) -> Path:
-    """Fig. 5: true angles of the motor and every mass during the flexible maneuver."""
+    """Fig. 5: true angles of the motor and every mass during the flexible maneuver.
+
+    Parameters
+    ----------
+    recording : Recording
+        The flexible maneuver's run (``plant.theta_m_true``, ``plant.theta[i]``, rad).
+    n : int
+        Number of load masses (a count).
+    path : Path
+        The PNG to write (replaced if it exists).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     plt = _pyplot()
     t = recording.time
     fig, (ax, zoom) = plt.subplots(2, 1, figsize=(9, 6.5))
@@ -187,7 +220,24 @@ def figure_whole_chain(
 def figure_load_torque(
     time: np.ndarray, truth: np.ndarray, estimates: dict[str, np.ndarray], path: Path
 ) -> Path:
-    """Fig. 8: the load torque on the last mass, estimated from the motor against the truth."""
+    """Fig. 8: the load torque on the last mass, estimated from the motor against the truth.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    truth : ndarray
+        The torque applied (N·m), shape ``(N,)``.
+    estimates : dict of str to ndarray
+        Label → the estimate (N·m), each of shape ``(N,)``.
+    path : Path
+        The PNG to write (replaced if it exists).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     plt = _pyplot()
     fig, (ax, err) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
     ax.plot(time, truth * 1e3, color="k", lw=1.4, label="applied (plant tau_ext[3])")
@@ -240,14 +290,30 @@ def measured_response(
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    """A GitHub markdown table."""
+    """A GitHub markdown table.
+
+    Examples
+    --------
+    >>> print(markdown_table(["a", "b"], [[1, 2]]))
+    | a | b |
+    |---|---|
+    | 1 | 2 |
+    """
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
 
 
 def text_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    """The same table as aligned plain text, for the terminal."""
+    """The same table as aligned plain text, for the terminal.
+
+    Examples
+    --------
+    >>> print(text_table(["a", "bb"], [[1, 2]]))
+    a  bb
+    -  --
+    1   2
+    """
     cells = [list(map(str, header))] + [[str(c) for c in row] for row in rows]
     widths = [max(len(r[j]) for r in cells) for j in range(len(header))]
     out = ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]

@@ -22,23 +22,29 @@ a folder; ``arcosim reproduce`` is the command line.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from arcosim.build.builder import ensure_built, fmu_variables
 from arcosim.experiments.load_scores import score_profile, step_truth
-from arcosim.experiments.metrics import flexible_score, percent_error
-from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
+from arcosim.experiments.metrics import flexible_score
+from arcosim.experiments.findings import (
+    N_MASSES,
+    SEEDS,
+    TRUE_CHAIN,
+    Results,
+    report_markdown,
+)
 from arcosim.experiments.report import (
     figure_flexible_response,
     figure_load_torque,
     figure_reaction_torque,
     figure_state_estimates,
     figure_whole_chain,
-    markdown_table,
     measured_response,
 )
 from arcosim.experiments.scenarios import (
@@ -60,28 +66,6 @@ from arcosim.identification.records import encoder_record, motor_record
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, write_text
-from arcosim.version import __version__
-
-N_MASSES = 3
-SEEDS = (1, 2, 3, 4, 5)
-TRUE = {"D_m": defaults.D_M, "f_c": defaults.F_C, "k": defaults.K, "B": defaults.B}
-
-
-@dataclass
-class Results:
-    """What the five experiments found (SI units)."""
-
-    actuator: dict[str, float] = field(default_factory=dict)
-    rigid: list[dict[str, float]] = field(default_factory=list)
-    scores: list[float] = field(default_factory=list)
-    whole_chain: dict[str, float] = field(default_factory=dict)
-    whole_chain_std: dict[str, float] = field(default_factory=dict)
-    masses: int = 0
-    whole_scores: list[float] = field(default_factory=list)
-    load: dict[str, dict[str, float]] = field(default_factory=dict)
-    load_angles: dict[str, list[float]] = field(default_factory=dict)
-    files: list[Path] = field(default_factory=list)
-
 
 #: The files :func:`reproduce` writes into its folder.
 OUTPUTS = (
@@ -110,8 +94,31 @@ def reproduce(
 ) -> Results:
     """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
 
-    Refuses to start (:class:`UserError`) when one of :data:`OUTPUTS` exists in
-    ``out`` unless ``force``; every file is written atomically.
+    Parameters
+    ----------
+    out : Path
+        The folder to write into (created if needed).
+    ideal : bool
+        Ideal sensors (exact angle, true velocity, no noise) instead of the realistic
+        2000-count encoder and 5 mA rms current noise.
+    show_progress : bool
+        Whether to show a progress bar over the co-simulation steps.
+    fmu_dir : Path, optional
+        Folder of the FMUs, built there if missing or stale (default: the per-user cache).
+    force : bool
+        Whether the files of :data:`OUTPUTS` may be replaced.
+
+    Returns
+    -------
+    Results
+        What the experiments found, and every file written.
+
+    Raises
+    ------
+    UserError
+        When ``out`` is not a folder that can be written, or one of :data:`OUTPUTS`
+        exists in it and not ``force`` (checked before any run); every file is written
+        atomically.
     """
     from tqdm import tqdm
 
@@ -119,114 +126,194 @@ def reproduce(
     if not force:
         refuse_existing(out, OUTPUTS)
     folder = ensure_built(N_MASSES, fmu_dir)
-    steps = (
+    results = Results()
+    with tqdm(
+        total=_total_steps(),
+        unit="step",
+        unit_scale=True,
+        disable=not show_progress,
+        desc="reproduce",
+    ) as bar:
+        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str)
+        actuator = _self_identification(bench)
+        rigid, k_mean, b_mean = _rigid_maneuvers(bench, actuator)
+        flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
+        identification, estimated = _whole_chain(bench, actuator, flexible)
+        loaded = _load_torque(bench, actuator) if estimated is not None else None
+    if loaded is not None:
+        results.files.append(_load_torque_figure(out, loaded))
+    results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
+    if estimated is not None:
+        results.files.append(_whole_chain_figure(out, identification, results))
+    report = write_text(
+        out / "report.md", report_markdown(results, ideal, k_mean, b_mean), force=True
+    )
+    results.files.append(report)
+    return results
+
+
+def _total_steps() -> int:
+    """The co-simulation steps of the five experiments, for the progress bar (a count)."""
+    return (
         round(SCENARIOS["selfid"].duration / STEP)
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
         + 2 * round(SCENARIOS["flexible"].duration / STEP)
         + round(SCENARIOS["identification"].duration / STEP)
         + 2 * round(LOAD_PROFILE.duration / STEP)
     )
-    results = Results()
-    with tqdm(
-        total=steps, unit="step", unit_scale=True, disable=not show_progress, desc="reproduce"
-    ) as bar:
 
-        def run(name: str, **kw) -> Recording:
-            bar.set_postfix_str(name)
-            recording = run_scenario(
-                SCENARIOS[name], N_MASSES, ideal=ideal, fmu_dir=folder, progress=bar.update, **kw
-            )
-            return recording
 
-        selfid = run("selfid")
-        final = {k.split(".", 1)[1]: v[-1] for k, v in selfid.signals.items()}
-        results.actuator = {
-            k: float(final[k])
-            for k in ("dkt_hat", "dJm_hat", "D_m_hat", "f_c_hat", "self_id_rank_deficient")
-        }
-        results.files.append(write_csv(out / "selfid.csv", recording_columns(selfid), force=True))
-        actuator = {
-            "dkt": final["dkt_hat"],
-            "dJm": final["dJm_hat"],
-            "D_m": final["D_m_hat"],
-            "f_c": final["f_c_hat"],
-        }
+@dataclass
+class _Bench:
+    """Where the experiments run and write: the output folder, the FMUs, the sensors,
+    the results being filled in, and the progress bar's two calls."""
 
-        first_rigid = None
-        for seed in SEEDS:
-            rec = run("rigid", plant={"seed": seed}, observer=actuator)
-            k_hat, b_hat = rec["observer.k_hat"][-1], rec["observer.B_hat"][-1]
-            results.rigid.append(
-                {
-                    "seed": seed,
-                    "k": float(k_hat),
-                    "B": float(b_hat),
-                    "valid": bool(rec["observer.id_valid"][-1]),
-                }
-            )
-            results.files.append(
-                write_csv(out / f"rigid_seed{seed}.csv", recording_columns(rec), force=True)
-            )
-            first_rigid = first_rigid or rec
-        k_mean = float(np.mean([r["k"] for r in results.rigid]))
-        b_mean = float(np.mean([r["B"] for r in results.rigid]))
+    out: Path
+    folder: Path
+    ideal: bool
+    results: Results
+    progress: Callable[[int], object]
+    status: Callable[[str], object]
 
-        chain = {
-            f"{p}[{i}]": v
-            for i in range(1, N_MASSES + 1)
-            for p, v in (("k", k_mean), ("B", max(b_mean, 0.0)))
-        }
-        flexible = run("flexible", observer={**actuator, **chain})
-        results.files.append(
-            write_csv(out / "flexible.csv", recording_columns(flexible), force=True)
+    def run(self, name: str, **settings: dict) -> Recording:
+        """Co-simulate the scenario ``name`` on the bench (``plant=``, ``observer=``)."""
+        self.status(name)
+        return run_scenario(
+            SCENARIOS[name],
+            N_MASSES,
+            ideal=self.ideal,
+            fmu_dir=self.folder,
+            progress=self.progress,
+            **settings,
         )
 
-        identification = run("identification", plant={"seed": 1}, observer=actuator)
-        results.files.append(
-            write_csv(out / "identification.csv", recording_columns(identification), force=True)
+    def keep(self, name: str, recording: Recording) -> None:
+        """Write ``recording`` as the CSV ``name`` in the output folder."""
+        path = write_csv(self.out / name, recording_columns(recording), force=True)
+        self.results.files.append(path)
+
+    @functools.cached_property
+    def encoder_cpr(self) -> int:
+        """The plant's encoder counts per revolution (0: ideal sensors, no counts)."""
+        if self.ideal:
+            return 0
+        return int(fmu_variables(self.folder)["plant"]["encoder_cpr"].start)
+
+
+def _self_identification(bench: _Bench) -> dict[str, float]:
+    """Experiment 1: the actuator terms, the load detached (mode 0).
+
+    Fills ``results.actuator``; returns the terms as observer parameters (``dkt``,
+    ``dJm``, ``D_m``, ``f_c``) for the experiments after it.
+    """
+    selfid = bench.run("selfid")
+    final = {k.split(".", 1)[1]: v[-1] for k, v in selfid.signals.items()}
+    bench.results.actuator = {
+        k: float(final[k])
+        for k in ("dkt_hat", "dJm_hat", "D_m_hat", "f_c_hat", "self_id_rank_deficient")
+    }
+    bench.keep("selfid.csv", selfid)
+    return {
+        "dkt": final["dkt_hat"],
+        "dJm": final["dJm_hat"],
+        "D_m": final["D_m_hat"],
+        "f_c": final["f_c_hat"],
+    }
+
+
+def _rigid_maneuvers(bench: _Bench, actuator: dict[str, float]) -> tuple[Recording, float, float]:
+    """Experiment 2: k and B from five rigid maneuvers (mode 1), one per seed.
+
+    Fills ``results.rigid``; returns the first maneuver's recording (Fig. 4's) and the
+    mean k̂ (N·m/rad) and B̂ (N·m·s/rad).
+    """
+    runs = []
+    for seed in SEEDS:
+        rec = bench.run("rigid", plant={"seed": seed}, observer=actuator)
+        k_hat, b_hat = rec["observer.k_hat"][-1], rec["observer.B_hat"][-1]
+        bench.results.rigid.append(
+            {
+                "seed": seed,
+                "k": float(k_hat),
+                "B": float(b_hat),
+                "valid": bool(rec["observer.id_valid"][-1]),
+            }
         )
-        bar.set_postfix_str("whole-chain fit")
-        cpr = 0 if ideal else int(fmu_variables(folder)["plant"]["encoder_cpr"].start)
-        choice = _whole_chain(identification, results.actuator, cpr)
-        results.masses = choice.n
-        results.whole_chain = choice.fit.as_dict()
-        results.whole_chain_std = choice.fit.std_dict()
-        estimated = None
-        if choice.n == N_MASSES:  # the plant has three masses: n must match to co-simulate
-            identified = {**actuator, **results.whole_chain, "estimator": MODEL_BASED}
-            estimated = run("flexible", observer=identified)
-            results.files.append(
-                write_csv(out / "whole_chain.csv", recording_columns(estimated), force=True)
-            )
-            loaded = {}
-            for label, chain, name in (
-                ("true chain", TRUE_CHAIN, "load_true_chain.csv"),
-                ("identified chain", results.whole_chain, "load_identified_chain.csv"),
-            ):
-                loaded[label] = run(LOAD_PROFILE.scenario().name, observer={**actuator, **chain})
-                results.files.append(
-                    write_csv(out / name, recording_columns(loaded[label]), force=True)
-                )
-    motor = flexible["plant.theta_m_true"]
-    results.scores = _angle_scores(flexible, motor)
-    if estimated is not None:
-        results.whole_scores = _angle_scores(estimated, motor)
-    if estimated is not None:
-        results.files.append(_load_experiment(loaded, results, cpr, out / "fig8_load_torque.png"))
-    results.files += _figures(out, first_rigid, flexible, results, k_mean, b_mean, estimated)
-    if estimated is not None:
-        results.files.append(_whole_chain_figure(out, identification, results))
-    report = write_text(out / "report.md", _report(results, ideal, k_mean, b_mean), force=True)
-    results.files.append(report)
-    return results
+        bench.keep(f"rigid_seed{seed}.csv", rec)
+        runs.append(rec)
+    k_mean = float(np.mean([r["k"] for r in bench.results.rigid]))
+    b_mean = float(np.mean([r["B"] for r in bench.results.rigid]))
+    return runs[0], k_mean, b_mean
 
 
-#: The bench's chain as observer parameters (experiment 5's "true chain").
-TRUE_CHAIN = {
-    f"{p}[{i}]": v
-    for i in range(1, N_MASSES + 1)
-    for p, v in (("J", defaults.J[i - 1]), ("k", defaults.K), ("B", defaults.B))
-}
+def _flexible_maneuver(
+    bench: _Bench, actuator: dict[str, float], k_mean: float, b_mean: float
+) -> Recording:
+    """Experiment 3: every mass's angle by the paper's recursion (mode 2), with the
+    uniform chain of experiment 2's mean k̂ (N·m/rad) and B̂ (N·m·s/rad, at least 0).
+
+    Fills ``results.scores``; returns the recording (Figs. 5 and 6).
+    """
+    chain = {
+        f"{p}[{i}]": v
+        for i in range(1, N_MASSES + 1)
+        for p, v in (("k", k_mean), ("B", max(b_mean, 0.0)))
+    }
+    flexible = bench.run("flexible", observer={**actuator, **chain})
+    bench.keep("flexible.csv", flexible)
+    bench.results.scores = _angle_scores(flexible, flexible["plant.theta_m_true"])
+    return flexible
+
+
+def _whole_chain(
+    bench: _Bench, actuator: dict[str, float], flexible: Recording
+) -> tuple[Recording, Recording | None]:
+    """Experiment 4: the whole chain (n too) from one identification record, then every
+    mass's angle by the model-based observer with it on experiment 3's maneuver.
+
+    Fills ``results.masses``, ``whole_chain``, ``whole_chain_std`` and, when n is the
+    plant's, ``whole_scores``; returns the identification record and the observer's run
+    (None when n is not the plant's: the FMUs cannot co-simulate).
+    """
+    results = bench.results
+    identification = bench.run("identification", plant={"seed": 1}, observer=actuator)
+    bench.keep("identification.csv", identification)
+    bench.status("whole-chain fit")
+    choice = _fit_whole_chain(identification, results.actuator, bench.encoder_cpr)
+    results.masses = choice.n
+    results.whole_chain = choice.fit.as_dict()
+    results.whole_chain_std = choice.fit.std_dict()
+    if choice.n != N_MASSES:
+        return identification, None
+    identified = {**actuator, **results.whole_chain, "estimator": MODEL_BASED}
+    estimated = bench.run("flexible", observer=identified)
+    bench.keep("whole_chain.csv", estimated)
+    results.whole_scores = _angle_scores(estimated, flexible["plant.theta_m_true"])
+    return identification, estimated
+
+
+def _load_torque(bench: _Bench, actuator: dict[str, float]) -> dict[str, Recording]:
+    """Experiment 5: the load torque on mass 3 from the motor alone, with the true chain
+    and with experiment 4's (which must have the plant's n).
+
+    Fills ``results.load`` and ``results.load_angles``; returns the runs by chain.
+    """
+    results = bench.results
+    loaded = {}
+    for label, chain, name in (
+        ("true chain", TRUE_CHAIN, "load_true_chain.csv"),
+        ("identified chain", results.whole_chain, "load_identified_chain.csv"),
+    ):
+        loaded[label] = bench.run(LOAD_PROFILE.scenario().name, observer={**actuator, **chain})
+        bench.keep(name, loaded[label])
+    for label, rec in loaded.items():
+        estimate = rec["observer.tau_load_hat"]
+        results.load[label] = score_profile(rec.time, estimate, LOAD_PROFILE).as_dict()
+        results.load_angles[label] = _angle_scores(rec, rec["plant.theta_m_true"])
+    results.load_angles["true chain, no torque state"] = _angles_without_torque_state(
+        loaded["true chain"], results.actuator, bench.encoder_cpr
+    )
+    return loaded
 
 
 def _angle_scores(run: Recording, motor: np.ndarray) -> list[float]:
@@ -238,18 +325,14 @@ def _angle_scores(run: Recording, motor: np.ndarray) -> list[float]:
     ]
 
 
-def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, figure: Path) -> Path:
-    """Experiment 5's scores (into ``results``) and its figure."""
-    estimates = {}
-    for label, rec in runs.items():
-        estimates[label] = rec["observer.tau_load_hat"]
-        results.load[label] = score_profile(rec.time, estimates[label], LOAD_PROFILE).as_dict()
-        results.load_angles[label] = _angle_scores(rec, rec["plant.theta_m_true"])
-    # the same run and chain without the torque state: what the unmodelled load costs
-    rec = runs["true chain"]
+def _angles_without_torque_state(
+    rec: Recording, actuator: dict[str, float], cpr: int
+) -> list[float]:
+    """Experiment 5's run and true chain without the torque state: what the unmodelled
+    load costs, as every mass's angle score."""
     settings = ObserverSettings(
         mode=STATE_ESTIMATION,
-        actuator=_terms(results.actuator),
+        actuator=_terms(actuator),
         g_dist=G_DIST,
         g_lpf=G_DIST,
         J=tuple(defaults.J),
@@ -262,11 +345,9 @@ def _load_experiment(runs: dict[str, Recording], results: Results, cpr: int, fig
     log["time"] = rec.time
     theta = estimate_states(settings, log)
     motor = rec["plant.theta_m_true"]
-    results.load_angles["true chain, no torque state"] = [
+    return [
         flexible_score(theta[:, i], rec[f"plant.theta[{i + 1}]"], motor) for i in range(N_MASSES)
     ]
-    truth = step_truth(rec.time, LOAD_PROFILE.torque(rec.time))
-    return figure_load_torque(rec.time, truth, estimates, figure)
 
 
 def _terms(actuator: dict[str, float]) -> Actuator:
@@ -281,7 +362,7 @@ def _terms(actuator: dict[str, float]) -> Actuator:
     )
 
 
-def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> ChainChoice:
+def _fit_whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> ChainChoice:
     """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
     terms = _terms(actuator)
     signals = [identification[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
@@ -290,26 +371,6 @@ def _whole_chain(identification: Recording, actuator: dict[str, float], cpr: int
     if cpr > 0:  # ideal sensors: no counts
         encoder = encoder_record(identification.time, signals[0], signals[2], terms, cpr)
     return identify_whole_chain(record, "auto", encoder)
-
-
-WHOLE_CHAIN_HEADER = ["parameter", "identified", "σ", "true", "error"]
-
-
-def whole_chain_rows(results: Results) -> list[list[str]]:
-    """Experiment 4: identified against true J_i, k_i, B_i."""
-    rows = []
-    for i in range(1, results.masses + 1):
-        for p, unit, truth in (
-            ("J", "kg·m²", defaults.J[i - 1] if i <= N_MASSES else None),
-            ("k", "N·m/rad", defaults.K),
-            ("B", "N·m·s/rad", defaults.B),
-        ):
-            value = results.whole_chain[f"{p}[{i}]"]
-            sigma = results.whole_chain_std[f"{p}[{i}]"]
-            true = "—" if truth is None or i > N_MASSES else f"{truth:.4g}"
-            error = "—" if true == "—" else _pct(value, truth)
-            rows.append([f"{p}[{i}] ({unit})", f"{value:.4g}", f"{sigma:.2g}", true, error])
-    return rows
 
 
 def _figures(
@@ -321,6 +382,8 @@ def _figures(
     b_hat: float,
     model_based: Recording | None,
 ) -> list[Path]:
+    """Figs. 4, 5 and 6: the reaction torque of a rigid maneuver against the one
+    rebuilt from k̂ (N·m/rad) and B̂ (N·m·s/rad), the flexible response, the angles."""
     raw = k_hat * (rigid["plant.theta_m_true"] - rigid["plant.theta[1]"]) + b_hat * (
         rigid["plant.omega_m_true"] - rigid["plant.omega[1]"]
     )
@@ -366,231 +429,9 @@ def _whole_chain_figure(out: Path, identification: Recording, results: Results) 
     )
 
 
-LOAD_HEADER = [
-    "chain",
-    "settling (s)",
-    "settled error (mean)",
-    "settled max abs error",
-    "rms error, flexible motion",
-    "sine amplitude",
-    "sine lag (ms)",
-    "sine rms error",
-]
-
-
-def load_rows(results: Results) -> list[list[str]]:
-    """Experiment 5: the load torque estimate's scores, % of the step."""
-    if not results.load:
-        return [["—", f"not run: n = {results.masses} ≠ the plant's {N_MASSES}"]]
-    rows = []
-    for label, s in results.load.items():
-        settling = "never" if math.isnan(s["settling_s"]) else f"{s['settling_s']:.2f}"
-        rows.append(
-            [
-                label,
-                settling,
-                f"{s['settled_mean_percent']:+.2f} %",
-                f"{s['settled_max_percent']:.2f} %",
-                f"{s['settled_rms_percent']:.2f} %",
-                f"{s['sine_amplitude_ratio']:.3f}",
-                f"{1e3 * s['sine_lag_s']:.0f}",
-                f"{s['sine_rms_percent']:.1f} %",
-            ]
-        )
-    return rows
-
-
-def load_angle_rows(results: Results) -> list[list[str]]:
-    return [[label, *(f"{x:.3g}" for x in scores)] for label, scores in results.load_angles.items()]
-
-
-def actuator_rows(results: Results) -> list[list[str]]:
-    a = results.actuator
-    return [
-        [
-            "D_m (N·m·s/rad)",
-            f"{a['D_m_hat']:.4g}",
-            f"{TRUE['D_m']:.4g}",
-            _pct(a["D_m_hat"], TRUE["D_m"]),
-        ],
-        ["f_c (N·m)", f"{a['f_c_hat']:.4g}", f"{TRUE['f_c']:.4g}", _pct(a["f_c_hat"], TRUE["f_c"])],
-        ["ΔJ_m (kg·m²)", f"{a['dJm_hat']:.3g}", "0", "—"],
-        [
-            "Δk_t (N·m/A)",
-            f"{a['dkt_hat']:.3g}",
-            "0",
-            "fixed (rank deficient)" if a["self_id_rank_deficient"] else "fitted",
-        ],
-    ]
-
-
-def table_ii_rows(results: Results) -> list[list[str]]:
-    """Our five maneuvers next to the paper's five, errors against each one's truth."""
-    rows = []
-    for ours, (k_p, b_p) in zip(results.rigid, table_ii_si()):
-        rows.append(
-            [
-                f"{ours['seed']}",
-                f"{ours['k']:.5f}",
-                _pct(ours["k"], TRUE["k"]),
-                f"{ours['B']:.3g}",
-                _pct(ours["B"], TRUE["B"]),
-                f"{k_p:.5f}",
-                _pct(k_p, K_TRUE_PAPER),
-                f"{b_p:.3g}",
-                _pct(b_p, B_TRUE_PAPER),
-            ]
-        )
-    ks = np.array([r["k"] for r in results.rigid])
-    bs = np.array([r["B"] for r in results.rigid])
-    kp = np.array([k for k, _ in table_ii_si()])
-    bp = np.array([b for _, b in table_ii_si()])
-    rows.append(
-        [
-            "mean",
-            f"{ks.mean():.5f}",
-            _pct(ks.mean(), TRUE["k"]),
-            f"{bs.mean():.3g}",
-            _pct(bs.mean(), TRUE["B"]),
-            f"{kp.mean():.5f}",
-            _pct(kp.mean(), K_TRUE_PAPER),
-            f"{bp.mean():.3g}",
-            _pct(bp.mean(), B_TRUE_PAPER),
-        ]
-    )
-    rows.append(
-        [
-            "spread (std)",
-            f"{ks.std(ddof=1):.2g}",
-            f"{100 * ks.std(ddof=1) / TRUE['k']:.2f} %",
-            f"{bs.std(ddof=1):.2g}",
-            f"{100 * bs.std(ddof=1) / TRUE['B']:.0f} %",
-            f"{kp.std(ddof=1):.2g}",
-            f"{100 * kp.std(ddof=1) / K_TRUE_PAPER:.2f} %",
-            f"{bp.std(ddof=1):.2g}",
-            f"{100 * bp.std(ddof=1) / B_TRUE_PAPER:.2f} %",
-        ]
-    )
-    return rows
-
-
-TABLE_II_HEADER = [
-    "run (seed)",
-    "k̂ (N·m/rad)",
-    "k err",
-    "B̂ (N·m·s/rad)",
-    "B err",
-    "paper k̂",
-    "paper k err",
-    "paper B̂",
-    "paper B err",
-]
-
-
-def whole_state_rows(results: Results) -> list[list[str]]:
-    if not results.whole_scores:
-        return [["—", f"not run: n = {results.masses} ≠ the plant's {N_MASSES}"]]
-    return [[f"mass {i}", f"{s:.3g}"] for i, s in enumerate(results.whole_scores, start=1)]
-
-
-def state_rows(results: Results) -> list[list[str]]:
-    return [[f"mass {i}", f"{s:.3g}", "1"] for i, s in enumerate(results.scores, start=1)]
-
-
-def _pct(value: float, truth: float) -> str:
-    return f"{percent_error(value, truth):+.2f} %"
-
-
-def _report(results: Results, ideal: bool, k_mean: float, b_mean: float) -> str:
-    rerun = "arcosim reproduce --ideal" if ideal else "arcosim reproduce"
-    sensors = (
-        "ideal (exact angle, true velocity, no noise)"
-        if ideal
-        else ("realistic (2000-count encoder, 5 mA rms current noise)")
-    )
-    return f"""# The paper's experiments, reproduced (arcosim {__version__})
-
-Bench of Khalil & Sabanovic in SI units (docs/method.md), n = 3, 1 ms steps,
-Gauss–Seidel co-simulation of `MotorChainPlant.fmu` and `ReactionTorqueObserver.fmu`,
-g_dist = g_lpf = 100 rad/s, sensors {sensors}. Re-run: `{rerun}`.
-
-## 1. Actuator self-identification (load detached, mode 0)
-
-Forward rotation at a varying speed for 10 s (`selfid.csv`). A free motor cannot
-separate k_t from J_m, so k_t is fixed to its datasheet value.
-
-{markdown_table(["term", "identified", "true", "error"], actuator_rows(results))}
-
-## 2. Chain identification from five rigid maneuvers (mode 1) — Table II
-
-A 3 A maneuver at 2.1 rad/s (an eighth of the first mode) under raised-cosine
-ramps, 24 s, noise seeds 1–5 (`rigid_seed*.csv`), with the actuator terms of
-experiment 1 and the multi-mass correction κ = 1.614. True k = {TRUE["k"]} N·m/rad,
-B = {TRUE["B"]} N·m·s/rad. The paper's rows are converted to SI at a 10 mm lever
-(docs/method.md); its errors are against its stated 1.627 kN/m and 0.0888 N·s/m.
-
-{markdown_table(TABLE_II_HEADER, table_ii_rows(results))}
-
-B is weakly identifiable at the bench's damping (ζ ≈ 5·10⁻⁴): treat B̂ as unknown.
-
-![Fig. 4](fig4_reaction_torque.png)
-
-## 3. State estimation under a flexible maneuver (mode 2, the paper's recursion)
-
-Multi-sine 3–120 rad/s for 10 s (`flexible.csv`), with k = {k_mean:.5f} N·m/rad and
-B = {max(b_mean, 0.0):.3g} N·m·s/rad from experiment 2. Score per mass:
-rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (0 is perfect; the naive "θ_i = θ_m" scores 1).
-
-{markdown_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(results))}
-
-The recursion differentiates along the chain, so errors grow from mass to mass
-(docs/method.md); it also inherits the DOB's lag at g_dist = 100 rad/s.
-
-![Fig. 5](fig5_flexible_response.png)
-
-![Fig. 6](fig6_state_estimates.png)
-
-## 4. Beyond the paper: the whole chain from the motor alone (mode 2, model-based)
-
-One 20 s record of the `identification` scenario (multi-sine of 40 lines 3–150 rad/s,
-3 A peak; `identification.csv`, seed 1). Known: the actuator terms of experiment 1,
-nothing of the chain, not even n. `--masses auto` read n = {results.masses} from the
-record; every J_i, k_i, B_i by the whole-chain fit
-(`arcosim identify identification.csv --method whole-chain --masses auto`):
-
-{markdown_table(WHOLE_CHAIN_HEADER, whole_chain_rows(results))}
-
-The fit ends with the prediction-error fit from the current to the encoder (README);
-the B_i are the weakest parameters (the bench's inner springs' B_i have standard errors
-near 25 %). With these parameters alone, the model-based
-observer on experiment 3's flexible maneuver (`whole_chain.csv`) scores per mass:
-
-{markdown_table(["mass", "model-based score, identified chain"], whole_state_rows(results))}
-
-![Fig. 7](fig7_whole_chain.png)
-
-Fig. 6 above shows the model-based observer with these parameters beside the recursion.
-
-## 5. Beyond the paper: the load torque on the last mass from the motor alone
-
-Scenario `load-torque` (`load_true_chain.csv`, `load_identified_chain.csv`, seed 1):
-the broadband multi-sine of 11 lines 3–150 rad/s, {LOAD_PROFILE.amplitude:g} A, for
-{LOAD_PROFILE.duration:g} s, and on mass 3 (plant input `tau_ext[3]`) a step of a tenth of
-the drive's peak torque, {1e3 * LOAD_PROFILE.size():.3f} mN·m, at {LOAD_PROFILE.step_time:g} s,
-then from {LOAD_PROFILE.sine_time:g} s the same size times cos(2 rad/s · t). The observer
-(mode 2, estimator 1, `load_mass = 3`, `load_torque_bandwidth` at its default) knows the
-actuator terms of experiment 1 and either the true chain or experiment 4's. Errors in % of
-the step: settling is the time from the step until the estimate stays within 5 %; the
-settled window runs from {LOAD_PROFILE.settled_from:g} s to the sine; the sine is scored
-over its last two periods (from {LOAD_PROFILE.sine_from:.2f} s). Re-run the estimate on a
-log: `arcosim identify load_true_chain.csv --method load-torque --set load_mass=3 ...`.
-
-{markdown_table(LOAD_HEADER, load_rows(results))}
-
-The angles of the same runs (score per mass; the last row: the true chain without the
-torque state, whose static deflections the unmodelled torque leaves wrong):
-
-{markdown_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results))}
-
-![Fig. 8](fig8_load_torque.png)
-"""
+def _load_torque_figure(out: Path, runs: dict[str, Recording]) -> Path:
+    """Fig. 8: experiment 5's load torque estimates by chain against the truth."""
+    estimates = {label: rec["observer.tau_load_hat"] for label, rec in runs.items()}
+    rec = runs["true chain"]
+    truth = step_truth(rec.time, LOAD_PROFILE.torque(rec.time))
+    return figure_load_torque(rec.time, truth, estimates, out / "fig8_load_torque.png")

@@ -19,7 +19,7 @@ import numpy as np
 
 from arcosim.build.builder import ensure_built
 from arcosim.build.recipes import OBSERVER, PLANT
-from arcosim.experiments import excitation
+from arcosim.experiments import current_commands
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
@@ -87,22 +87,25 @@ def _self_identification_current(t: np.ndarray) -> np.ndarray:
 
 def _flexible_current(t: np.ndarray) -> np.ndarray:
     """Energy across the bench's three modes: multi-sine from 3 to 120 rad/s, 0.48 A."""
-    return excitation.multisine(t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1)
+    return current_commands.multisine(
+        t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), 1
+    )
 
 
 #: Lines of the whole-chain identification multi-sine (rad/s): 40, log-spaced over 3 … 150.
 #: The subspace start needs many lines: with 11 it takes excitation lines for modes.
 IDENTIFICATION_LINES = np.geomspace(3.0, 150.0, 40)
-#: Its peak current (A): at 1 A the motor's Coulomb friction and the encoder's counts
-#: bias every J_i and k_i by 1.5–3 % on the five-mass chain; at 3 A by ≤ 1.3 % (README).
+#: Its peak current (A): at 1 A the motor sticks 18 % of the time and the five-mass chain's
+#: J_i, k_i come out 0.4–1.5 % off; at 3 A within 0.1 % (docs/identification.md, "What a
+#: log needs").
 IDENTIFICATION_AMPLITUDE = 3.0
 #: Its length (s).
 IDENTIFICATION_DURATION = 20.0
 
 
 def identification_current(t: np.ndarray) -> np.ndarray:
-    """The whole-chain identification multi-sine (A)."""
-    return excitation.multisine(t, IDENTIFICATION_AMPLITUDE, IDENTIFICATION_LINES, 1)
+    """The whole-chain identification multi-sine (A) at the step times ``t`` (s), shape ``(N,)``."""
+    return current_commands.multisine(t, IDENTIFICATION_AMPLITUDE, IDENTIFICATION_LINES, 1)
 
 
 #: The maneuver's length: 8 periods at 2.1 rad/s.
@@ -124,15 +127,22 @@ class LoadProfile:
     the bench with this load: at 1 A the 2000-count encoder sees no new count within a
     step (ω_m = 0, so the DOB knows the reaction torque only to within ±f_c) in 3 % of
     the samples; at the flexible scenario's 0.48 A in 35 %, and the settled estimate
-    comes out 11 % low (README, "Sensorless load torque").
+    comes out 11 % low (docs/identification.md, "Sensorless load torque").
 
-    Attributes:
-        mass: the load mass the torque acts on (1 … n).
-        amplitude: peak current argument of the multi-sine (A).
-        fraction: step size over the drive's peak torque.
-        step_time, sine_time: s.
-        frequency: of the sine (rad/s).
-        duration: s.
+    Parameters
+    ----------
+    mass : int
+        The load mass the torque acts on (1 … n, an index).
+    amplitude : float
+        Peak current argument of the multi-sine (A).
+    fraction : float
+        Step size over the drive's peak torque (dimensionless).
+    step_time, sine_time : float
+        When the step, then the sine, starts (s).
+    frequency : float
+        Frequency of the sine (rad/s).
+    duration : float
+        Length of the run (s).
     """
 
     mass: int = 3
@@ -144,8 +154,8 @@ class LoadProfile:
     duration: float = 15.0
 
     def current(self, t: np.ndarray) -> np.ndarray:
-        """The maneuver's current command (A)."""
-        return excitation.multisine(t, self.amplitude, BROADBAND_LINES, 1)
+        """The maneuver's current command (A) at the step times ``t`` (s), shape ``(N,)``."""
+        return current_commands.multisine(t, self.amplitude, BROADBAND_LINES, 1)
 
     def size(self) -> float:
         """The step (N·m): ``fraction`` of the bench drive's peak torque over the run."""
@@ -157,7 +167,8 @@ class LoadProfile:
         return self.fraction * defaults.K_T * float(np.max(np.abs(self.current(t))))
 
     def torque(self, t: np.ndarray) -> np.ndarray:
-        """The external torque (N·m) held over the step starting at each of ``t`` (s)."""
+        """The external torque (N·m) held over the step starting at each of ``t`` (s),
+        shape ``(N,)``."""
         size = self.size()
         tau = np.where(t >= self.step_time, size, 0.0)
         sine = size * np.cos(self.frequency * (t - self.sine_time))
@@ -174,7 +185,7 @@ class LoadProfile:
         return self.duration - 2.0 * (2.0 * np.pi / self.frequency)
 
     def inputs(self, t: np.ndarray) -> dict[str, np.ndarray]:
-        """The plant inputs: ``tau_ext[mass]``."""
+        """The plant inputs at the step times ``t`` (s): ``tau_ext[mass]`` (N·m), shape ``(N,)``."""
         return {f"tau_ext[{self.mass}]": self.torque(t)}
 
     def scenario(self, name: str = "load-torque") -> Scenario:
@@ -209,7 +220,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "rigid",
             "rigid maneuver: 3 A at 2.1 rad/s under raised-cosine ramps, no drift (mode 1)",
-            lambda t: excitation.rigid_maneuver(t),
+            lambda t: current_commands.rigid_maneuver(t),
             RIGID_DURATION,
             {},
             {"mode": 1},
@@ -234,7 +245,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "chirp",
             "chirp 1 → 150 rad/s over 10 s, 0.2 A (mode 2)",
-            lambda t: excitation.chirp(t, 0.2, 1.0, 150.0, 10.0),
+            lambda t: current_commands.chirp(t, 0.2, 1.0, 150.0, 10.0),
             10.0,
             {},
             {"mode": 2},
@@ -242,7 +253,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "random",
             "filtered random current, 0.15 A rms below 150 rad/s (mode 2)",
-            lambda t: excitation.filtered_random(t, 0.15, 150.0, seed=7),
+            lambda t: current_commands.filtered_random(t, 0.15, 150.0, seed=7),
             10.0,
             {},
             {"mode": 2},

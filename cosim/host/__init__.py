@@ -1,0 +1,16 @@
+"""``cosim/host/`` installed as ``arcosim.host``: the FMI host side, the project's FMUs run
+on fmpy.
+
+Modules, in the order data flows:
+
+overrides  -- ``plant.k[2]=0.2`` texts typed and checked against an FMU's variables
+instance   -- one FMU instance through fmpy's FMI 2.0 calls (``FmuInstance``), ctypes ports
+master     -- the fixed-step master of plant and observer (``cosimulate``, ``Recording``)
+replay     -- a drive log fed to the observer FMU, sample by sample (``replay_log``)
+ssp        -- an SSP 1.0 system read and run by a Jacobi master (``run_ssp``)
+ecos       -- the ecos C++ engine in a separate process: the FMUs in a host not Python
+validate   -- the checks a strict FMI host runs on an FMU (``arcosim validate``)
+
+Imports of the project: :mod:`arcosim.errors`, :mod:`arcosim.logs`, :mod:`arcosim.fmu`,
+:mod:`arcosim.portability`, :mod:`arcosim.version` (``tests/test_layout.py``).
+"""

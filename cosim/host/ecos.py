@@ -71,7 +71,30 @@ def run_ecos(
     parameter_set: str | None = None,
     timeout: float = 300.0,
 ) -> subprocess.CompletedProcess:
-    """``ecos simulate`` of an FMU or SSP in ``workdir`` with a bare environment."""
+    """``ecos simulate`` of an FMU or SSP in ``workdir`` with a bare environment.
+
+    Parameters
+    ----------
+    binary : Path
+        The ecos executable (:func:`ecos_binary`).
+    path : Path
+        The ``.fmu`` or ``.ssp`` to run.
+    workdir : Path
+        Where ecos runs and writes its CSV (also its ``HOME``).
+    stop : float
+        Stop time (s).
+    step : float
+        Communication step (s).
+    parameter_set : str, optional
+        The SSP's parameter set to apply.
+    timeout : float
+        Longest the run may take (s).
+
+    Returns
+    -------
+    subprocess.CompletedProcess
+        Its exit status and text output.
+    """
     command = [
         str(binary),
         "simulate",

@@ -77,13 +77,27 @@ class RealPort:
     """One ``fmi2GetReal``/``fmi2SetReal`` of fixed value references, through
     :func:`raw_function` and preallocated arrays: no allocation, no conversion per call.
 
-    Attributes:
-        values: the ctypes ``fmi2Real`` array read into by :meth:`get` and sent by
-            :meth:`send`; a port's ``values`` may be another port's (connections).
-        array: numpy view of ``values`` (no copy).
-        get_real, set_real, component, vrs, count: the call's function and
-            arguments, for masters that make the call themselves
-            (``get_real(component, vrs, count, values)``).
+    Parameters
+    ----------
+    slave : FMU2Slave
+        The instantiated FMU (it must outlive the port).
+    vrs : sequence of int
+        Value references of the Real variables, shape ``(M,)``.
+
+    Attributes
+    ----------
+    values : ctypes array of fmi2Real
+        Read into by :meth:`get` and sent by :meth:`send` (each in its variable's
+        unit), shape ``(M,)``; a port's ``values`` may be another port's (connections).
+    array : ndarray
+        Numpy view of ``values`` (no copy), shape ``(M,)``.
+    get_real, set_real : ctypes function
+        ``fmi2GetReal`` and ``fmi2SetReal`` (:func:`raw_function`), for masters that
+        make the call themselves: ``get_real(component, vrs, count, values)``.
+    component, vrs, count : ctypes values
+        The call's other arguments: the instance, the value references, their number.
+    size : int
+        The number of variables, M (a count).
     """
 
     def __init__(self, slave: FMU2Slave, vrs: Sequence[int]) -> None:

@@ -134,29 +134,16 @@ def cosimulate(
     >>> run.time.shape, sorted(run.signals)
     ((101,), ['observer.d_hat', 'plant.theta[1]'])
     """
-    if ordering not in ORDERINGS:
-        raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
-    if not (h > 0.0 and np.isfinite(h)):
-        raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
-    if record_every < 1:
-        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
+    _check_arguments(ordering, h, record_every)
     currents = [float(x) for x in i_ref]
     steps = len(currents)
-    extra = {name: [float(x) for x in values] for name, values in (plant_inputs or {}).items()}
-    for name, values in extra.items():
-        var = plant.variables.get(name)
-        if name == "i_ref" or var is None or var.causality != "input" or var.type != "Real":
-            raise UserError(f"plant input {name!r}: not a Real input of the plant besides i_ref")
-        if len(values) != steps:
-            raise UserError(f"plant input {name!r}: {len(values)} values for {steps} steps")
+    extra = _plant_inputs(plant, plant_inputs or {}, steps)
     plant.initialize(plant_parameters, t0)
     measured = plant.real_port(MEASURED)
     observer_in = observer.real_port(MEASURED)
     _check(measured.get() | observer_in.send(measured.values), plant, "reading the sensors", t0)
     observer.initialize(observer_parameters, t0)
-    recorded = [0, *range(record_every, steps + 1, record_every)]
-    if recorded[-1] != steps:
-        recorded.append(steps)
+    recorded = record_points(steps, record_every)
     plant_log = np.empty((len(recorded), len(record_plant)))
     observer_log = np.empty((len(recorded), len(record_observer)))
     read_plant, read_observer = _recorder(plant, record_plant), _recorder(observer, record_observer)
@@ -210,11 +197,55 @@ def cosimulate(
         progress(steps % 1000)
     plant.time = observer.time = t0 + steps * h
     recording = Recording(time=t0 + np.array(recorded) * h)
-    for j, name in enumerate(record_plant):
-        recording.signals[f"plant.{name}"] = plant_log[:, j]
-    for j, name in enumerate(record_observer):
-        recording.signals[f"observer.{name}"] = observer_log[:, j]
+    recording.signals.update(_signals("plant", record_plant, plant_log))
+    recording.signals.update(_signals("observer", record_observer, observer_log))
     return recording
+
+
+def _check_arguments(ordering: str, h: float, record_every: int) -> None:
+    """Refuse an unknown ordering, a step ``h`` (s) that is not finite and > 0, and a
+    ``record_every`` below 1."""
+    if ordering not in ORDERINGS:
+        raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
+    if not (h > 0.0 and np.isfinite(h)):
+        raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
+    if record_every < 1:
+        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
+
+
+def _plant_inputs(
+    plant: FmuInstance, inputs: Mapping[str, Sequence[float]], steps: int
+) -> dict[str, list[float]]:
+    """The plant's other Real inputs as floats, one per step; refuse a name that is not
+    such an input, or a length that is not ``steps``."""
+    extra = {name: [float(x) for x in values] for name, values in inputs.items()}
+    for name, values in extra.items():
+        var = plant.variables.get(name)
+        if name == "i_ref" or var is None or var.causality != "input" or var.type != "Real":
+            raise UserError(f"plant input {name!r}: not a Real input of the plant besides i_ref")
+        if len(values) != steps:
+            raise UserError(f"plant input {name!r}: {len(values)} values for {steps} steps")
+    return extra
+
+
+def record_points(steps: int, record_every: int) -> list[int]:
+    """The steps after which a run of ``steps`` steps records: 0 (the initial values),
+    every ``record_every``-th, and always the last.
+
+    Examples
+    --------
+    >>> record_points(10, 4)
+    [0, 4, 8, 10]
+    """
+    recorded = [0, *range(record_every, steps + 1, record_every)]
+    if recorded[-1] != steps:
+        recorded.append(steps)
+    return recorded
+
+
+def _signals(prefix: str, names: Sequence[str], log: np.ndarray) -> dict[str, np.ndarray]:
+    """The columns of ``log`` (shape ``(R, len(names))``) as ``"prefix.name"`` signals."""
+    return {f"{prefix}.{name}": log[:, j] for j, name in enumerate(names)}
 
 
 def _recorder(fmu: FmuInstance, names: Sequence[str]) -> Callable[[], Sequence[float]]:

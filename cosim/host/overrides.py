@@ -85,10 +85,24 @@ def split_overrides(
 ) -> dict[str, dict[str, Value]]:
     """Sort ``fmu.name=value`` assignments by FMU, typed and checked.
 
-    Args:
-        assignments: texts such as ``"plant.k[2]=0.2"``.
-        fmus: for each FMU prefix (``"plant"``, ``"observer"``), its variables by
-            name (fmpy ``ScalarVariable`` objects, which carry ``type`` and ``causality``).
+    Parameters
+    ----------
+    assignments : iterable of str
+        Texts such as ``"plant.k[2]=0.2"`` (the value in the variable's unit).
+    fmus : mapping of str to mapping
+        For each FMU prefix (``"plant"``, ``"observer"``), its variables by name (fmpy
+        ``ScalarVariable`` objects, which carry ``type`` and ``causality``).
+
+    Returns
+    -------
+    dict of str to dict
+        For each prefix, the typed start values by variable name.
+
+    Raises
+    ------
+    UserError
+        An assignment without a known FMU prefix, naming no variable of it or no
+        parameter, or with a value of the wrong type.
     """
     result: dict[str, dict[str, Value]] = {prefix: {} for prefix in fmus}
     for text in assignments:

@@ -92,7 +92,23 @@ def replay_log(
 
 
 def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer") -> dict:
-    """Last value of every recorded output, typed as JSON likes it."""
+    """Last value of every recorded output, typed as JSON likes it.
+
+    Parameters
+    ----------
+    fmu : FmuInstance
+        The instance recorded (its variables' types).
+    recording : Recording
+        Its run; signals named ``"prefix.name"``.
+    prefix : str
+        The FMU's prefix in the signal names.
+
+    Returns
+    -------
+    dict
+        Name → last value (in the variable's unit): a bool, an int or a float by the
+        variable's FMI type.
+    """
     result = {}
     for key, series in recording.signals.items():
         name = key.split(".", 1)[1]

@@ -29,7 +29,21 @@ from arcosim.host.master import MAX_STEPS, Recording
 
 @dataclass
 class SspSystem:
-    """What :func:`read_ssp` found: FMU paths, connections, parameter sets, experiment."""
+    """What :func:`read_ssp` found: FMU paths, connections, parameter sets, experiment.
+
+    Parameters
+    ----------
+    components : dict of str to Path
+        Component name → its FMU, unpacked from the SSP.
+    connections : list of tuple of str
+        ``(start component, start connector, end component, end connector)``.
+    parameter_sets : dict
+        Set name → component → variable → start value (in the variable's unit).
+    start, stop : float
+        The DefaultExperiment's start and stop time (s).
+    folder : TemporaryDirectory, optional
+        Where the SSP is unpacked; the caller cleans it up.
+    """
 
     components: dict[str, Path]
     connections: list[tuple[str, str, str, str]]
@@ -40,7 +54,23 @@ class SspSystem:
 
 
 def read_ssp(path: Path) -> SspSystem:
-    """Unpack an SSP and read its structure (raises :class:`UserError` on bad files)."""
+    """Unpack an SSP and read its structure.
+
+    Parameters
+    ----------
+    path : Path
+        The ``.ssp`` file.
+
+    Returns
+    -------
+    SspSystem
+        Its structure; ``folder`` holds the unpacked files (clean it up when done).
+
+    Raises
+    ------
+    UserError
+        A missing file, or one that is not a readable SSP (the reason named).
+    """
     if not Path(path).is_file():
         raise UserError(f"{path}: no such file")
     folder = tempfile.TemporaryDirectory(prefix="arcosim_ssp_")
@@ -137,62 +167,91 @@ def run_ssp(
     system = read_ssp(path)
     instances: dict[str, FmuInstance] = {}
     try:
-        if parameter_set is not None and parameter_set not in system.parameter_sets:
-            known = ", ".join(system.parameter_sets) or "none"
-            raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
-        chosen = system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
+        chosen = _parameter_values(path, system, parameter_set)
         stop = system.stop if stop is None else stop
-        if not (math.isfinite(stop) and stop > system.start):
-            raise UserError(
-                f"stop time {stop:g} s: it must be finite and after the start, {system.start:g} s"
-            )
-        steps = round((stop - system.start) / h) if h > 0 and math.isfinite(h) else 0
-        if not 1 <= steps <= MAX_STEPS:
-            raise UserError(
-                f"step {h:g} s from {system.start:g} to {stop:g} s gives {steps:.3g} steps; "
-                f"a run takes 1 to {MAX_STEPS:,} steps"
-            )
-        for name, fmu in system.components.items():
-            if not fmu.is_file():
-                raise UserError(f"{path}: component {name}: no file {fmu.name} in the SSP")
-            try:
-                instances[name] = FmuInstance(fmu, name)
-            except UserError as error:
-                said = str(error).split(": ", 1)[-1]
-                raise UserError(f"{path}: component {name} ({fmu.name}): {said}") from None
+        steps = _steps(system.start, stop, h)
+        _instantiate(path, system, instances)
         for name, fmu in instances.items():
             fmu.initialize({**chosen.get(name, {}), **(extra or {}).get(name, {})}, system.start)
-        links = [
-            (instances[a].reader([ca]), instances[b].real_writer([cb]))
-            for a, ca, b, cb in system.connections
-        ]
-        outputs = {name: fmu.output_names() for name, fmu in instances.items()}
-        readers = {
-            name: (fmu.reader(outputs[name]), outputs[name]) for name, fmu in instances.items()
-        }
-        logs = {name: np.empty((steps + 1, len(outs))) for name, (_, outs) in readers.items()}
-        for name, (read, _) in readers.items():
-            logs[name][0] = read()
-        for k in range(steps):
-            t = system.start + k * h
-            for read, write in links:
-                write(read())
-            for name, fmu in instances.items():
-                if fmu.do_step(t, h) > 1:
-                    raise UserError(
-                        f"{name} refused the step at t = {float(t):.10g} s: {fmu.messages[-1:]}"
-                    )
-            for name, (read, _) in readers.items():
-                logs[name][k + 1] = read()
+        outputs, logs = _run_steps(system, instances, steps, h)
     finally:
         for fmu in instances.values():
             fmu.close()
         system.folder.cleanup()
     recording = Recording(time=system.start + np.arange(steps + 1) * h)
-    for name, (_, outs) in readers.items():
+    for name, outs in outputs.items():
         for j, out in enumerate(outs):
             recording.signals[f"{name}.{out}"] = logs[name][:, j]
     return recording
+
+
+def _parameter_values(
+    path: Path, system: SspSystem, parameter_set: str | None
+) -> dict[str, dict[str, float | int | bool | str]]:
+    """The start values of the parameter set ``parameter_set`` (None: none), by
+    component; refuse a set the file does not have."""
+    if parameter_set is not None and parameter_set not in system.parameter_sets:
+        known = ", ".join(system.parameter_sets) or "none"
+        raise UserError(f"{path}: no parameter set {parameter_set!r} (it has: {known})")
+    return system.parameter_sets.get(parameter_set, {}) if parameter_set else {}
+
+
+def _steps(start: float, stop: float, h: float) -> int:
+    """The number of steps of ``h`` s from ``start`` to ``stop`` (s); refuse a stop
+    that is not finite and after the start, and none or more than :data:`MAX_STEPS`."""
+    if not (math.isfinite(stop) and stop > start):
+        raise UserError(f"stop time {stop:g} s: it must be finite and after the start, {start:g} s")
+    steps = round((stop - start) / h) if h > 0 and math.isfinite(h) else 0
+    if not 1 <= steps <= MAX_STEPS:
+        raise UserError(
+            f"step {h:g} s from {start:g} to {stop:g} s gives {steps:.3g} steps; "
+            f"a run takes 1 to {MAX_STEPS:,} steps"
+        )
+    return steps
+
+
+def _instantiate(path: Path, system: SspSystem, instances: dict[str, FmuInstance]) -> None:
+    """Instantiate every component into ``instances`` (filled as it goes, so the caller
+    closes those made before a failure)."""
+    for name, fmu in system.components.items():
+        if not fmu.is_file():
+            raise UserError(f"{path}: component {name}: no file {fmu.name} in the SSP")
+        try:
+            instances[name] = FmuInstance(fmu, name)
+        except UserError as error:
+            said = str(error).split(": ", 1)[-1]
+            raise UserError(f"{path}: component {name} ({fmu.name}): {said}") from None
+
+
+def _run_steps(
+    system: SspSystem, instances: dict[str, FmuInstance], steps: int, h: float
+) -> tuple[dict[str, list[str]], dict[str, np.ndarray]]:
+    """Step the initialized components ``steps`` times by ``h`` s, Jacobi-wise.
+
+    Returns every component's output names and their values after initialization and
+    after every step (shape ``(steps + 1, outputs)``), by component.
+    """
+    links = [
+        (instances[a].reader([ca]), instances[b].real_writer([cb]))
+        for a, ca, b, cb in system.connections
+    ]
+    outputs = {name: fmu.output_names() for name, fmu in instances.items()}
+    readers = {name: fmu.reader(outputs[name]) for name, fmu in instances.items()}
+    logs = {name: np.empty((steps + 1, len(outputs[name]))) for name in instances}
+    for name, read in readers.items():
+        logs[name][0] = read()
+    for k in range(steps):
+        t = system.start + k * h
+        for read, write in links:
+            write(read())
+        for name, fmu in instances.items():
+            if fmu.do_step(t, h) > 1:
+                raise UserError(
+                    f"{name} refused the step at t = {float(t):.10g} s: {fmu.messages[-1:]}"
+                )
+        for name, read in readers.items():
+            logs[name][k + 1] = read()
+    return outputs, logs
 
 
 def _parse(kind: str, text: str) -> float | int | bool | str:

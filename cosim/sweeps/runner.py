@@ -98,7 +98,25 @@ def lock_sweep(out: Path) -> Iterator[None]:
 def run_one(
     run: int, values: Mapping[str, object], spec: SweepSpec, blobs: Mapping[str, bytes]
 ) -> dict:
-    """One co-simulation (a Dask task): returns its row, with ``error`` set on failure."""
+    """One co-simulation (a Dask task): its row of the results.
+
+    Parameters
+    ----------
+    run : int
+        The run's number (an index).
+    values : mapping of str to object
+        Its varied values by ``"fmu.name"`` (each in the variable's unit).
+    spec : SweepSpec
+        The sweep.
+    blobs : mapping of str to bytes
+        The FMU files by name, shipped to the worker.
+
+    Returns
+    -------
+    dict
+        ``run``, the varied values, the metrics, ``runtime`` (s) and ``error`` (empty,
+        or the failure in one line: a failed run is recorded, the sweep goes on).
+    """
     row: dict[str, object] = {"run": run, **values}
     start = time.perf_counter()
     try:
@@ -193,7 +211,36 @@ def sweep(
     show_progress: bool = True,
     fmu_dir: Path | None = None,
 ) -> Path:
-    """Run the sweep; return the results CSV (see module doc)."""
+    """Run the sweep (the module's docstring says how).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The checked spec.
+    out : Path
+        The sweep's folder: ``results.csv``, ``summary.md`` and the PNG plots.
+    scheduler : str, optional
+        Address of a Dask scheduler; default: a local cluster of ``workers`` processes.
+    workers : int
+        Number of local worker processes (a count).
+    resume : bool
+        Whether to finish the sweep in ``out``, running only the runs it lacks.
+    show_progress : bool
+        Whether to show a progress bar.
+    fmu_dir : Path, optional
+        Folder of the FMUs, built there if missing or stale (default: the per-user cache).
+
+    Returns
+    -------
+    Path
+        The results CSV.
+
+    Raises
+    ------
+    UserError
+        A name or value the FMUs refuse, a results file that exists without ``resume``,
+        a folder another sweep holds.
+    """
     folder = ensure_built(spec.masses, fmu_dir)
     fmus = {f"{r.name}.fmu": folder / f"{r.name}.fmu" for r in (PLANT, OBSERVER)}
     variables = fmu_variables(folder)

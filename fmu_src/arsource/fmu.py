@@ -1,7 +1,7 @@
 """``ExcitationSource``: the scenarios' current commands as an FMI 2.0 co-simulation FMU.
 
 Feeds the plant's ``i_ref`` in any FMI host (an SSP system, ecos, Simulink) with the
-same signals that ``arcosim.experiments.excitation`` gives offline (both evaluate
+same signals that ``arcosim.experiments.current_commands`` gives offline (both evaluate
 :mod:`arcosim.fmu.flexchain.waveforms`). After ``doStep(t, h)`` the
 output is the command for the step that starts at ``t + h``.
 """

@@ -2,8 +2,8 @@
 multi-sine, the chirp and filtered noise, one sample at a time.
 
 Standard library only: the ExcitationSource FMU bundles this module, and
-``arcosim.experiments.excitation`` evaluates the same functions over arrays, so an FMU run and
-an offline run see the same signal.
+``arcosim.experiments.current_commands`` evaluates the same functions over arrays, so an FMU
+run and an offline run see the same signal.
 """
 
 from __future__ import annotations

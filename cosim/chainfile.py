@@ -1,0 +1,104 @@
+"""A chain file: the JSON report of a whole-chain fit, read back as the chain it holds.
+
+``arcosim identify LOG.csv --method whole-chain --out chain.json`` (or ``--json``) writes
+every load inertia ``J[i]``, stiffness ``k[i]`` and damping ``B[i]`` under the observer's
+own parameter names, with ``masses`` and, when fitted, the motor friction ``D_m``,
+``f_c``. :func:`read_chain` reads those values back (``arcosim identify --method
+load-torque --chain chain.json`` does), ignoring the rest of the report (standard
+errors, evidence, assumptions).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from arcosim.build.recipes import check_masses
+from arcosim.errors import UserError
+from arcosim.logs import read_text_file
+
+#: The chain's parameters, ``J[i]``, ``k[i]``, ``B[i]``, by their name before ``[``.
+CHAIN_PARAMETERS = ("J", "k", "B")
+#: The other values a chain file may carry: the number of masses and the motor friction.
+OTHER_VALUES = ("masses", "D_m", "f_c")
+
+
+class ChainFileError(UserError):
+    """A chain file that is not a JSON object of finite numbers with every J[i], k[i], B[i]."""
+
+
+def read_chain(path: str | Path) -> dict[str, float]:
+    """The chain of a whole-chain report: ``J[i]``, ``k[i]``, ``B[i]`` and ``masses``.
+
+    Parameters
+    ----------
+    path : str or Path
+        A UTF-8 JSON file holding one object, as ``arcosim identify --method whole-chain
+        --out FILE.json`` writes it: ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]``
+        (N·m·s/rad) for i = 1 … n, and optionally ``masses`` (n, a count) and the motor
+        friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m). Other keys are ignored.
+
+    Returns
+    -------
+    dict of str to float
+        The values kept, as floats in SI units under the observer's parameter names, in
+        the file's order, and ``masses`` (n, an int; counted from the ``J[i]`` when the
+        file does not give it).
+
+    Raises
+    ------
+    ChainFileError
+        When the file is not JSON, not an object, a value is not a finite number, or
+        ``masses`` is not a whole number, or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing;
+        the message starts with the file's name.
+    UserError
+        When the file is missing, a folder or not UTF-8 text
+        (:func:`arcosim.logs.read_text_file`), or n is not a supported number of masses
+        (:func:`arcosim.build.recipes.check_masses`).
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "chain.json"
+    >>> report = {"J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3, "std": {"J[1]": 1e-6}}
+    >>> _ = path.write_text(json.dumps(report))
+    >>> arcosim.read_chain(path)
+    {'J[1]': 0.0001, 'k[1]': 50.0, 'B[1]': 0.001, 'masses': 1}
+    """
+    path = Path(path)
+    try:
+        data = json.loads(read_text_file(path, "chain"))
+    except ValueError as error:
+        raise ChainFileError(f"{path}: cannot read it as JSON ({error})") from None
+    if not isinstance(data, dict):
+        raise ChainFileError(f"{path}: expected a JSON object with J[i], k[i], B[i]")
+    chain = {k: v for k, v in data.items() if _is_chain_value(k)}
+    for key, value in chain.items():
+        _check_number(path, key, value)
+    masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
+    if masses != int(masses):
+        raise ChainFileError(f"{path}: masses = {masses} is not a whole number")
+    n = check_masses(int(masses))
+    missing = [
+        f"{p}[{i}]" for p in CHAIN_PARAMETERS for i in range(1, n + 1) if f"{p}[{i}]" not in chain
+    ]
+    if missing:
+        raise ChainFileError(f"{path}: missing {', '.join(missing)}")
+    return {**{k: float(v) for k, v in chain.items()}, "masses": n}
+
+
+def _is_chain_value(key: str) -> bool:
+    """Whether a report's key is one :func:`read_chain` keeps: ``J[…]``, ``k[…]``,
+    ``B[…]`` or one of :data:`OTHER_VALUES`."""
+    indexed = key.split("[")[0] in CHAIN_PARAMETERS and key.endswith("]")
+    return indexed or key in OTHER_VALUES
+
+
+def _check_number(path: Path, key: str, value: object) -> None:
+    """Refuse a value that is not a finite JSON number (a Boolean is not one)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ChainFileError(f"{path}: {key} = {value!r:.40} is not a number")
+    if not math.isfinite(value):
+        raise ChainFileError(f"{path}: {key} = {value} is not a finite number")

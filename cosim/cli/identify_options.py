@@ -1,0 +1,139 @@
+"""The options every method of ``arcosim identify`` shares, checked where they enter:
+which options go with which method, ``--masses``, ``--out`` (refused before any work)
+and the report an offline fit writes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from arcosim.build.recipes import check_masses
+from arcosim.errors import UserError
+from arcosim.outputs import check_output, write_text
+
+#: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
+OFFLINE = ("output-error", "whole-chain")
+
+
+def check_method_options(args: argparse.Namespace) -> None:
+    """Refuse an option given with a method it is not for.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``arcosim identify`` arguments.
+
+    Raises
+    ------
+    UserError
+        When ``--start-k`` or ``--fit-inertia-scale`` comes without ``--method
+        output-error``, or ``--mode`` without ``--method observer``.
+    """
+    for given, option in (
+        (args.start_k is not None, "--start-k"),
+        (args.fit_inertia_scale, "--fit-inertia-scale"),
+    ):
+        if given and args.method != "output-error":
+            raise UserError(f"{option} is for --method output-error (not {args.method})")
+    if args.mode is not None and args.method != "observer":
+        raise UserError(f"--mode is for --method observer (not {args.method})")
+
+
+def masses_option(text: str) -> int:
+    """``--masses`` as a supported number of masses.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    int
+        The number of load masses (a count).
+
+    Raises
+    ------
+    UserError
+        When ``text`` is not a whole number (``auto`` is for ``--method whole-chain``
+        only, which reads it before this) or not a supported number of masses.
+
+    Examples
+    --------
+    >>> masses_option("3")
+    3
+    """
+    try:
+        n = int(text)
+    except ValueError:
+        what = " ('auto' needs --method whole-chain)" if text == "auto" else ""
+        raise UserError(f"--masses {text}: not a whole number{what}") from None
+    return check_masses(n)
+
+
+def check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
+    """Refuse ``--out`` before any work.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``arcosim identify`` arguments (``out``, ``method``, ``log``,
+        ``chain``, ``force``).
+    fmus : sequence of Path
+        The FMU files the command reads (``--out`` may not be one of them).
+
+    Raises
+    ------
+    UserError
+        A name that does not fit the method's format (a report is ``.json``, outputs
+        over time are ``.csv``), an existing file without ``--force``, the log, the
+        chain file or an FMU.
+    """
+    if args.out is None:
+        return
+    is_json = args.out.suffix.lower() == ".json"
+    if args.method in OFFLINE and not is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
+        )
+    if args.method not in OFFLINE and is_json:
+        raise UserError(
+            f"--out {args.out}: --method {args.method} writes its outputs over time as CSV; "
+            "name a .csv file (--json prints a summary)"
+        )
+    chain = [args.chain] if args.chain else []
+    check_output(args.out, inputs=[args.log, *chain, *fmus], force=args.force)
+
+
+def write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None:
+    """Refuse a report with a non-finite estimate; write it to ``--out`` if given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``arcosim identify`` arguments (``log``, ``out``, ``force``).
+    report : mapping of str to object
+        An offline fit's report; its floats, and those under ``std``, must be finite.
+
+    Raises
+    ------
+    UserError
+        When an estimate or a standard error is not finite (the log does not determine
+        it), or ``--out`` cannot be written.
+    """
+    bad = [
+        key
+        for key, value in [*report.items(), *dict(report.get("std") or {}).items()]
+        if isinstance(value, float) and not math.isfinite(value)
+    ]
+    if bad:
+        raise UserError(
+            f"{args.log}: the fit ended on non-finite numbers ({', '.join(bad[:6])}): the log "
+            "does not determine them; check --set and the excitation"
+        )
+    if args.out:
+        write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)

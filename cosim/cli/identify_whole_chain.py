@@ -1,0 +1,83 @@
+"""``arcosim identify --method whole-chain``: every load inertia, stiffness and damping
+(and n) fitted offline from the motor's current and encoder, only the actuator terms
+known; the report, and the ``--set`` line that gives the observer this chain.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from arcosim.cli.identify_options import write_report
+from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
+from arcosim.identification.drive import DriveIdentification, identify_drive
+from arcosim.logs import DriveLog
+
+
+def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
+    """Identify the whole chain from ``log``; print and write the report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``arcosim identify`` arguments (``set``, ``load``, ``out``,
+        ``force``, ``json``, ``log``).
+    log : DriveLog
+        The checked log, SI units, at a constant step.
+    masses : int or "auto"
+        Number of load masses (a count), or ``"auto"``: read it from the record.
+
+    Returns
+    -------
+    int
+        The exit status, 0.
+
+    Raises
+    ------
+    UserError
+        A bad ``--set``, a record the fit cannot work with, a fit that ends on
+        non-finite numbers.
+    """
+    values = known_parameters(masses if isinstance(masses, int) else 3, args.set)
+    given = set_names(args.set)
+    friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
+    actuator = actuator_of(values)
+    c = log.columns
+    result = identify_drive(
+        log.time,
+        c["i_a"],
+        c["omega_m"],
+        c["theta_m"],
+        k_t=actuator.k_to + actuator.dkt,
+        J_m=actuator.J_mo + actuator.dJm,
+        encoder_cpr=int(values["encoder_cpr"]),
+        masses=masses,
+        load=args.load,
+        g_dist=values["g_dist"],
+        **friction,
+    )
+    note = defaults_note(values, ("J_mo", "k_to", "encoder_cpr"), given)
+    if note:
+        result.assumptions["defaults"] = note
+    report = result.report()
+    write_report(args, report)
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        _print_report(result, report, len(log))
+    return 0
+
+
+def _print_report(result: DriveIdentification, report: dict, samples: int) -> None:
+    """The report as text, ending with the ``--set`` line for the observer."""
+    print(f"{samples} samples, whole-chain fit ({result.masses} masses):")
+    for key, value in result.parameters.items():
+        print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
+    for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
+        print(f"  {key}: {report[key]}")
+    for key, text in result.assumptions.items():
+        print(f"  assumption, {key}: {text}")
+    for text in result.warnings:
+        print(f"  warning: {text}")
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.observer_parameters().items())
+    print(f"every load angle, the observer with this chain: --masses {result.masses} {settings}")
