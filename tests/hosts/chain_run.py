@@ -36,60 +36,66 @@ def mapped_libpythons():
     return sorted(found)
 
 
-def main(spec_path, out_path):
-    with open(spec_path) as f:
-        spec = json.load(f)
+def import_shadow(folder):
+    """Put ``folder`` first on sys.path and import every package in it; their names."""
+    sys.path.insert(0, folder)
     shadowed = []
-    if spec.get("shadow"):
-        sys.path.insert(0, spec["shadow"])
-        for name in sorted(os.listdir(spec["shadow"])):
-            if os.path.isfile(os.path.join(spec["shadow"], name, "__init__.py")):
-                importlib.import_module(name)
-                shadowed.append(name)
+    for name in sorted(os.listdir(folder)):
+        if os.path.isfile(os.path.join(folder, name, "__init__.py")):
+            importlib.import_module(name)
+            shadowed.append(name)
+    return shadowed
+
+
+def set_parameter(slave, variable, value):
+    """Set one start value through the setter of the variable's type."""
+    if variable.type == "Real":
+        slave.setReal([variable.valueReference], [float(value)])
+    elif variable.type in ("Integer", "Enumeration"):
+        slave.setInteger([variable.valueReference], [int(value)])
+    elif variable.type == "Boolean":
+        slave.setBoolean([variable.valueReference], [bool(value)])
+    else:
+        slave.setString([variable.valueReference], [str(value)])
+
+
+def load(name, fmu, parameters):
+    """Extract, instantiate and initialize one FMU: (slave, its folder, its variables)."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    environ_before = dict(os.environ)
-    maps_before = mapped_libpythons()
-    slaves, readers, writers, outputs = {}, {}, {}, {}
-    folders = []
-    for name, fmu in spec["components"].items():
-        md = read_model_description(fmu)
-        folder = extract(fmu, unzipdir=tempfile.mkdtemp(prefix="chain_"))
-        folders.append(folder)
-        variables = {v.name: v for v in md.modelVariables}
-        slave = FMU2Slave(
-            guid=md.guid,
-            unzipDirectory=folder,
-            modelIdentifier=md.coSimulation.modelIdentifier,
-            instanceName=name,
-        )
-        slave.instantiate(loggingOn=True)
-        slave.setupExperiment(startTime=0.0)
-        for var, value in spec["parameters"].get(name, {}).items():
-            v = variables[var]
-            if v.type == "Real":
-                slave.setReal([v.valueReference], [float(value)])
-            elif v.type in ("Integer", "Enumeration"):
-                slave.setInteger([v.valueReference], [int(value)])
-            elif v.type == "Boolean":
-                slave.setBoolean([v.valueReference], [bool(value)])
-            else:
-                slave.setString([v.valueReference], [str(value)])
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        slaves[name] = slave
-        outs = [v for v in md.modelVariables if v.causality == "output"]
-        outputs[name] = [v.name for v in outs]
-        readers[name] = (
-            [v.valueReference for v in outs if v.type == "Real"],
-            [v.valueReference for v in outs if v.type == "Boolean"],
-            [v.name for v in outs if v.type == "Real"]
-            + [v.name for v in outs if v.type == "Boolean"],
-        )
-        writers[name] = variables
-    environ_loaded = dict(os.environ)
-    maps_loaded = mapped_libpythons()
+    md = read_model_description(fmu)
+    folder = extract(fmu, unzipdir=tempfile.mkdtemp(prefix="chain_"))
+    variables = {v.name: v for v in md.modelVariables}
+    slave = FMU2Slave(
+        guid=md.guid,
+        unzipDirectory=folder,
+        modelIdentifier=md.coSimulation.modelIdentifier,
+        instanceName=name,
+    )
+    slave.instantiate(loggingOn=True)
+    slave.setupExperiment(startTime=0.0)
+    for var, value in parameters.items():
+        set_parameter(slave, variables[var], value)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    return slave, folder, variables
+
+
+def output_reader(variables):
+    """(Real value references, Boolean value references, their names in that order)."""
+    outs = [v for v in variables.values() if v.causality == "output"]
+    reals = [v for v in outs if v.type == "Real"]
+    bools = [v for v in outs if v.type == "Boolean"]
+    return (
+        [v.valueReference for v in reals],
+        [v.valueReference for v in bools],
+        [v.name for v in reals] + [v.name for v in bools],
+    )
+
+
+def simulate(slaves, readers, links, stop, h):
+    """Jacobi steps from 0 to ``stop``; every output at every communication point."""
     log = {name: {out: [] for out in readers[name][2]} for name in slaves}
 
     def record():
@@ -100,33 +106,54 @@ def main(spec_path, out_path):
             for out, value in zip(names, values):
                 log[name][out].append(value)
 
-    links = []
-    for a, out, b, inp in spec["connections"]:
-        src = {v.name: v for v in read_model_description(spec["components"][a]).modelVariables}
-        links.append((a, src[out].valueReference, b, writers[b][inp].valueReference))
     record()
-    h, steps = spec["h"], round(spec["stop"] / spec["h"])
-    for k in range(steps):
+    for k in range(round(stop / h)):
         t = k * h
         for a, vr_out, b, vr_in in links:
             slaves[b].setReal([vr_in], slaves[a].getReal([vr_out]))
         for slave in slaves.values():
             slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
         record()
+    return log
+
+
+def changed_variables(*environs):
+    """Names of the environment variables that differ between any of ``environs``."""
+    keys = set().union(*environs)
+    return sorted(k for k in keys if len({repr(e.get(k)) for e in environs}) > 1)
+
+
+def main(spec_path, out_path):
+    with open(spec_path) as f:
+        spec = json.load(f)
+    shadowed = import_shadow(spec["shadow"]) if spec.get("shadow") else []
+    # fmpy is imported before the environment is first read, as it always was
+    import fmpy.fmi2  # noqa: F401
+
+    environ_before = dict(os.environ)
+    maps_before = mapped_libpythons()
+    slaves, readers, variables, folders = {}, {}, {}, []
+    for name, fmu in spec["components"].items():
+        parameters = spec["parameters"].get(name, {})
+        slaves[name], folder, variables[name] = load(name, fmu, parameters)
+        folders.append(folder)
+        readers[name] = output_reader(variables[name])
+    environ_loaded = dict(os.environ)
+    maps_loaded = mapped_libpythons()
+    links = [
+        (a, variables[a][out].valueReference, b, variables[b][inp].valueReference)
+        for a, out, b, inp in spec["connections"]
+    ]
+    log = simulate(slaves, readers, links, spec["stop"], spec["h"])
     for slave in slaves.values():
         slave.terminate()
         slave.freeInstance()
     for folder in folders:
         shutil.rmtree(folder, ignore_errors=True)
-    changed = sorted(
-        k
-        for k in set(environ_before) | set(environ_loaded) | set(os.environ)
-        if not (environ_before.get(k) == environ_loaded.get(k) == os.environ.get(k))
-    )
     report = {
         "python": sys.version,
         "executable": sys.executable,
-        "environ_changed": changed,
+        "environ_changed": changed_variables(environ_before, environ_loaded, dict(os.environ)),
         "libpython_before": maps_before,
         "libpython_after": maps_loaded,
         "shadowed": shadowed,
