@@ -144,6 +144,10 @@ static int python_alive(void) {
     return py_initialized && py_initialized() && !(py_finalizing && py_finalizing());
 }
 
+#define PYTHON_GONE                                                                        \
+    "the process's Python has finalized or is finalizing: the FMU's Python model cannot " \
+    "be called any more (its memory is left to the process's exit)"
+
 /* ------------------------------------------------------------------------------------ */
 /* Small text helpers (bounded, always terminated)                                      */
 
@@ -432,7 +436,13 @@ static int start_interpreter(const char *home, char *why, size_t size) {
 static int ensure_python(char *why, size_t size) {
     static Search s; /* large; used under load_lock only */
     memset(&s, 0, sizeof s);
-    IsInitializedFn is_initialized;
+    IsInitializedFn is_initialized, finalizing;
+    if (!LOOKUP(RTLD_DEFAULT, "Py_IsFinalizing", finalizing))
+        LOOKUP(RTLD_DEFAULT, "_Py_IsFinalizing", finalizing);
+    if (finalizing && finalizing()) { /* never start or use a Python on its way out */
+        snprintf(why, size, "%s", PYTHON_GONE);
+        return -1;
+    }
     LOOKUP(RTLD_DEFAULT, "Py_IsInitialized", is_initialized);
     char mapped[PATH_MAX] = "";
     if (!is_initialized && dl_iterate_phdr(find_mapped, mapped) && mapped[0]) {
@@ -654,10 +664,6 @@ static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status stat
 }
 
 static void *allocate(size_t n, size_t size) { return calloc(n, size); }
-
-#define PYTHON_GONE                                                                        \
-    "the process's Python has finalized or is finalizing: the FMU's Python model cannot " \
-    "be called any more (its memory is left to the process's exit)"
 
 /* Whether the host's logger runs without Python: code mapped from a file that is not
  * libffi, libpython or a ctypes/cffi module. A ctypes or cffi callback lives in
