@@ -1,8 +1,10 @@
 """Write the SSP 1.0 system source → plant → observer (``ActionReaction.ssp``).
 
 :func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
-connectors, connections, a DefaultExperiment, and parameter sets bound inline per
-component, as ecos reads them). :mod:`arcosim.host.ssp` runs such a file.
+connectors, connections, a DefaultExperiment, parameter sets bound inline per
+component, as ecos reads them, and OMSimulator's annotation of the system: its type,
+a fixed-step master, without which OMSimulator cannot open a valid SSP 1.0 file).
+:mod:`arcosim.host.ssp` runs such a file.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from __future__ import annotations
 import os
 import zipfile
 from collections.abc import Mapping
+from decimal import Decimal
 from pathlib import Path
 from xml.etree import ElementTree
 from xml.etree.ElementTree import Element, SubElement
@@ -20,7 +23,13 @@ from arcosim.fmu.fmukit.variables import type_of
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
-NS = {"ssd": SSD, "ssc": SSC, "ssv": SSV}
+#: OMSimulator's vendor namespace (its schema/oms.xsd); OMSimulator matches the prefix
+#: ``oms`` literally, as it does ``ssd`` and ``ssc``
+OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
+NS = {"ssd": SSD, "ssc": SSC, "ssv": SSV, "oms": OMS}
+#: OMSimulator's relative tolerance of a fixed-step master (its own default); unused by
+#: a fixed step, required by its schema
+OMS_RELATIVE_TOLERANCE = "0.0001"
 
 #: (component, FMU file stem)
 COMPONENTS = (
@@ -57,12 +66,16 @@ def write_ssp(
     parameter_sets: Mapping[str, Mapping[str, Mapping[str, float | int | bool | str]]]
     | None = None,
     stop: float = 10.0,
+    step: float = 1e-3,
 ) -> Path:
-    """Pack the three FMUs of ``fmu_dir`` into an SSP at ``path``; return it."""
+    """Pack the three FMUs of ``fmu_dir`` into an SSP at ``path``; return it.
+
+    ``stop`` (s) goes into the DefaultExperiment, ``step`` (s) into OMSimulator's
+    fixed-step master (SSP 1.0 has no place for a step).
+    """
     sets = {"bench": BENCH} if parameter_sets is None else parameter_sets
-    ElementTree.register_namespace("ssd", SSD)
-    ElementTree.register_namespace("ssc", SSC)
-    ElementTree.register_namespace("ssv", SSV)
+    for prefix, uri in NS.items():
+        ElementTree.register_namespace(prefix, uri)
     root = Element(
         f"{{{SSD}}}SystemStructureDescription", {"version": "1.0", "name": "ActionReaction"}
     )
@@ -112,6 +125,7 @@ def write_ssp(
             f"{{{SSD}}}Connection",
             {"startElement": a, "startConnector": ca, "endElement": b, "endConnector": cb},
         )
+    _omsimulator_annotation(system, step)
     SubElement(
         root, f"{{{SSD}}}DefaultExperiment", {"startTime": "0.0", "stopTime": repr(float(stop))}
     )
@@ -126,6 +140,25 @@ def write_ssp(
             z.write(fmu_dir / f"{stem}.fmu", f"resources/{stem}.fmu")
     partial.replace(path)
     return path
+
+
+def _omsimulator_annotation(system: Element, step: float) -> None:
+    """OMSimulator's system annotation: a weakly coupled system (its ``oms-ma``, fixed
+    step ``step`` s), the last child of ``ssd:System`` as SSP 1.0 orders it."""
+    annotations = SubElement(system, f"{{{SSD}}}Annotations")
+    annotation = SubElement(annotations, f"{{{SSC}}}Annotation", {"type": "org.openmodelica"})
+    information = SubElement(
+        SubElement(annotation, f"{{{OMS}}}Annotations"), f"{{{OMS}}}SimulationInformation"
+    )
+    SubElement(
+        information,
+        f"{{{OMS}}}FixedStepMaster",
+        {
+            "description": "oms-ma",
+            "stepSize": format(Decimal(repr(float(step))), "f"),  # xs:decimal: no exponent
+            "relativeTolerance": OMS_RELATIVE_TOLERANCE,
+        },
+    )
 
 
 def _text(value: object) -> str:

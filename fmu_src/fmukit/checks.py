@@ -1,9 +1,9 @@
 """Parameter checks that name the parameter and say what is wrong.
 
 The numbers every FMU computes in (SI units): a Real parameter or input of magnitude
-above :data:`LARGEST`, a step below :data:`SMALLEST_STEP`, or a chain whose fastest
-mode or decay exceeds :data:`FASTEST_RATE` is refused, so no output can become
-infinite or NaN from them.
+above :data:`LARGEST`, or a chain whose fastest mode or decay exceeds
+:data:`FASTEST_RATE` is refused, and a step below :data:`SMALLEST_STEP` takes no new
+sample, so no output can become infinite or NaN from them.
 """
 
 from __future__ import annotations
@@ -13,8 +13,13 @@ from collections.abc import Callable, Iterable, Sequence
 
 #: Largest magnitude of a Real parameter or input (SI units).
 LARGEST = 1e15
-#: Smallest communication step (s): below it the discrete filters' differences lose
-#: every digit (a velocity change over 1e-308 s is not a number).
+#: Shortest step (s) that takes a new sample. A shorter one (a host that sums its time
+#: ends 10 s of 1 ms steps on one of 1.03e-13 s) is accepted and only advances the time:
+#: the Python FMUs hold their state and outputs (their filters divide by the step, and a
+#: difference over 1e-13 s has no digit left), the C plant integrates it exactly but keeps
+#: its measured outputs. 1e-9 s is the communication point's tolerance (``1e-9 *
+#: max(1, |t|)``) and was the refusal limit before, so every step taken before is
+#: integrated as before.
 SMALLEST_STEP = 1e-9
 #: Fastest mode (rad/s) or decay rate (1/s) of a motor–spring–mass chain the models
 #: integrate; a stiffer or more damped chain is refused at initialization.

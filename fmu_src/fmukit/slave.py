@@ -9,7 +9,8 @@ Conventions it settles (see README, "FMU conventions"):
   and every later ``doStep`` answers fmi2Discard with the same message. A bad
   step (non-finite input, step size ≤ 0, communication point that is not the
   current time) is refused with fmi2Discard and a log line naming the problem,
-  and leaves the state untouched.
+  and leaves the state untouched. A step below ``SMALLEST_STEP`` is taken by holding
+  the state and outputs: only the time advances.
 * Algorithm state is kept in plain data (floats, ints, lists, small classes), so
   FMU state get/set and serialization cover every filter and accumulator
   (:mod:`arcosim.fmu.fmukit.state`).
@@ -255,8 +256,11 @@ class FmuSlave(Fmi2Slave):
             and SMALLEST_STEP <= step_size < _INF
             and -1e-9 <= current_time - self.time <= 1e-9
             and sum(map(abs, self._read_inputs(self.v))) <= LARGEST
-        ) and not self._step_allowed(current_time, step_size):
-            return False
+        ):
+            if not self._step_allowed(current_time, step_size):
+                return False
+            if step_size < SMALLEST_STEP:
+                return self._hold(current_time + step_size)
         try:
             self.step(current_time, step_size)
         except StepRefusedError as refusal:
@@ -269,6 +273,14 @@ class FmuSlave(Fmi2Slave):
             self._refuse_not_finite(current_time, step_size)
             return False
         self.time = current_time + step_size
+        if self._trace is not None:
+            self._write_trace()
+        return True
+
+    def _hold(self, end: float) -> bool:
+        """Take a step below SMALLEST_STEP (a summing host's rounding residue): the
+        state and the outputs stay as they are, only the time moves to ``end`` (s)."""
+        self.time = end
         if self._trace is not None:
             self._write_trace()
         return True
@@ -343,8 +355,6 @@ class FmuSlave(Fmi2Slave):
     def _step_problem(self, t: float, h: float) -> str | None:
         if not (math.isfinite(h) and h > 0.0):
             return f"step size {h!r} s refused: it must be a finite number > 0"
-        if h < SMALLEST_STEP:
-            return f"step size {h!r} s refused: it must be at least {SMALLEST_STEP:g} s"
         if not math.isfinite(t):
             return f"communication point {t!r} s refused: it must be finite"
         if self.time is not None and abs(t - self.time) > 1e-9 * max(1.0, abs(t)):

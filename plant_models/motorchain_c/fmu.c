@@ -11,7 +11,9 @@
  * logged at exitInitializationMode and every later doStep answers fmi2Discard
  * with the same message; a bad step (non-finite input, step size <= 0,
  * communication point other than the FMU's time) is refused with fmi2Discard and
- * leaves the state untouched. */
+ * leaves the state untouched. A step under SMALLEST_STEP (a summing host's rounding
+ * residue, e.g. 1e-13 s) is integrated exactly but takes no new sample: the measured
+ * outputs and the means over a step keep their values. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -51,7 +53,20 @@ typedef struct {
     fmi2ComponentEnvironment environment;
     char name[256];
     int logging;
+    int mode; /* where the FMI 2.0 co-simulation state machine stands: one of MODE_* */
 } Plant;
+
+/* The states of FMI 2.0's co-simulation state machine an instance can be in, as bits,
+ * so that a call names the states it is allowed in (as Reference-FMUs do). A failed
+ * exitInitializationMode leads to MODE_STEP like a good one: by the project's
+ * convention every later doStep answers fmi2Discard with the refused parameters. */
+enum {
+    MODE_INSTANTIATED = 1,
+    MODE_INITIALIZATION = 2,
+    MODE_STEP = 4, /* stepComplete: initialized, stepping */
+    MODE_TERMINATED = 8,
+    MODE_ANY = 15
+};
 
 /* ---- messages ---- */
 
@@ -206,6 +221,21 @@ static void check_parameters(Core *c) {
 
 /* ---- outputs ---- */
 
+/* The outputs that are the chain's state at the FMU's time (no sensor, no mean). */
+static void write_true_outputs(Core *c) {
+    const Physics *p = &c->physics;
+    const double *x = p->x;
+    double *v = c->v;
+    v[VR_theta_m_true] = x[0];
+    v[VR_omega_m_true] = x[N_MASSES + 1];
+    for (int j = 0; j < N_MASSES; j++) {
+        v[VR_theta + j] = x[1 + j];
+        v[VR_omega + j] = x[N_MASSES + 2 + j];
+    }
+    v[VR_tau_reac] = physics_reaction_torque(p);
+    v[VR_twist] = x[0] - x[1];
+}
+
 static void write_outputs(Core *c, double h /* <= 0: the sample at t0 */) {
     const Physics *p = &c->physics;
     const double *x = p->x;
@@ -226,16 +256,9 @@ static void write_outputs(Core *c, double h /* <= 0: the sample at t0 */) {
     v[VR_i_a] = i_true + noise;
     v[VR_theta_m] = theta_q;
     v[VR_omega_m] = omega_q;
-    v[VR_theta_m_true] = x[0];
-    v[VR_omega_m_true] = x[N_MASSES + 1];
-    for (int j = 0; j < N_MASSES; j++) {
-        v[VR_theta + j] = x[1 + j];
-        v[VR_omega + j] = x[N_MASSES + 2 + j];
-    }
-    v[VR_tau_reac] = physics_reaction_torque(p);
     v[VR_tau_reac_mean] = tau_mean;
     v[VR_i_true] = i_true;
-    v[VR_twist] = x[0] - x[1];
+    write_true_outputs(c);
 }
 
 static void initialize(Core *c) {
@@ -288,6 +311,38 @@ static void open_trace(Plant *p) {
     write_trace(p);
 }
 
+/* ---- FMI: guards ---- */
+
+static const char *mode_name(int mode) {
+    switch (mode) {
+    case MODE_INSTANTIATED: return "instantiated (before fmi2EnterInitializationMode)";
+    case MODE_INITIALIZATION: return "initialization mode";
+    case MODE_STEP: return "initialized (stepping)";
+    default: return "terminated";
+    }
+}
+
+/* Whether `call` may run now: never on a NULL instance (fmi2Error, nothing to log
+ * through); in a state outside `modes` it is logged and answers fmi2Error. */
+static int allowed(Plant *p, int modes, const char *call) {
+    if (!p) return 0;
+    if (p->mode & modes) return 1;
+    log_message(p, fmi2Error, "%s is not allowed when the FMU is %s (FMI 2.0 co-simulation "
+                "state machine); call refused, nothing changed", call, mode_name(p->mode));
+    return 0;
+}
+
+/* A NULL array with a nonzero length, or a NULL result pointer: logged, fmi2Error. */
+static int given(Plant *p, const void *pointer, const char *what, const char *call) {
+    if (pointer) return 1;
+    log_message(p, fmi2Error, "%s: %s is NULL; call refused", call, what);
+    return 0;
+}
+
+#define BEGIN(c, modes)                      \
+    Plant *p = (Plant *)(c);                 \
+    if (!allowed(p, (modes), __func__)) return fmi2Error
+
 /* ---- FMI: instance life cycle ---- */
 
 static void reset_core(Core *c) {
@@ -332,6 +387,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     *p = probe;
     p->logging = loggingOn;
     p->cache = cache;
+    p->mode = MODE_INSTANTIATED;
     reset_core(&p->core);
     return p;
 }
@@ -348,7 +404,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t n,
                                const fmi2String categories[]) {
     (void)n;
     (void)categories;
-    ((Plant *)c)->logging = loggingOn;
+    BEGIN(c, MODE_ANY);
+    p->logging = loggingOn;
     return fmi2OK;
 }
 
@@ -359,20 +416,22 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     (void)tolerance;
     (void)stopTimeDefined;
     (void)stopTime;
-    Plant *p = c;
+    BEGIN(c, MODE_INSTANTIATED);
     p->core.time = startTime;
     p->core.time_known = 1;
     return fmi2OK;
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    (void)c;
+    BEGIN(c, MODE_INSTANTIATED);
+    p->mode = MODE_INITIALIZATION;
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    Plant *p = c;
+    BEGIN(c, MODE_INITIALIZATION);
     Core *core = &p->core;
+    p->mode = MODE_STEP;
     core->problems[0] = '\0';
     check_parameters(core);
     if (!core->problems[0]) {
@@ -388,20 +447,26 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     return fmi2OK;
 }
 
-fmi2Status fmi2Terminate(fmi2Component c) {
-    Plant *p = c;
+static void close_trace(Plant *p) {
     if (p->trace) {
         fclose(p->trace);
         p->trace = NULL;
     }
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    BEGIN(c, MODE_STEP);
+    close_trace(p);
+    p->mode = MODE_TERMINATED;
     return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
-    Plant *p = c;
-    fmi2Terminate(c);
+    BEGIN(c, MODE_ANY);
+    close_trace(p);
     reset_core(&p->core);
     physics_cache_clear(p->cache);
+    p->mode = MODE_INSTANTIATED;
     return fmi2OK;
 }
 
@@ -413,12 +478,6 @@ static int step_problem(Plant *p, double t, double h) {
     if (!(isfinite(h) && h > 0.0)) {
         repr_double(a, sizeof a, h);
         log_message(p, fmi2Discard, "step size %s s refused: it must be a finite number > 0", a);
-        return 1;
-    }
-    if (h < SMALLEST_STEP) {
-        repr_double(a, sizeof a, h);
-        log_message(p, fmi2Discard, "step size %s s refused: it must be at least %g s", a,
-                    SMALLEST_STEP);
         return 1;
     }
     if (!isfinite(t)) {
@@ -453,7 +512,8 @@ static int step_problem(Plant *p, double t, double h) {
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior) {
     (void)noSetPrior;
-    Plant *p = c;
+    /* before initialization: fmi2Discard with the project's message (below) */
+    BEGIN(c, MODE_INSTANTIATED | MODE_INITIALIZATION | MODE_STEP);
     Core *core = &p->core;
     if (!core->initialized) {
         log_message(p, fmi2Discard,
@@ -477,8 +537,13 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
     double outputs[N_VARS];
     memcpy(outputs, core->v, sizeof outputs);
     double theta_measured = core->theta_measured;
-    core->sample++;
-    write_outputs(core, h);
+    uint64_t sample = core->sample;
+    if (h < SMALLEST_STEP) { /* a host's rounding residue: the chain moves, no new sample */
+        write_true_outputs(core);
+    } else {
+        core->sample++;
+        write_outputs(core, h);
+    }
     for (int vr = 0; vr < N_VARS; vr++)
         if (VAR_CAUSALITY[vr] == C_OUTPUT && !isfinite(core->v[vr])) {
             char a[64], b[64];
@@ -491,7 +556,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
             core->physics = saved;
             memcpy(core->v, outputs, sizeof outputs);
             core->theta_measured = theta_measured;
-            core->sample--;
+            core->sample = sample;
             return fmi2Discard;
         }
     core->time = t + h;
@@ -501,7 +566,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
-    (void)c;
+    BEGIN(c, MODE_ANY);
+    log_message(p, fmi2Error, "fmi2CancelStep: doStep never runs asynchronously");
     return fmi2Error;
 }
 
@@ -520,9 +586,15 @@ static fmi2Status check_refs(Plant *p, const fmi2ValueReference vr[], size_t n, 
     return fmi2OK;
 }
 
-static fmi2Status get_numbers(fmi2Component c, const fmi2ValueReference vr[], size_t n, int type,
-                              double *reals, int *ints) {
-    Plant *p = c;
+#define GETTABLE (MODE_INITIALIZATION | MODE_STEP | MODE_TERMINATED)
+#define SETTABLE (MODE_INSTANTIATED | MODE_INITIALIZATION | MODE_STEP)
+
+static fmi2Status get_numbers(Plant *p, const fmi2ValueReference vr[], size_t n, int type,
+                              double *reals, int *ints, const char *call) {
+    if (!allowed(p, GETTABLE, call)) return fmi2Error;
+    if (n == 0) return fmi2OK;
+    if (!given(p, vr, "vr", call) || !given(p, reals ? (void *)reals : (void *)ints, "value", call))
+        return fmi2Error;
     if (check_refs(p, vr, n, type, "get") != fmi2OK) return fmi2Error;
     for (size_t i = 0; i < n; i++) {
         double x = p->core.v[vr[i]];
@@ -550,9 +622,13 @@ static fmi2Status settable(Plant *p, fmi2ValueReference vr) {
     return fmi2OK;
 }
 
-static fmi2Status set_numbers(fmi2Component c, const fmi2ValueReference vr[], size_t n, int type,
-                              const double *reals, const int *ints) {
-    Plant *p = c;
+static fmi2Status set_numbers(Plant *p, const fmi2ValueReference vr[], size_t n, int type,
+                              const double *reals, const int *ints, const char *call) {
+    if (!allowed(p, SETTABLE, call)) return fmi2Error;
+    if (n == 0) return fmi2OK;
+    if (!given(p, vr, "vr", call) ||
+        !given(p, reals ? (const void *)reals : (const void *)ints, "value", call))
+        return fmi2Error;
     if (check_refs(p, vr, n, type, "set") != fmi2OK) return fmi2Error;
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < n; i++) {
@@ -569,22 +645,24 @@ static fmi2Status set_numbers(fmi2Component c, const fmi2ValueReference vr[], si
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                        fmi2Real value[]) {
-    return get_numbers(c, vr, n, T_REAL, value, NULL);
+    return get_numbers(c, vr, n, T_REAL, value, NULL, __func__);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                           fmi2Integer value[]) {
-    return get_numbers(c, vr, n, T_INTEGER, NULL, value);
+    return get_numbers(c, vr, n, T_INTEGER, NULL, value, __func__);
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                           fmi2Boolean value[]) {
-    return get_numbers(c, vr, n, T_BOOLEAN, NULL, value);
+    return get_numbers(c, vr, n, T_BOOLEAN, NULL, value, __func__);
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                          fmi2String value[]) {
-    Plant *p = c;
+    BEGIN(c, GETTABLE);
+    if (n == 0) return fmi2OK;
+    if (!given(p, vr, "vr", __func__) || !given(p, value, "value", __func__)) return fmi2Error;
     if (check_refs(p, vr, n, T_STRING, "get") != fmi2OK) return fmi2Error;
     for (size_t i = 0; i < n; i++) value[i] = p->core.trace_file; /* the only String */
     return fmi2OK;
@@ -592,22 +670,24 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                        const fmi2Real value[]) {
-    return set_numbers(c, vr, n, T_REAL, value, NULL);
+    return set_numbers(c, vr, n, T_REAL, value, NULL, __func__);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                           const fmi2Integer value[]) {
-    return set_numbers(c, vr, n, T_INTEGER, NULL, value);
+    return set_numbers(c, vr, n, T_INTEGER, NULL, value, __func__);
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                           const fmi2Boolean value[]) {
-    return set_numbers(c, vr, n, T_BOOLEAN, NULL, value);
+    return set_numbers(c, vr, n, T_BOOLEAN, NULL, value, __func__);
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                          const fmi2String value[]) {
-    Plant *p = c;
+    BEGIN(c, SETTABLE);
+    if (n == 0) return fmi2OK;
+    if (!given(p, vr, "vr", __func__) || !given(p, value, "value", __func__)) return fmi2Error;
     if (check_refs(p, vr, n, T_STRING, "set") != fmi2OK) return fmi2Error;
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < n; i++) {
@@ -630,7 +710,8 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 /* ---- FMI: FMU state ---- */
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
-    Plant *p = c;
+    BEGIN(c, MODE_ANY);
+    if (!given(p, state, "state", __func__)) return fmi2Error;
     Core *copy = *state ? (Core *)*state : malloc(sizeof(Core));
     if (!copy) return fmi2Error;
     *copy = p->core;
@@ -639,15 +720,18 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
-    Plant *p = c;
-    if (!state) return fmi2Error;
+    BEGIN(c, MODE_ANY);
+    if (!given(p, state, "state", __func__)) return fmi2Error;
     p->core = *(const Core *)state;
+    if (p->mode != MODE_TERMINATED)
+        p->mode = p->core.initialized ? MODE_STEP : MODE_INSTANTIATED;
     physics_cache_clear(p->cache); /* derived data: rebuilt on demand */
     return fmi2OK;
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
-    (void)c;
+    BEGIN(c, MODE_ANY);
+    if (!given(p, state, "state", __func__)) return fmi2Error;
     free(*state);
     *state = NULL;
     return fmi2OK;
@@ -660,16 +744,19 @@ static const char IDENTITY[] = MODEL_IDENTIFIER " " MODEL_GUID " " PLANT_BUILD;
 #define SERIALIZED (ENVELOPE_OVERHEAD(IDENTITY_LENGTH) + sizeof(Core))
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
-    (void)c;
-    (void)state;
+    BEGIN(c, MODE_ANY);
+    if (!given(p, state, "state", __func__) || !given(p, size, "size", __func__))
+        return fmi2Error;
     *size = SERIALIZED;
     return fmi2OK;
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[],
                                  size_t size) {
-    Plant *p = c;
-    if (!state || size != SERIALIZED) {
+    BEGIN(c, MODE_ANY);
+    if (!given(p, state, "state", __func__) || !given(p, bytes, "bytes", __func__))
+        return fmi2Error;
+    if (size != SERIALIZED) {
         log_message(p, fmi2Error, "serializeFMUstate: %zu bytes given, %zu needed (ask "
                     "fmi2SerializedFMUstateSize)", size, (size_t)SERIALIZED);
         return fmi2Error;
@@ -689,7 +776,9 @@ static fmi2Status refuse(Plant *p, const char *why) {
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
                                    fmi2FMUstate *state) {
-    Plant *p = c;
+    BEGIN(c, MODE_ANY);
+    if (!given(p, bytes, "bytes", __func__) || !given(p, state, "state", __func__))
+        return fmi2Error;
     char why[TEXT];
     const unsigned char *payload;
     uint64_t payload_length;
@@ -716,38 +805,46 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2ValueReference z[], size_t nz,
                                         const fmi2Real du[], fmi2Real dz[]) {
     (void)u, (void)nu, (void)z, (void)nz, (void)du, (void)dz;
-    log_message(c, fmi2Error, "directional derivatives are not provided");
+    BEGIN(c, MODE_ANY);
+    log_message(p, fmi2Error, "directional derivatives are not provided");
     return fmi2Error;
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr, (void)n, (void)order, (void)value;
-    log_message(c, fmi2Error, "input derivatives are not supported (canInterpolateInputs=false)");
+    BEGIN(c, MODE_ANY);
+    log_message(p, fmi2Error, "input derivatives are not supported (canInterpolateInputs=false)");
     return fmi2Error;
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
                                         size_t n, const fmi2Integer order[], fmi2Real value[]) {
     (void)vr, (void)n, (void)order, (void)value;
-    log_message(c, fmi2Error, "output derivatives are not provided");
+    BEGIN(c, MODE_ANY);
+    log_message(p, fmi2Error, "output derivatives are not provided");
     return fmi2Error;
 }
 
+#define STATUS_MODES (MODE_STEP | MODE_TERMINATED)
+
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    (void)c, (void)s, (void)value;
+    (void)s, (void)value;
+    BEGIN(c, STATUS_MODES);
     return fmi2Discard; /* doStep never runs asynchronously */
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    Plant *p = c;
+    BEGIN(c, STATUS_MODES);
+    if (!given(p, value, "value", __func__)) return fmi2Error;
     if (s != fmi2LastSuccessfulTime) return fmi2Discard;
     *value = p->core.time;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    (void)c, (void)s, (void)value;
+    (void)s, (void)value;
+    BEGIN(c, STATUS_MODES);
     return fmi2Discard;
 }
 
@@ -756,13 +853,15 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
  * a refused step leaves the state unchanged and the master may retry: false. The
  * Python FMUs answer the same (cosim/build/native/fmu_trampoline.c). */
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    Plant *p = c;
-    if (s != fmi2Terminated || !value) return fmi2Discard;
+    BEGIN(c, STATUS_MODES);
+    if (!given(p, value, "value", __func__)) return fmi2Error;
+    if (s != fmi2Terminated) return fmi2Discard;
     *value = p->core.initialized && p->core.problems[0] ? fmi2True : fmi2False;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    (void)c, (void)s, (void)value;
+    (void)s, (void)value;
+    BEGIN(c, STATUS_MODES);
     return fmi2Discard;
 }

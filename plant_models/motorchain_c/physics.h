@@ -27,6 +27,11 @@ typedef struct {
     double x[PH_SIZE];
     int stuck;
     double direction;
+    /* a bound on the chain's fastest rate (1/s): 2 sqrt(max_j sum |K_j.| / J_j) +
+     * max_j sum |D_j.| / J_j + current bandwidth (Gershgorin on the chain scaled so
+     * that angles and velocities weigh alike); tau * rate <= 1/2 makes a sub-step short
+     * enough for its Taylor series */
+    double rate;
 } Physics;
 
 /* Derived data, rebuilt on demand: not part of an FMU state. */

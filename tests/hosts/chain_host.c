@@ -13,6 +13,8 @@
  *   link A VR_OUT B VR_IN                   (Real output of A to Real input of B)
  *   out NAME VR r|b                         (an output to record: Real or Boolean)
  *   run STOP H
+ *   sum                                     (optional: sum the time, t += h, as many hosts
+ *                                            do; the last step is min(h, STOP - t))
  * OUT: a line per communication point, t then the outputs in "out" order (%.17g);
  * then "environ same|changed", "libpython PATH" lines, "status OK".
  * With CHAIN_HOST_LOCAL_LIBPYTHON=path the host first dlopen()s that libpython with
@@ -111,6 +113,7 @@ int main(int argc, char **argv) {
     static double number[MAX_ITEMS];
     int n = 0;
     double stop = 0, h = 0;
+    int summing = 0;
     char line[2048];
     const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     while (fgets(line, sizeof line, spec)) {
@@ -122,6 +125,8 @@ int main(int argc, char **argv) {
             sscanf(line, "fmu %63s %1023s %255s %127s", f->name, f->dir, f->id, f->guid);
         } else if (strcmp(word, "run") == 0) {
             sscanf(line, "run %lf %lf", &stop, &h);
+        } else if (strcmp(word, "sum") == 0) {
+            summing = 1;
         } else if (n < MAX_ITEMS) {
             snprintf(kind[n], sizeof kind[n], "%s", word);
             if (strcmp(word, "link") == 0) {
@@ -204,8 +209,9 @@ int main(int argc, char **argv) {
     FILE *out = fopen(argv[2], "w");
     if (!out) return 2;
     long steps = (long)(stop / h + 0.5);
-    for (long s = 0; s <= steps; s++) {
-        double t = (double)s * h;
+    double t = 0.0;
+    for (long s = 0;; s++) {
+        if (!summing) t = (double)s * h;
         fprintf(out, "%.17g", t);
         for (int k = 0; k < n; k++) {
             if (strcmp(kind[k], "out")) continue;
@@ -222,7 +228,8 @@ int main(int argc, char **argv) {
             fprintf(out, ",%.17g", x);
         }
         fputc('\n', out);
-        if (s == steps) break;
+        if (summing ? !(t < stop) : s == steps) break;
+        double step = summing && stop - t < h ? stop - t : h;
         for (int k = 0; k < n; k++) {
             if (strcmp(kind[k], "link")) continue;
             Fmu *from = find(a[k]), *to = find(b[k]);
@@ -232,7 +239,8 @@ int main(int argc, char **argv) {
             check(to->set_real(to->c, &in, 1, &x), "setReal", to);
         }
         for (int i = 0; i < nfmus; i++)
-            check(fmus[i].do_step(fmus[i].c, t, h, fmi2True), "doStep", &fmus[i]);
+            check(fmus[i].do_step(fmus[i].c, t, step, fmi2True), "doStep", &fmus[i]);
+        if (summing) t += step;
     }
     for (int i = 0; i < nfmus; i++) {
         check(fmus[i].terminate(fmus[i].c), "terminate", &fmus[i]);

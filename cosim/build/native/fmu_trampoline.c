@@ -42,7 +42,15 @@
  *     restored state); a refused step leaves the state unchanged and answers fmi2False;
  *   - fmi2GetRealStatus(fmi2LastSuccessfulTime): the end of the last accepted step;
  *   - serialized FMU states in an envelope (magic, format version, identity, n, length,
- *     CRC-32) checked before the core sees any byte.
+ *     CRC-32) checked before the core sees any byte;
+ *   - teardown in any order: a call made once the process's Python has finalized, or
+ *     while it finalizes (Py_IsInitialized false, or Py_IsFinalizing -- _Py_IsFinalizing
+ *     before 3.13 -- true), never reaches the core, which would take the GIL of a dead
+ *     interpreter: it is logged when the host's logger is native code (a ctypes or cffi
+ *     logger would need that Python too), fmi2Terminate answers fmi2Warning,
+ *     fmi2FreeInstance and fmi2FreeFMUstate free the trampoline's part and leak the
+ *     core's, every other call answers fmi2Error. While Python lives, any thread may
+ *     call (pythonfmu takes the GIL with PyGILState_Ensure).
  *
  * Compiled per build by cosim/build/portable.py with
  *   -DARCOSIM_IDENTIFIER="..." -DARCOSIM_GUID="{...}" -DARCOSIM_BUILD="<package>"
@@ -119,6 +127,26 @@ typedef void *(*SaveThreadFn)(void);
 
 /* dlsym into a function pointer without the object-to-function cast ISO C forbids */
 #define LOOKUP(handle, name, target) (*(void **)(&(target)) = dlsym((handle), (name)))
+
+/* Whether the process's Python may still be called: set with the core (under load_lock,
+ * before any instance exists). Py_IsFinalizing is 3.13's name, _Py_IsFinalizing 3.9's
+ * to 3.12's; both read a flag without the GIL. */
+static IsInitializedFn py_initialized;
+static IsInitializedFn py_finalizing;
+
+static void watch_python(void) {
+    LOOKUP(RTLD_DEFAULT, "Py_IsInitialized", py_initialized);
+    if (!LOOKUP(RTLD_DEFAULT, "Py_IsFinalizing", py_finalizing))
+        LOOKUP(RTLD_DEFAULT, "_Py_IsFinalizing", py_finalizing);
+}
+
+static int python_alive(void) {
+    return py_initialized && py_initialized() && !(py_finalizing && py_finalizing());
+}
+
+#define PYTHON_GONE                                                                        \
+    "the process's Python has finalized or is finalizing: the FMU's Python model cannot " \
+    "be called any more (its memory is left to the process's exit)"
 
 /* ------------------------------------------------------------------------------------ */
 /* Small text helpers (bounded, always terminated)                                      */
@@ -408,7 +436,13 @@ static int start_interpreter(const char *home, char *why, size_t size) {
 static int ensure_python(char *why, size_t size) {
     static Search s; /* large; used under load_lock only */
     memset(&s, 0, sizeof s);
-    IsInitializedFn is_initialized;
+    IsInitializedFn is_initialized, finalizing;
+    if (!LOOKUP(RTLD_DEFAULT, "Py_IsFinalizing", finalizing))
+        LOOKUP(RTLD_DEFAULT, "_Py_IsFinalizing", finalizing);
+    if (finalizing && finalizing()) { /* never start or use a Python on its way out */
+        snprintf(why, size, "%s", PYTHON_GONE);
+        return -1;
+    }
     LOOKUP(RTLD_DEFAULT, "Py_IsInitialized", is_initialized);
     char mapped[PATH_MAX] = "";
     if (!is_initialized && dl_iterate_phdr(find_mapped, mapped) && mapped[0]) {
@@ -631,11 +665,37 @@ static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status stat
 
 static void *allocate(size_t n, size_t size) { return calloc(n, size); }
 
-static int usable(Instance *in) {
+/* Whether the host's logger runs without Python: code mapped from a file that is not
+ * libffi, libpython or a ctypes/cffi module. A ctypes or cffi callback lives in
+ * anonymous memory or on libffi's trampoline pages and would take the dead GIL. */
+static int native_logger(fmi2CallbackLogger logger) {
+    Dl_info info;
+    if (!logger || !dladdr((void *)(uintptr_t)logger, &info)) return 0;
+    const char *name = info.dli_fname ? info.dli_fname : "";
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
+    return !strstr(base, "libffi") && !strstr(base, "libpython") && !strstr(base, "_ctypes") &&
+           !strstr(base, "_cffi");
+}
+
+/* A call that finds Python gone: say so if that is safe, touch nothing of Python. */
+static void python_gone(Instance *in, fmi2Status status, const char *call) {
+    const char *category = category_of(status);
+    if (!category_enabled(in, category) || !native_logger(in->host_logger)) return;
+    char text[TEXT];
+    snprintf(text, sizeof text, "%s: %s: %s", in->name, call, PYTHON_GONE);
+    emit(in->host_logger, in->host_env, in->name, status, category, text);
+}
+
+static int usable_in(Instance *in, const char *call) {
     if (!in || in->magic != INSTANCE_MAGIC) return 0;
     if (in->dead) {
         say(in, fmi2Error, "this instance failed fatally before; only fmi2FreeInstance may be "
             "called now");
+        return 0;
+    }
+    if (!python_alive()) {
+        python_gone(in, fmi2Error, call);
         return 0;
     }
     in->worst = fmi2OK;
@@ -654,9 +714,9 @@ static fmi2Status finish(Instance *in, fmi2Status status) {
     return status;
 }
 
-#define BEGIN(c)                          \
-    Instance *in = (Instance *)(c);       \
-    if (!usable(in)) return fmi2Error
+#define BEGIN(c)                                    \
+    Instance *in = (Instance *)(c);                 \
+    if (!usable_in(in, __func__)) return fmi2Error
 #define FORWARD(call) finish(in, core.call)
 
 /* ------------------------------------------------------------------------------------ */
@@ -685,12 +745,16 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         if (!core_loaded) {
             char reason[2 * TEXT - 300];
             if (ensure_python(reason, sizeof reason) == 0 &&
-                load_core(reason, sizeof reason) == 0)
+                load_core(reason, sizeof reason) == 0) {
+                watch_python();
                 core_loaded = 1;
-            else
+            } else {
                 snprintf(why, sizeof why, "%s: cannot start the FMU's Python: %s", name, reason);
+            }
         }
         pthread_mutex_unlock(&load_lock);
+        if (!why[0] && !python_alive())
+            snprintf(why, sizeof why, "%s: %s", name, PYTHON_GONE);
     }
     if (why[0]) { /* logged whatever loggingOn says: there is no instance to ask again */
         emit(logger, env, name, fmi2Error, "logStatusError", why);
@@ -732,8 +796,12 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 void fmi2FreeInstance(fmi2Component c) {
     Instance *in = c;
     if (!in || in->magic != INSTANCE_MAGIC) return;
-    /* after a fatal error the core's instance holds dangling Python pointers: leak it */
-    if (!in->dead) core.FreeInstance(in->core);
+    /* after a fatal error the core's instance holds dangling Python pointers, and with
+     * Python gone it cannot be freed: leak it */
+    if (!in->dead && python_alive())
+        core.FreeInstance(in->core);
+    else if (!in->dead)
+        python_gone(in, fmi2Warning, "fmi2FreeInstance");
     in->magic = 0;
     free(in->core_callbacks);
     free(in);
@@ -778,6 +846,12 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
+    Instance *given = c;
+    if (given && given->magic == INSTANCE_MAGIC && !given->dead && !python_alive()) {
+        /* nothing is left to do: Python's finalization closed the model's files */
+        python_gone(given, fmi2Warning, "fmi2Terminate");
+        return fmi2Warning;
+    }
     BEGIN(c);
     return FORWARD(Terminate(in->core));
 }
@@ -971,9 +1045,12 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
     State *st = state_of(in, *state, "fmi2FreeFMUstate");
     if (!st) return fmi2Error;
     fmi2Status s = fmi2OK;
-    if (!in->dead) {
+    if (!in->dead && python_alive()) {
         in->worst = fmi2OK;
         s = FORWARD(FreeFMUstate(in->core, &st->core));
+    } else if (!in->dead) {
+        python_gone(in, fmi2Warning, "fmi2FreeFMUstate");
+        s = fmi2Warning;
     }
     st->magic = 0;
     free(st);
