@@ -30,8 +30,6 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.builder import ensure_built, fmu_variables
-from arcosim.experiments.load_scores import score_profile, step_truth
-from arcosim.experiments.metrics import flexible_score
 from arcosim.experiments.findings import (
     N_MASSES,
     SEEDS,
@@ -39,6 +37,8 @@ from arcosim.experiments.findings import (
     Results,
     report_markdown,
 )
+from arcosim.experiments.load_scores import score_profile, step_truth
+from arcosim.experiments.metrics import flexible_score
 from arcosim.experiments.report import (
     figure_flexible_response,
     figure_load_torque,
@@ -362,7 +362,9 @@ def _terms(actuator: dict[str, float]) -> Actuator:
     )
 
 
-def _fit_whole_chain(identification: Recording, actuator: dict[str, float], cpr: int) -> ChainChoice:
+def _fit_whole_chain(
+    identification: Recording, actuator: dict[str, float], cpr: int
+) -> ChainChoice:
     """Experiment 4's fit: every J_i, k_i, B_i and n from the motor's signals alone."""
     terms = _terms(actuator)
     signals = [identification[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")]
