@@ -40,21 +40,12 @@ SOURCES = sorted(
     for folder in ("fmu_src", "plant_models", "cosim", "benchmarks")
     for path in (ROOT / folder).rglob("*.py")
 )
-#: Definitions still outside their home on this branch, for callers other sessions own;
-#: the merge switches them to ``arcosim.fmu.flexchain.codes`` and deletes the entry
-#: (the test fails while an entry is listed but gone, so none outlives its reason).
-PENDING = {
-    ("cosim/identification/chain_excitation.py", "MULTISINE"),  # → Signal.MULTISINE
-    # transitional names for cosim/cli/identify.py, cosim/identification/load_torque.py
-    # and cosim/experiments/reproduce.py (bound to the enum members, not to integers)
-    ("fmu_src/flexchain/observer.py", "SELF_IDENTIFICATION"),
-    ("fmu_src/flexchain/observer.py", "RIGID_IDENTIFICATION"),
-    ("fmu_src/flexchain/observer.py", "STATE_ESTIMATION"),
-    ("fmu_src/flexchain/observer.py", "RECURSION"),
-    ("fmu_src/flexchain/observer.py", "MODEL_BASED"),
-}
+#: Definitions allowed outside their home while callers move to
+#: ``arcosim.fmu.flexchain.codes`` (none left; the test fails while an entry is listed but
+#: gone, so none outlives its reason).
+PENDING: set[tuple[str, str]] = set()
 #: The model-based rule (mode 2 with estimator 1) written out, outside its home.
-PENDING_RULES = {"cosim/identification/load_torque.py"}  # → settings.model_based
+PENDING_RULES: set[str] = set()
 
 
 def read(path: Path) -> str:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.fmu.flexchain import excitation
+from arcosim.fmu.flexchain import waveforms
 from arcosim.identification.band import BAND_PER_G, SAMPLE_BAND, search_band
 from arcosim.identification.excitation_design import LINE_T, design_excitation
 
@@ -117,8 +117,8 @@ def test_the_designed_current_is_the_excitation_sources_multisine() -> None:
     """The design's lines and phases are the FMU's, and its current the FMU's sum of
     sines (evaluated over the whole record at once: equal to rounding)."""
     design = design_excitation((3.0, 150.0), 3.0, duration=2.0, lines=12, seed=4)
-    lines = excitation.log_spaced(3.0, 150.0, 12)
-    phases = excitation.multisine_phases(12, 4)
+    lines = waveforms.log_spaced(3.0, 150.0, 12)
+    phases = waveforms.multisine_phases(12, 4)
     assert design.frequencies.tolist() == lines and design.phases.tolist() == phases
-    played = [excitation.multisine(t, 3.0, lines, phases) for t in design.time.tolist()]
+    played = [waveforms.multisine(t, 3.0, lines, phases) for t in design.time.tolist()]
     np.testing.assert_allclose(design.signal, played, rtol=0.0, atol=1e-14)

@@ -20,7 +20,8 @@ from arcosim.cli.parameters import (
     set_names,
 )
 from arcosim.errors import UserError
-from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
+from arcosim.fmu.flexchain.codes import Estimator, Mode
+from arcosim.fmu.flexchain.observer import ObserverSettings
 from arcosim.identification import load_torque
 from arcosim.logs import DriveLog, write_csv
 
@@ -125,14 +126,14 @@ def _settings(values: dict[str, float], n: int) -> ObserverSettings:
             f"(got {load_mass})"
         )
     settings = ObserverSettings(
-        mode=STATE_ESTIMATION,
+        mode=Mode.STATE_ESTIMATION,
         actuator=actuator_of(values),
         g_dist=values["g_dist"],
         g_lpf=values["g_lpf"],
         J=tuple(values[f"J[{i}]"] for i in range(1, n + 1)),
         k=tuple(values[f"k[{i}]"] for i in range(1, n + 1)),
         B=tuple(values[f"B[{i}]"] for i in range(1, n + 1)),
-        estimator=MODEL_BASED,
+        estimator=Estimator.MODEL_BASED,
         encoder_cpr=int(values["encoder_cpr"]),
         torque_noise_std=values["torque_noise_std"],
         tau_noise_std=values["tau_noise_std"],

@@ -13,7 +13,7 @@ from arcosim.build.recipes import OBSERVER
 from arcosim.cli.identify_options import check_out
 from arcosim.cli.options import fmu_folder, fmu_inputs
 from arcosim.cli.parameters import defaults_note, drive_parameters, known_parameters, set_names
-from arcosim.fmu.flexchain.observer import STATE_ESTIMATION
+from arcosim.fmu.flexchain.codes import Mode
 from arcosim.host.instance import FmuInstance
 from arcosim.host.replay import final_values, observer_parameters, replay_log
 from arcosim.logs import DriveLog, write_csv
@@ -46,7 +46,7 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     check_out(args, fmu_inputs(folder))
     defaults = defaults_note(
         known_parameters(n, args.set),
-        drive_parameters(n, chain=args.mode in (None, STATE_ESTIMATION)),
+        drive_parameters(n, chain=args.mode in (None, Mode.STATE_ESTIMATION)),
         set_names(args.set),
     )
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:

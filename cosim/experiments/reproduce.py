@@ -55,9 +55,10 @@ from arcosim.experiments.scenarios import (
     run_scenario,
 )
 from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.codes import Estimator, Mode
 from arcosim.fmu.flexchain.defaults import G_DIST, STEP
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, ObserverSettings
+from arcosim.fmu.flexchain.observer import ObserverSettings
 from arcosim.host.master import Recording
 from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.offline_observer import estimate_states
@@ -285,7 +286,7 @@ def _whole_chain(
     results.whole_chain_std = choice.fit.std_dict()
     if choice.n != N_MASSES:
         return identification, None
-    identified = {**actuator, **results.whole_chain, "estimator": MODEL_BASED}
+    identified = {**actuator, **results.whole_chain, "estimator": int(Estimator.MODEL_BASED)}
     estimated = bench.run("flexible", observer=identified)
     bench.keep("whole_chain.csv", estimated)
     results.whole_scores = _angle_scores(estimated, flexible["plant.theta_m_true"])
@@ -331,14 +332,14 @@ def _angles_without_torque_state(
     """Experiment 5's run and true chain without the torque state: what the unmodelled
     load costs, as every mass's angle score."""
     settings = ObserverSettings(
-        mode=STATE_ESTIMATION,
+        mode=Mode.STATE_ESTIMATION,
         actuator=_terms(actuator),
         g_dist=G_DIST,
         g_lpf=G_DIST,
         J=tuple(defaults.J),
         k=(defaults.K,) * N_MASSES,
         B=(defaults.B,) * N_MASSES,
-        estimator=MODEL_BASED,
+        estimator=Estimator.MODEL_BASED,
         encoder_cpr=cpr,
     )
     log = {c: rec[f"plant.{c}"] for c in ("i_a", "omega_m", "theta_m")}

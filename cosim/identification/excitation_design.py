@@ -2,7 +2,7 @@
 
 :func:`design_excitation` turns a band and a current limit into a multi-sine: as arrays, and (for a
 current) as the ExcitationSource FMU's parameters, which play the same signal (the same
-``arcosim.fmu.flexchain.excitation`` functions). What the design rests on, measured on the
+``arcosim.fmu.flexchain.waveforms`` functions). What the design rests on, measured on the
 whole-chain rows (README):
 
 * many lines across the band (40 log-spaced lines; 11 let the subspace step take lines
@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arcosim.fmu.flexchain import waveforms as excitation
+from arcosim.fmu.flexchain import waveforms
+from arcosim.fmu.flexchain.codes import Signal
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.identification.band import dob_band, sample_band
 from arcosim.identification.errors import IdentificationError
@@ -45,8 +46,6 @@ TORQUE_PER_FRICTION = 5.0
 #: sample (dimensionless). The design holds its top line to it, the log's check every
 #: line it finds.
 LINE_T = 5.0
-#: ExcitationSource's multi-sine signal code (fmu_src/arsource/fmu.py).
-MULTISINE = 1
 
 
 class ExcitationError(IdentificationError):
@@ -171,8 +170,8 @@ def design_excitation(
     (40, [])
     """
     low, high = _checked_request(band, current_limit, h, lines, kind)
-    frequencies = np.array(excitation.log_spaced(low, high, lines))
-    phases = np.array(excitation.multisine_phases(lines, seed))
+    frequencies = np.array(waveforms.log_spaced(low, high, lines))
+    phases = np.array(waveforms.multisine_phases(lines, seed))
     time = np.arange(round(duration / h) + 1) * h
     warnings: list[str] = []
     if kind == "current":
@@ -232,7 +231,7 @@ def _source_parameters(
 ) -> dict[str, float | int]:
     """The ExcitationSource FMU's parameters that play the designed current (A, rad/s)."""
     return {
-        "signal": MULTISINE,
+        "signal": int(Signal.MULTISINE),
         "amplitude": float(current_limit),
         "frequency": low,
         "frequency_end": high,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arcosim.fmu.flexchain.observer import MODEL_BASED, STATE_ESTIMATION, Observer, ObserverSettings
+from arcosim.fmu.flexchain.observer import Observer, ObserverSettings
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.offline_observer import replay
 
@@ -105,11 +105,7 @@ def estimate_load_torque(
     >>> estimate.tau_load.shape, bool(abs(estimate.tau_load[-1]) < 1e-3)  # no load: ≈ 0 N·m
     ((2001,), True)
     """
-    if not (
-        settings.mode == STATE_ESTIMATION
-        and settings.estimator == MODEL_BASED
-        and 1 <= settings.load_mass <= len(settings.J)
-    ):
+    if not (settings.model_based and 1 <= settings.load_mass <= len(settings.J)):
         raise IdentificationError(
             f"the load torque estimator needs mode 2, estimator 1 and a load mass 1 … "
             f"{len(settings.J)}, got mode {settings.mode}, estimator {settings.estimator}, "

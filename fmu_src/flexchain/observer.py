@@ -27,15 +27,6 @@ from .recursion import ChainRecursion
 from .rigid_identification import RigidChainIdentifier
 from .self_identification import ActuatorIdentifier
 
-# The names callers outside fmu_src still import (cosim/cli/identify.py,
-# cosim/identification/load_torque.py): the enum members themselves, no second
-# definition; to be replaced by Mode.* and Estimator.* there, then removed.
-SELF_IDENTIFICATION = Mode.SELF_IDENTIFICATION
-RIGID_IDENTIFICATION = Mode.RIGID_IDENTIFICATION
-STATE_ESTIMATION = Mode.STATE_ESTIMATION
-RECURSION = Estimator.RECURSION
-MODEL_BASED = Estimator.MODEL_BASED
-
 
 @dataclass(frozen=True)
 class ObserverSettings:
