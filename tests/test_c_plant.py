@@ -31,6 +31,7 @@ def reference_plant(n: int, parameters: dict):
     return plant
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("n", "parameters"), CASES)
 def test_c_plant_matches_the_python_reference(build_fmus, n: int, parameters: dict) -> None:
     reference = reference_plant(n, parameters)

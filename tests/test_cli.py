@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from arcosim import __version__
 from arcosim.cli import main
 
@@ -16,6 +18,8 @@ def arcosim(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_version_is_the_package_version() -> None:
     result = arcosim("--version")
     assert result.returncode == 0
@@ -35,6 +39,8 @@ def test_no_command_prints_help(capsys) -> None:
     assert "build" in capsys.readouterr().out
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_build_writes_into_the_user_cache_by_default(tmp_path: Path, monkeypatch) -> None:
     from arcosim.build.cache import default_folder
 
@@ -51,6 +57,8 @@ def test_build_writes_into_the_user_cache_by_default(tmp_path: Path, monkeypatch
     assert list(work.iterdir()) == []  # nothing written where the command ran
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_build_writes_into_the_folder_named(tmp_path: Path) -> None:
     result = arcosim("build", "--masses", "2", "--out", str(tmp_path / "mine"), cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -58,6 +66,8 @@ def test_build_writes_into_the_folder_named(tmp_path: Path) -> None:
     assert (tmp_path / "mine" / "ActionReaction.ssp").is_file()
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path) -> None:
     """The paper's three experiments and the three beyond them, end to end (about 90 s)."""
     build_fmus(3)  # into the session cache, where reproduce finds them current
@@ -105,6 +115,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         assert float(cells[5]) < limit, cells
 
 
+@pytest.mark.slow
 def test_fmus_built_from_other_sources_are_rebuilt_not_run(build_fmus, tmp_path: Path) -> None:
     """A stale folder of FMUs (sources edited since the build) must never be simulated."""
     import shutil
@@ -138,6 +149,7 @@ def test_excite_writes_the_multisine_and_warns_of_sticking(tmp_path: Path, capsy
     assert "exists" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_check_says_whether_a_log_supports_identification(build_fmus, tmp_path, capsys) -> None:
     good, poor = tmp_path / "identification.csv", tmp_path / "flexible.csv"
     for scenario, path in (("identification", good), ("flexible", poor)):

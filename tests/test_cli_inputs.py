@@ -319,6 +319,7 @@ def test_validate_refuses_files_that_are_not_fmus(capsys, fmus, tmp_path) -> Non
     assert "an SSP system, not an FMU" in refused(capsys, "validate", fmus / "ActionReaction.ssp")
 
 
+@pytest.mark.slow
 def test_a_corrupt_fmu_found_later_is_rebuilt(build_fmus, tmp_path) -> None:
     import shutil
 

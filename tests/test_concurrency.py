@@ -15,6 +15,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from arcosim.cli import main
 
 SPEC = """
@@ -43,6 +45,8 @@ def finish(process: subprocess.Popen, timeout: float = 600) -> tuple[int, str, s
     return process.returncode, out, err
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_two_builds_and_a_simulation_in_one_folder(tmp_path: Path) -> None:
     from arcosim.build.cache import fmu_problem, is_current
     from arcosim.build.recipes import RECIPES, SSP_NAME
@@ -85,6 +89,8 @@ def test_a_second_sweep_into_a_locked_folder_is_refused_naming_the_first(
     assert not (out / "results.csv").exists()
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_two_sweeps_into_one_folder_run_every_run_once(build_fmus, tmp_path: Path) -> None:
     """Two fresh starts at once and a --resume while they run: one sweep runs, the
     others are refused naming it, and every run is in the results once."""

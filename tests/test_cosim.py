@@ -156,6 +156,8 @@ def test_filtered_random_is_below_its_cutoff() -> None:
 # -- simulate and identify ---------------------------------------------------------
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_identify_on_a_simulated_log_gives_the_cosimulation_estimates(workdir) -> None:
     settings = ["--set", "observer.D_m=2e-5", "--set", "observer.f_c=2e-3"]
     sim = arcosim(
@@ -197,6 +199,8 @@ def test_identify_on_a_simulated_log_gives_the_cosimulation_estimates(workdir) -
     assert written["k_hat"][-1] == final["k_hat"] and len(written) == 12001
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_identify_scale_converts_units(workdir) -> None:
     sim = arcosim(
         "simulate", "--scenario", "flexible", "--duration", "1", "--out", "si.csv", cwd=workdir
@@ -225,6 +229,8 @@ def test_identify_scale_converts_units(workdir) -> None:
         assert converted[key] == pytest.approx(si[key], rel=1e-9, abs=1e-15)
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_identify_takes_a_varying_time_step(workdir) -> None:
     rng = np.random.default_rng(1)
     t = np.cumsum(rng.uniform(0.5e-3, 2e-3, 400))
@@ -237,6 +243,8 @@ def test_identify_takes_a_varying_time_step(workdir) -> None:
     assert all(np.isfinite(v) for v in json.loads(result.stdout).values())
 
 
+@pytest.mark.system
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("content", "phrase"),
     [
@@ -266,6 +274,8 @@ def test_bad_logs_get_a_one_line_error(workdir, content, phrase) -> None:
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.system
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("args", "phrase"),
     [
@@ -285,6 +295,8 @@ def test_command_line_mistakes_are_named(workdir, args, phrase) -> None:
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_simulate_applies_overrides(workdir) -> None:
     stiff = json.loads(
         arcosim(
@@ -309,6 +321,7 @@ def test_simulate_applies_overrides(workdir) -> None:
     assert stiff["tau_reac_hat"] != plain["tau_reac_hat"]
 
 
+@pytest.mark.slow
 def test_run_scenario_python_api(build_fmus) -> None:
     r = run_scenario(
         SCENARIOS["selfid"],

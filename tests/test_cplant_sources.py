@@ -24,6 +24,8 @@ import pytest
 
 from arcosim.build.cplant import CFLAGS, compiler, fmi_headers
 
+pytestmark = pytest.mark.system
+
 STRICT = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror", "-fPIC", "-shared")
 FMI2014 = "pythonfmu-0.6.5/pythonfmu/pythonfmu-export/src/fmi/"
 
@@ -93,6 +95,7 @@ def build(sources: Path, headers: Path, flags, out: Path) -> subprocess.Complete
     return subprocess.run(command, capture_output=True, text=True)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no cc")
 @pytest.mark.parametrize("version", ["2.0 (2014)", "2.0.1 (fmpy)"])
 def test_sources_compile_strictly(plant_sources, headers_2014, tmp_path, version) -> None:

@@ -21,6 +21,8 @@ import arcosim
 PUBLIC = [name for name in arcosim.__all__ if name != "__version__"]
 #: Public names that are data, not callables: described in the catalogue only.
 DATA = {"SCENARIOS"}
+#: Public names whose examples take over ~5 s (they build FMUs or fit whole records).
+SLOW_EXAMPLES = {"build_all", "check_log", "identify_drive", "identify_whole_chain"}
 #: A unit in parentheses, e.g. "(A)", "(rad/s, shape (N,))", "(kg·m²)", or a word
 #: that says there is none.
 UNIT = re.compile(r"\([^)]*[A-Za-zΩµ°%²][^)]*\)|dimensionless|count|number of|index")
@@ -77,7 +79,14 @@ def test_public_name_has_a_numpydoc_docstring(name: str) -> None:
     assert "+SKIP" not in examples, f"{name}: its example must run"
 
 
-@pytest.mark.parametrize("name", [n for n in PUBLIC if n not in DATA])
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.slow) if n in SLOW_EXAMPLES else n
+        for n in PUBLIC
+        if n not in DATA
+    ],
+)
 def test_public_examples_run(name: str, build_fmus, tmp_path, monkeypatch) -> None:
     build_fmus(3)  # the examples that co-simulate find current FMUs in the session cache
     monkeypatch.chdir(tmp_path)

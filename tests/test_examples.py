@@ -8,10 +8,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_identify_your_drive_finds_the_belt_drive(build_fmus, tmp_path) -> None:
     """The sample log (a belt drive of benchmarks/sample_log.py: J 3e-4, 9e-4 kg·m²,
     k 0.45, 0.3 N·m/rad) identified from the motor alone, then its load angles."""
@@ -42,6 +45,7 @@ def test_identify_your_drive_finds_the_belt_drive(build_fmus, tmp_path) -> None:
     assert (tmp_path / "belt_drive_estimate.csv").stat().st_size > 100_000
 
 
+@pytest.mark.slow
 def test_the_sample_log_is_what_its_script_writes(tmp_path) -> None:
     """``python -m benchmarks.sample_log`` regenerates examples/data/belt_drive.csv: the
     same times and, within one step's rounding, the same current (0.01 mA, as written),

@@ -69,6 +69,8 @@ def test_built_fmus_carry_the_fix(build_fmus, name) -> None:
         assert fini_functions(binary), "the C++ runtime's own destructor stays"
 
 
+@pytest.mark.system
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux binaries only")
 def test_no_invalid_memory_access_at_exit_under_valgrind(build_fmus, tmp_path: Path) -> None:
     """Instantiate the observer (pythonfmu) and the plant (C) a few times, step them,

@@ -61,6 +61,7 @@ def assert_chain(choice, d: field_sim.Drive, rtol: float) -> None:
             np.testing.assert_allclose(values, truth, rtol=rtol)
 
 
+@pytest.mark.slow
 def test_the_simulator_agrees_with_the_project_plant(build_fmus) -> None:
     """Bench chain, Coulomb friction with sticking, ideal sensors, 5 s of a multi-sine:
     the two independent simulations agree to 0.1 % of the motion (the sticking
@@ -131,6 +132,7 @@ def test_the_friction_sign_over_a_step_counts_a_reversal_inside_it() -> None:
     np.testing.assert_allclose(mean_sign(velocity), [1, 1, 0.5, -1, -1, 0, 1])
 
 
+@pytest.mark.slow
 def test_three_masses_at_4_khz_and_a_refusal_that_names_the_modes() -> None:
     d = drive()
     log = field_sim.simulate(d, 2.5e-4, 10.0, current=field_sim.multisine(LINES, 3.0))
@@ -141,6 +143,7 @@ def test_three_masses_at_4_khz_and_a_refusal_that_names_the_modes() -> None:
         fit(d, log, masses=5)
 
 
+@pytest.mark.slow
 def test_closely_spaced_modes_and_a_weakly_coupled_one() -> None:
     """Clamped modes 20, 40, 42 rad/s; the last one with 1/30 of the first's share."""
     p = np.array([20.0, 40.0, 42.0])
@@ -152,6 +155,7 @@ def test_closely_spaced_modes_and_a_weakly_coupled_one() -> None:
     assert_chain(choice, d, rtol=1e-2)
 
 
+@pytest.mark.slow
 def test_friction_fitted_from_k_t_and_J_m_alone() -> None:
     d = drive()
     log = field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))
@@ -164,6 +168,7 @@ def test_friction_fitted_from_k_t_and_J_m_alone() -> None:
     assert "same ε" in choice.fit.extra["assumptions"]["actuator"]
 
 
+@pytest.mark.slow
 def test_a_pi_speed_loop_with_a_constant_load_torque() -> None:
     """Closed-loop data (the current depends on the encoder's noise) and a load torque
     the loop holds: both in the model, the load estimated."""
@@ -177,6 +182,7 @@ def test_a_pi_speed_loop_with_a_constant_load_torque() -> None:
     assert abs(tau - 0.01) <= 4 * sigma and sigma < 1e-3
 
 
+@pytest.mark.slow
 def test_a_slowly_varying_load_torque_is_modelled_not_taken_for_the_chain() -> None:
     d = drive(load_sine=(0.01, 0.3))
     log = field_sim.simulate(d, 1e-3, 20.0, current=field_sim.multisine(LINES, 3.0))
@@ -204,6 +210,7 @@ def test_excite_designs_what_the_excitation_source_plays() -> None:
         design_excitation((3.0, 500.0), 3.0, h=1e-3)
 
 
+@pytest.mark.slow
 def test_check_tells_a_good_log_from_a_poor_one() -> None:
     d = drive()
     good = field_sim.simulate(d, 1e-3, 20.0, current=field_sim.multisine(LINES, 3.0))

@@ -67,6 +67,8 @@ def test_built_fmus_pass_the_portability_checks(fmus) -> None:
         assert portability_problems(fmu) == [], fmu.name
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_a_host_with_its_own_fmukit_flexchain_pythonfmu_gets_the_fmus_results(
     fmus, reference, tmp_path
 ) -> None:
@@ -116,6 +118,8 @@ def rebundle(fmu: Path, out: Path, digest: str, patch: str) -> str:
     return new
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_two_builds_of_the_observer_run_in_one_process(fmus, reference, tmp_path) -> None:
     variant = tmp_path / "ReactionTorqueObserver_variant.fmu"
     new = rebundle(fmus["observer"], variant, "f" * 40, VARIANT)

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.system
+
 PROBE = Path(__file__).parent / "hosts" / "state_probe.py"
 FMI_ERROR, FMI_DISCARD = 3, 2
 

@@ -12,6 +12,8 @@ import pytest
 
 from arcosim.host.ecos import ecos_binary, run_ecos
 
+pytestmark = pytest.mark.system
+
 
 def ecos_executable() -> Path:
     """The ecos binary, or skip naming what is missing (.ci/run installs libtbb12)."""

@@ -81,6 +81,8 @@ def _noise() -> NoiseModel:
     return NoiseModel(0.0, 1e-4, 1.5e-3)
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_offline_tool_gives_the_fmus_estimate(build_fmus, tmp_path: Path) -> None:
     """``arcosim identify LOG --method load-torque`` runs the FMU's code: same numbers."""
     profile = LoadProfile(duration=4.0, sine_time=2.5)

@@ -110,6 +110,7 @@ def test_observer_tracks_the_chain_from_exact_signals() -> None:
         )
 
 
+@pytest.mark.slow
 def test_observer_corrects_a_wrong_start() -> None:
     """Started with mass 1 displaced, the innovation pulls the estimate back."""
     t = np.arange(3000) * H

@@ -52,7 +52,9 @@ def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -
     return float(np.sqrt(np.mean((estimate - truth) ** 2) / np.mean((truth - motor) ** 2)))
 
 
-@pytest.mark.parametrize("n", [1, 3, 20])
+@pytest.mark.parametrize(
+    "n", [pytest.param(1, marks=pytest.mark.slow), 3, pytest.param(20, marks=pytest.mark.slow)]
+)
 def test_observer_validates_without_problems(build_fmus, n: int) -> None:
     assert validate_fmu(str(build_fmus(n) / "ReactionTorqueObserver.fmu")) == []
 
@@ -107,6 +109,7 @@ def test_jacobi_ordering_is_gauss_seidel_one_step_later(fmus) -> None:
         )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sensors", [IDEAL, {}], ids=["ideal", "realistic"])
 def test_self_identification_recovers_friction_with_kt_fixed(fmus, sensors) -> None:
     t = np.arange(10000) * 1e-3
@@ -143,6 +146,7 @@ def rigid_run(fmus, kappa_correction: bool, sensors=IDEAL):
     )
 
 
+@pytest.mark.slow
 def test_rigid_maneuver_identifies_k_with_kappa(fmus) -> None:
     r = rigid_run(fmus, True)
     assert r["observer.id_valid"][-1] == 1.0
@@ -150,6 +154,7 @@ def test_rigid_maneuver_identifies_k_with_kappa(fmus) -> None:
     assert abs(r["plant.twist"][-1]) < 0.05 * np.max(np.abs(r["plant.twist"]))  # little ringing
 
 
+@pytest.mark.slow
 def test_literal_eq21_underestimates_k_by_kappa(fmus) -> None:
     k_literal = rigid_run(fmus, False)["observer.k_hat"][-1]
     assert k_literal == pytest.approx(K_TRUE / 1.614, rel=0.03)  # ~38 % low, as docs/method.md says
@@ -256,6 +261,7 @@ def test_trace_file_holds_current_identification_outputs(fmus, tmp_path) -> None
     assert k_hat != 0.0 and float(rows[-1].split(",")[column]) == k_hat
 
 
+@pytest.mark.system
 def test_same_fmu_instantiates_again_and_again_in_one_process(fmus) -> None:
     """pythonfmu 0.7 releases a reference to the slave module's namespace per
     instantiation; the loader text takes one back each time (arcosim/build/portable.py).

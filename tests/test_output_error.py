@@ -86,6 +86,7 @@ def test_prediction_matches_the_observer_on_an_ideal_co_simulation(build_fmus) -
     assert error < 0.03 * np.sqrt(np.mean(record.tau_hat**2))  # measured 1.9 %
 
 
+@pytest.mark.slow
 def test_identify_output_error_cli(build_fmus, tmp_path, capsys) -> None:
     log = tmp_path / "flex.csv"
     assert main(["simulate", "--scenario", "flexible", "--out", str(log)]) == 0
@@ -100,6 +101,7 @@ def test_identify_output_error_cli(build_fmus, tmp_path, capsys) -> None:
     assert "has no variable 'J[7]'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_accuracy_benchmark_runs_in_quick_mode(build_fmus, tmp_path) -> None:
     """CI proves the benchmark still runs (the bench, one seed); no thresholds here."""
     code = main(

@@ -23,7 +23,9 @@ BENCH_J = [2.09e-5, 5.15299e-4, 5.15299e-4, 6.192707e-4]
 K, B = 0.1627, 8.88e-6
 
 
-@pytest.mark.parametrize("n", [1, 3, 20])
+@pytest.mark.parametrize(
+    "n", [pytest.param(1, marks=pytest.mark.slow), 3, pytest.param(20, marks=pytest.mark.slow)]
+)
 def test_plant_validates_without_problems(build_fmus, n: int) -> None:
     assert validate_fmu(str(build_fmus(n) / "MotorChainPlant.fmu")) == []
 
@@ -67,6 +69,7 @@ def test_model_description_carries_units_structure_and_version(plant_fmu: Path) 
         assert required in names
 
 
+@pytest.mark.slow
 def test_natural_frequencies_match_chain_eigenvalues(plant_fmu: Path) -> None:
     """Free response after a current pulse → poles by the eigensystem realization
     algorithm → natural frequencies within 0.1 % of the undamped chain's."""
@@ -166,6 +169,7 @@ def test_outputs_follow_the_timing_contract(plant_fmu: Path) -> None:
     np.testing.assert_allclose(run["i_a"], [0.0, 0.3, 0.6, -0.2], rtol=1e-15)
 
 
+@pytest.mark.slow
 def test_plants_for_three_and_five_masses_run_side_by_side(build_fmus) -> None:
     with (
         FmuInstance(build_fmus(3) / "MotorChainPlant.fmu", "three") as three,
@@ -276,6 +280,7 @@ def test_trace_file_records_outputs_and_never_overwrites(plant_fmu: Path, tmp_pa
     assert len(trace.read_text().splitlines()) == 7  # the user's file is intact
 
 
+@pytest.mark.slow
 def test_every_fmu_for_several_n_loads_in_one_process(build_fmus) -> None:
     """Nine FMUs (three kinds × n = 1, 3, 5) instantiated, initialized and stepped
     together: model identifiers carry n, bundled packages are identical copies."""

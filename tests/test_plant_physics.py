@@ -73,6 +73,7 @@ def test_multisine_run_matches_solve_ivp() -> None:
     assert np.max(np.abs(ours - reference) / scale) < 1e-6
 
 
+@pytest.mark.slow
 def test_step_size_does_not_change_the_motion_with_friction() -> None:
     """Exact steps and located friction events: 1 ms and 1/16 ms give one trajectory.
 

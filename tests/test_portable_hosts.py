@@ -40,7 +40,10 @@ import pytest
 from arcosim.build.ssp import BENCH, CONNECTIONS
 from tests.chain_harness import chain_fmus, chain_spec, run_chain
 
-pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only")
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only"),
+    pytest.mark.system,
+]
 
 HERE = Path(__file__).parent / "hosts"
 STOP, H = 1.0, 1e-3
@@ -195,6 +198,7 @@ def bare_env(python: str | None = None) -> dict[str, str]:
 # -- fmpy hosts ---------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("label", WANTED)
 def test_chain_in_fmpy_of_another_python(
     fmus, reference, venvs, tmp_path, label, declared_outputs
@@ -358,6 +362,7 @@ def test_a_libpython_the_host_loaded_privately_is_the_one_used(
     assert assert_matches(reference, out["outputs"]) == declared_outputs
 
 
+@pytest.mark.slow
 def test_chain_in_ecos_with_a_bare_path(fmus, reference, tmp_path, declared_outputs) -> None:
     from arcosim.build.ssp import write_ssp
     from arcosim.host.ecos import ecos_binary
@@ -415,6 +420,7 @@ def libcosim_python(venvs) -> str:
     pytest.skip("libcosimpy installs under none of CPython 3.12, 3.13, 3.10 here")
 
 
+@pytest.mark.slow
 def test_chain_in_libcosim_under_another_python(
     fmus, reference, libcosim_python, tmp_path, declared_outputs
 ):

@@ -123,6 +123,7 @@ def test_log_reader_on_bytes(data: bytes) -> None:
     check_read(data)
 
 
+@pytest.mark.slow
 @settings(FAST, max_examples=80)
 @given(csv_logs())
 def test_log_reader_on_csv_like_text(data: bytes) -> None:
@@ -351,6 +352,7 @@ def test_spec_loader_on_bytes(data: bytes) -> None:
     check_spec(data)
 
 
+@pytest.mark.slow
 @settings(FAST, max_examples=200)
 @given(specs())
 def test_spec_loader_on_toml_of_every_type(data: bytes) -> None:

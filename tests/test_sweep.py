@@ -87,6 +87,7 @@ def test_unknown_parameter_is_named_before_any_run(workdir) -> None:
     assert not (workdir / "out" / "results.csv").exists()
 
 
+@pytest.mark.slow
 def test_same_seed_same_runs_and_results(workdir) -> None:
     spec = load_spec(spec_file(workdir, SMALL))
     assert draw_runs(spec) == draw_runs(spec)
@@ -96,6 +97,7 @@ def test_same_seed_same_runs_and_results(workdir) -> None:
     assert all(not r["error"] and abs(float(r["D_m_error"])) < 5 for r in first)
 
 
+@pytest.mark.slow
 def test_a_failing_run_is_recorded_and_the_sweep_goes_on(workdir) -> None:
     text = SMALL.replace(
         '"plant.i_noise_std" = { distribution = "uniform", low = 0.0, high = 0.01 }\n', ""
@@ -114,6 +116,7 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(workdir) -> None:
     assert "Failed runs" in (workdir / "f" / "summary.md").read_text()
 
 
+@pytest.mark.slow
 def test_resume_keeps_finished_runs_and_repeats_none(workdir) -> None:
     spec = load_spec(spec_file(workdir, SMALL))
     complete = read_results(sweep(spec, workdir / "full", workers=1, show_progress=False))
@@ -148,6 +151,8 @@ def test_resume_keeps_finished_runs_and_repeats_none(workdir) -> None:
     assert without_runtime(resumed) == without_runtime(complete)
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_runs_on_an_existing_cluster(workdir) -> None:
     from dask.distributed import LocalCluster
 

@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from arcosim.cli import main
 
 
+@pytest.mark.slow
 def test_speed_benchmark_runs_in_quick_mode(build_fmus, tmp_path, monkeypatch, capsys) -> None:
     folder = build_fmus(3)
     monkeypatch.setattr("benchmarks.speed.ensure_built", lambda n=3: build_fmus(n))

@@ -5,9 +5,13 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
+import pytest
+
 from arcosim.cli import main
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_validate_passes_the_built_fmus(build_fmus, capsys) -> None:
     fmus = [
         str(build_fmus(n) / f"{name}.fmu")
@@ -37,6 +41,8 @@ def test_validate_names_what_is_wrong(build_fmus, tmp_path: Path, capsys) -> Non
     assert "J_m: no description" in out
 
 
+@pytest.mark.system
+@pytest.mark.slow
 def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> None:
     build_fmus(3)
     assert main(["validate"]) == 0

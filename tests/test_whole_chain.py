@@ -57,6 +57,7 @@ def test_modes_no_chain_has_are_refused(p: tuple, r: tuple) -> None:
         chain_from_modes(p, r)
 
 
+@pytest.mark.slow
 def test_every_inertia_stiffness_and_damping_of_an_unequal_chain_is_recovered() -> None:
     """Noise-free: nothing but the motor angle and the reaction torque is given."""
     result = fit_chain(record(10.0), 2)
@@ -80,6 +81,7 @@ def test_auto_reads_the_number_of_masses_from_the_record() -> None:
     )
 
 
+@pytest.mark.slow
 def test_a_record_that_cannot_determine_the_chain_is_refused_with_what_to_do() -> None:
     """τ̂ unrelated to the motor's motion. (A single sine is not such a record: its
     start rings the modes, and with ζ ≈ 1e-3 the ringing determines the chain.)"""
@@ -107,6 +109,7 @@ def test_a_chain_without_masses_is_refused() -> None:
         fit_chain(record(3.0), 0)
 
 
+@pytest.mark.slow
 def test_identify_whole_chain_cli_finds_the_bench_from_the_motor_alone(
     build_fmus, tmp_path, capsys
 ) -> None:
@@ -127,6 +130,7 @@ def test_identify_whole_chain_cli_finds_the_bench_from_the_motor_alone(
     assert (report["D_m"], report["f_c"]) == (2e-5, 2e-3)  # the chain file carries them
 
 
+@pytest.mark.slow
 def test_the_printed_set_line_estimates_every_load_angle(build_fmus, tmp_path, capsys) -> None:
     """The whole-chain text output ends with the observer's --set line; pasted back, it
     runs the model-based observer (estimator 1, the fitted friction), which follows every
