@@ -23,6 +23,9 @@ from arcosim.build.ssp import BENCH, CONNECTIONS
 from arcosim.fmu.fmukit.checks import SMALLEST_STEP
 from arcosim.host.instance import FmuInstance
 
+#: C test programs and hosts compiled and run in subprocesses (the system tier).
+pytestmark = pytest.mark.system
+
 HERE = Path(__file__).parent / "hosts"
 COMPONENTS = {
     "source": "ExcitationSource",

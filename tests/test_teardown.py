@@ -24,7 +24,11 @@ import pytest
 HERE = Path(__file__).parent / "hosts"
 PYTHON_FMUS = ["ReactionTorqueObserver", "ExcitationSource"]
 
-pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux binaries")
+#: C hosts compiled and run in subprocesses (the system tier).
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux binaries"),
+    pytest.mark.system,
+]
 
 
 def _libpythons() -> dict[str, tuple[Path, Path]]:
@@ -124,6 +128,7 @@ def test_calls_after_the_host_finalized_python_return_without_crashing(
 
 
 @pytest.mark.parametrize("name", PYTHON_FMUS)
+@pytest.mark.slow
 def test_no_invalid_access_after_the_host_finalized_python_under_valgrind(
     teardown_host, unzipped, name, tmp_path
 ) -> None:
