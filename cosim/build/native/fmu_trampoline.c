@@ -47,7 +47,8 @@
  *     while it finalizes (Py_IsInitialized false, or Py_IsFinalizing -- _Py_IsFinalizing
  *     before 3.13 -- true), never reaches the core, which would take the GIL of a dead
  *     interpreter: it is logged when the host's logger is native code (a ctypes or cffi
- *     logger would need that Python too), fmi2Terminate answers fmi2Warning,
+ *     logger would need that Python too), fmi2Terminate answers fmi2OK (a host such
+ *     as OMSimulator stops terminating its other components on any other status),
  *     fmi2FreeInstance and fmi2FreeFMUstate free the trampoline's part and leak the
  *     core's, every other call answers fmi2Error. While Python lives, any thread may
  *     call (pythonfmu takes the GIL with PyGILState_Ensure).
@@ -850,7 +851,8 @@ fmi2Status fmi2Terminate(fmi2Component c) {
     if (given && given->magic == INSTANCE_MAGIC && !given->dead && !python_alive()) {
         /* nothing is left to do: Python's finalization closed the model's files */
         python_gone(given, fmi2Warning, "fmi2Terminate");
-        return fmi2Warning;
+        return fmi2OK; /* logged as a warning; OMSimulator stops its teardown on anything
+                        * but fmi2OK, leaving the other components unterminated */
     }
     BEGIN(c);
     return FORWARD(Terminate(in->core));
