@@ -31,6 +31,7 @@ from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.cli.options import (
     MAX_TIME,
+    add_command,
     add_fmus_option,
     check_steps,
     fmu_folder,
@@ -56,11 +57,18 @@ from arcosim.outputs import check_output
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim simulate``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "simulate",
-        help="run one scenario (plant + observer)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="run one scenario (plant + observer)",
+        description="""
+Run one scenario of the plant and observer FMUs and print the observer's final
+outputs; any parameter of either FMU can be changed with --set FMU.NAME=VALUE. The
+CSV written by --out is also a log that arcosim identify accepts (time, i_a,
+omega_m, theta_m, then every recorded signal).""",
+        examples="""
+arcosim simulate --scenario identification --out identification.csv
+arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --json""",
     )
     names = ", ".join(f"{s.name} ({s.description})" for s in SCENARIOS.values())
     p.add_argument("--scenario", default="flexible", help=f"one of: {names}")

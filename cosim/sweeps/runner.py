@@ -275,6 +275,9 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
     from tqdm import tqdm
 
     cluster = None
+    if show_progress:  # Dask takes seconds to start, before the bar's first run
+        where = f"{workers} local Dask workers" if scheduler is None else scheduler
+        print(f"{spec.name}: starting {where} for {len(pending)} runs…", file=sys.stderr)
     if scheduler is None:
         cluster = LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
