@@ -16,17 +16,13 @@
    experiment 4's chain: settling time, settled error, lag of the sine (scenario
    ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
 
-:func:`reproduce` writes ``report.md``, the PNG figures and the CSV of every run into a
-folder: by default one CSV per maneuver (:data:`DEFAULT_CSV`) holding the run's log
-only (:data:`LOG_COLUMNS`, what ``arcosim identify`` reads; about 7 MB with the
-figures), with ``all_csv`` every run with every recorded signal (about 100 MB).
+:func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
 ``arcosim reproduce`` is the command line.
 """
 
 from __future__ import annotations
 
 import functools
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -72,18 +68,9 @@ from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, write_text
 
-#: The columns of a run's CSV by default: the log (``all_csv``: every recorded signal too).
-LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
-#: The runs written by default, one per maneuver (``all_csv``: every run): the other rigid
-#: seeds are the same maneuver under other noise, ``whole_chain.csv`` and
-#: ``load_identified_chain.csv`` the same logs as ``flexible.csv`` and ``load_true_chain.csv``.
-DEFAULT_CSV = (
-    "selfid.csv",
-    "rigid_seed1.csv",
-    "flexible.csv",
-    "identification.csv",
-    "load_true_chain.csv",
-)
+#: The runs written by default, each its log only (``all_csv``: every run, every signal).
+DEFAULT_CSV = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
+DEFAULT_CSV += ("load_true_chain.csv",)
 
 #: The files :func:`reproduce` writes into its folder.
 OUTPUTS = (
@@ -121,16 +108,14 @@ def reproduce(
         Ideal sensors (exact angle, true velocity, no noise) instead of the realistic
         2000-count encoder and 5 mA rms current noise.
     show_progress : bool
-        Whether to show a progress bar over the co-simulation steps and, on stderr, a
-        line for each stretch after it (the FMUs' build, the figures and the report).
+        Whether to show a progress bar on stderr (what runs, then the figures).
     fmu_dir : Path, optional
         Folder of the FMUs, built there if missing or stale (default: the per-user cache).
     force : bool
         Whether the files of :data:`OUTPUTS` may be replaced.
     all_csv : bool
-        Whether to write every run with every recorded signal (about 100 MB in all)
-        rather than one run per maneuver, :data:`DEFAULT_CSV`, with its log only,
-        :data:`LOG_COLUMNS` (about 6 MB).
+        Whether to write every run with every signal rather than :data:`DEFAULT_CSV`,
+        each with the log's columns only.
 
     Returns
     -------
@@ -164,17 +149,14 @@ def reproduce(
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
         identification, estimated = _whole_chain(bench, actuator, flexible)
         loaded = _load_torque(bench, actuator) if estimated is not None else None
-    if show_progress:
-        print(f"reproduce: writing the figures and report.md into {out}…", file=sys.stderr)
-    if loaded is not None:
-        results.files.append(_load_torque_figure(out, loaded))
-    results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
-    if estimated is not None:
-        results.files.append(_whole_chain_figure(out, identification, results))
-    report = write_text(
-        out / "report.md", report_markdown(results, ideal, k_mean, b_mean), force=True
-    )
-    results.files.append(report)
+        bar.set_postfix_str(f"writing the figures and report.md into {out}")
+        if loaded is not None:
+            results.files.append(_load_torque_figure(out, loaded))
+        results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
+        if estimated is not None:
+            results.files.append(_whole_chain_figure(out, identification, results))
+        report = report_markdown(results, ideal, k_mean, b_mean)
+        results.files.append(write_text(out / "report.md", report, force=True))
     return results
 
 
@@ -217,13 +199,9 @@ class _Bench:
     def keep(self, name: str, recording: Recording) -> None:
         """Write ``recording`` as the CSV ``name`` in the output folder: with
         ``all_csv`` every signal, else only a run of :data:`DEFAULT_CSV`, its log."""
-        columns = recording_columns(recording)
-        if not self.all_csv:
-            if name not in DEFAULT_CSV:
-                return
-            columns = {k: v for k, v in columns.items() if k in LOG_COLUMNS}
-        path = write_csv(self.out / name, columns, force=True)
-        self.results.files.append(path)
+        if self.all_csv or name in DEFAULT_CSV:
+            columns = recording_columns(recording, log_only=not self.all_csv)
+            self.results.files.append(write_csv(self.out / name, columns, force=True))
 
     @functools.cached_property
     def encoder_cpr(self) -> int:
