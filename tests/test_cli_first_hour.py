@@ -203,3 +203,31 @@ def test_a_first_build_says_so_on_stderr(capsys, tmp_path, monkeypatch) -> None:
     captured = capsys.readouterr()
     assert captured.out == ""
     assert f"building the FMUs for 2 masses into {tmp_path / 'fmus'}" in captured.err
+
+
+@pytest.mark.slow
+def test_a_sweep_says_dask_is_starting_on_stderr(capsys, build_fmus, tmp_path) -> None:
+    """Dask takes seconds to start before the first run: a line on stderr says so;
+    ``--no-progress`` drops it with the bar."""
+    build_fmus(3)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(SWEEP)
+    common = ["sweep", spec, "--workers", "1"]
+    code, out, err = run(capsys, *common, "--out", tmp_path / "a")
+    assert code == 0, err
+    assert "tiny: starting a local Dask cluster (1 workers) for 2 runs" in err and "starting" not in out
+    code, _, err = run(capsys, *common, "--out", tmp_path / "b", "--no-progress")
+    assert code == 0 and "starting" not in err
+
+
+#: The smallest sweep: two runs of a second each.
+SWEEP = """
+name = "tiny"
+scenario = "selfid"
+duration = 0.2
+runs = 2
+seed = 3
+metrics = ["runtime"]
+[vary]
+"observer.g_dist" = { distribution = "choice", values = [100.0, 200.0] }
+"""
