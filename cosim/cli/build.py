@@ -35,12 +35,14 @@ arcosim build --masses 2 --out fmus2""",
         "--masses",
         type=int,
         default=3,
+        metavar="N",
         help=f"number of load masses n, {MIN_MASSES} to {MAX_MASSES} (default 3)",
     )
     p.add_argument(
         "--out",
         type=Path,
         default=None,
+        metavar="DIR",
         help="output folder (default: the per-user cache, ~/.cache/arcosim/fmus/...)",
     )
     p.set_defaults(execute=_execute)

@@ -131,6 +131,7 @@ def step_option(parser: argparse.ArgumentParser, default: float = STEP) -> None:
         "--step",
         type=number(MIN_STEP, MAX_TIME, unit="s"),
         default=default,
+        metavar="H",
         help=f"communication step in s, {MIN_STEP:g} to {MAX_TIME:g} (default {default:g})",
     )
 

@@ -76,6 +76,7 @@ arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --jso
         "--masses",
         type=whole_number(MIN_MASSES, MAX_MASSES),
         default=3,
+        metavar="N",
         help=f"number of load masses, {MIN_MASSES} to {MAX_MASSES} (default 3)",
     )
     p.add_argument(
@@ -93,9 +94,12 @@ arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --jso
     p.add_argument(
         "--duration",
         type=number(0.0, MAX_TIME, low_open=True, unit="s"),
+        metavar="S",
         help=f"length in s, up to {MAX_TIME:g} (default: the scenario's)",
     )
-    p.add_argument("--out", type=Path, help="CSV of every recorded signal (a log for identify)")
+    p.add_argument(
+        "--out", type=Path, metavar="FILE", help="CSV of every recorded signal (a log for identify)"
+    )
     force_option(p)
     p.add_argument("--json", action="store_true", help="print the final observer outputs as JSON")
     add_fmus_option(p)

@@ -40,15 +40,18 @@ arcosim sweep spec.toml --out sweeps/noise --resume""",
     )
     p.add_argument("spec", type=Path, help="the sweep specification (TOML)")
     p.add_argument(
-        "--scheduler", help="address of an existing Dask scheduler (default: a local cluster)"
+        "--scheduler",
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler (default: a local cluster)",
     )
     p.add_argument(
         "--workers",
         type=whole_number(1, 1024),
         default=2,
+        metavar="N",
         help="worker processes of the local cluster, 1 to 1024 (default 2)",
     )
-    p.add_argument("--out", type=Path, help="output folder (default sweeps/<name>)")
+    p.add_argument("--out", type=Path, metavar="DIR", help="output folder (default sweeps/<name>)")
     p.add_argument("--resume", action="store_true", help="finish an interrupted sweep in --out")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_fmus_option(p)
