@@ -12,6 +12,10 @@ Contract (scripts rely on it)::
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
   of docs/method.md); the step may vary, and the observer gets the step taken;
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
+* ``--chain FIT.json`` (observer, output-error, load-torque; refused with whole-chain):
+  the chain ``J[i]``, ``k[i]``, ``B[i]``, the friction ``D_m``, ``f_c`` and ``--masses``
+  from a whole-chain report (:func:`arcosim.read_chain`), as if given with ``--set``
+  before the user's own (which win);
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
 * ``--out FILE``: every output over time as CSV (``time`` first); with
