@@ -11,7 +11,7 @@ designs. Columns as a drive records them: ``time`` (s), ``i_a`` (mA), ``omega_m`
 drive could not measure, ``theta_1_true``, ``theta_2_true`` (rad).
 
 Run: ``python -m benchmarks.sample_log`` (from the repository root); it also copies the
-log into ``cosim/example_files/data/``, the package data ``arcosim example`` writes out.
+log into ``cosim/example-files/data/``, the package data ``arcosim example`` writes out.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from benchmarks import field_sim
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "examples" / "data" / "belt_drive.csv"
 #: The packaged copy of :data:`OUT` (``arcosim example``).
-PACKAGED = ROOT / "cosim" / "example_files" / "data" / "belt_drive.csv"
+PACKAGED = ROOT / "cosim" / "example-files" / "data" / "belt_drive.csv"
 COUNTS = 2000
 J, K = (3e-4, 9e-4), (0.45, 0.3)
 

@@ -1,5 +1,5 @@
 """``arcosim example --out DIR``: the sample log and the script that identifies it,
-copied out of the installed package (``arcosim/example_files/``, the same files as the
+copied out of the installed package (``arcosim/example-files/``, the same files as the
 checkout's ``examples/``) so that quick start 2 runs without a checkout.
 """
 
@@ -42,7 +42,7 @@ def _execute(args: argparse.Namespace) -> int:
     folder = check_output_folder(args.out)
     if not args.force:
         refuse_existing(folder, FILES)
-    source = resources.files("arcosim") / "example_files"
+    source = resources.files("arcosim") / "example-files"
     for name in FILES:
         target = folder / name
         target.parent.mkdir(parents=True, exist_ok=True)
