@@ -10,7 +10,8 @@ designs. Columns as a drive records them: ``time`` (s), ``i_a`` (mA), ``omega_m`
 (counts/s, the encoder's backward difference), ``theta_m`` (counts), and the truth the
 drive could not measure, ``theta_1_true``, ``theta_2_true`` (rad).
 
-Run: ``python -m benchmarks.sample_log`` (from the repository root).
+Run: ``python -m benchmarks.sample_log`` (from the repository root); it also copies the
+log into ``cosim/example-files/data/``, the package data ``arcosim example`` writes out.
 """
 
 from __future__ import annotations
@@ -23,7 +24,10 @@ import numpy as np
 from arcosim.identification.excitation_design import design_excitation
 from benchmarks import field_sim
 
-OUT = Path(__file__).resolve().parents[1] / "examples" / "data" / "belt_drive.csv"
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "examples" / "data" / "belt_drive.csv"
+#: The packaged copy of :data:`OUT` (``arcosim example``).
+PACKAGED = ROOT / "cosim" / "example-files" / "data" / "belt_drive.csv"
 COUNTS = 2000
 J, K = (3e-4, 9e-4), (0.45, 0.3)
 
@@ -74,6 +78,9 @@ def main(out: Path = OUT) -> None:
                 ]
             )
     print(f"wrote {out} ({out.stat().st_size / 1e3:.0f} kB)")
+    if out == OUT:
+        PACKAGED.write_bytes(out.read_bytes())
+        print(f"copied it to {PACKAGED}")
 
 
 if __name__ == "__main__":

@@ -170,7 +170,8 @@ def ensure_built(n: int = 3, folder: Path | None = None) -> Path:
 
     A folder whose FMUs are missing, incomplete, corrupt or built from other sources
     is rebuilt (no stale FMU is ever run). Safe to call from several processes at
-    once: the check and the build hold the folder's lock.
+    once: the check and the build hold the folder's lock. A build says so first in one
+    line on stderr (it takes seconds; stdout stays the caller's).
 
     Parameters
     ----------
@@ -195,6 +196,11 @@ def ensure_built(n: int = 3, folder: Path | None = None) -> Path:
         return target
     with lock_folder(target):
         if not is_current(target, n):
+            print(
+                f"arcosim: building the FMUs for {n} masses into {target} (about 10 s, once)…",
+                file=sys.stderr,
+                flush=True,
+            )
             build_locked(n, target)
     return target
 

@@ -16,6 +16,7 @@ identify_observer      -- ``--method observer``: the observer FMU replayed over 
 identify_output_error  -- ``--method output-error``: the uniform chain's k and B
 identify_whole_chain   -- ``--method whole-chain``: every J_i, k_i, B_i and n
 identify_load_torque   -- ``--method load-torque``: the torque on a load mass over time
+example                -- ``arcosim example``: the sample log and its script into a folder
 reproduce              -- ``arcosim reproduce``: the paper's experiments and the report
 sweep                  -- ``arcosim sweep``: Monte Carlo and grid sweeps on Dask
 ssp                    -- ``arcosim ssp``: an SSP system run
@@ -51,6 +52,7 @@ from arcosim.cli import (
     bench,
     build,
     check,
+    example,
     excite,
     identify,
     reproduce,
@@ -93,6 +95,7 @@ def make_parser() -> argparse.ArgumentParser:
         excite,
         check,
         identify,
+        example,
         reproduce,
         sweep,
         ssp,

@@ -12,6 +12,7 @@ import importlib
 import sys
 from pathlib import Path
 
+from arcosim.cli.options import add_command
 from arcosim.errors import UserError
 
 #: Benchmark name → module of the ``benchmarks`` package.
@@ -20,11 +21,17 @@ BENCHMARKS = {"accuracy": "accuracy", "speed": "speed"}
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim bench``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "bench",
-        help="run a benchmark of the source checkout (accuracy, speed)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="run a benchmark of the source checkout (accuracy, speed)",
+        description="""
+Run one of the benchmarks in a source checkout's benchmarks/ folder (they are not
+part of the installed package): the folder is found from the current directory
+upwards, and ARGS go to the benchmark (arcosim bench NAME --help lists them).""",
+        examples="""
+arcosim bench accuracy
+arcosim bench speed --help""",
     )
     p.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
     p.add_argument("args", nargs=argparse.REMAINDER, help="the benchmark's own arguments")

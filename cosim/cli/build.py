@@ -13,21 +13,36 @@ from pathlib import Path
 
 from arcosim.build.builder import build_all
 from arcosim.build.recipes import MAX_MASSES, MIN_MASSES, check_masses
+from arcosim.cli.options import add_command
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim build``."""
-    p = subparsers.add_parser("build", help="build the FMUs", description=__doc__)
+    p = add_command(
+        subparsers,
+        "build",
+        summary="build the FMUs",
+        description="""
+Build the plant, observer and excitation FMUs and their SSP system for n load
+masses into a folder (default: the per-user cache, where every other command looks
+for them; they are built there on first use anyway, so this is only needed to get
+the files themselves).""",
+        examples="""
+arcosim build --out fmus
+arcosim build --masses 2 --out fmus2""",
+    )
     p.add_argument(
         "--masses",
         type=int,
         default=3,
+        metavar="N",
         help=f"number of load masses n, {MIN_MASSES} to {MAX_MASSES} (default 3)",
     )
     p.add_argument(
         "--out",
         type=Path,
         default=None,
+        metavar="DIR",
         help="output folder (default: the per-user cache, ~/.cache/arcosim/fmus/...)",
     )
     p.set_defaults(execute=_execute)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from arcosim.cli.options import log_options
+from arcosim.cli.options import add_command, log_options
 from arcosim.cli.parameters import defaults_note, known_parameters, set_names
 from arcosim.identification.log_check import check_log
 from arcosim.logs import parse_scales, read_log
@@ -27,11 +27,26 @@ NEEDED = ("k_to", "J_mo", "encoder_cpr")
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim check``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "check",
-        help="say whether a log can support identification, before any fit",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="say whether a log can support identification, before any fit",
+        description="""
+Before any fit, say whether a log can support whole-chain identification: the
+step, the motion the encoder sees, the excitation against the band the sample rate
+and the disturbance observer leave, and the modes the record shows, each problem
+with what would fix it. Exit status 0: it can; 1: it cannot (reasons printed);
+2: a bad input.
+
+Give first what you know of the motor (anything not given takes the paper bench's
+value, and the output says so):
+  --set k_to=VALUE        torque constant, N.m/A
+  --set J_mo=VALUE        motor inertia, kg.m2
+  --set encoder_cpr=N     encoder counts per revolution, after quadrature
+  --scale COLUMN=FACTOR   the log's units to SI, e.g. --scale i_a=0.001 for mA""",
+        examples="""
+arcosim check log.csv --set k_to=0.0406 --set J_mo=2.09e-5 --set encoder_cpr=2000
+arcosim check log.csv --scale i_a=0.001 --set k_to=0.0406 --json""",
     )
     log_options(p, "k_to (N.m/A), J_mo (kg.m2), encoder_cpr, g_dist (rad/s); repeatable")
     p.add_argument("--json", action="store_true", help="print the report as one JSON object")

@@ -16,7 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
-from arcosim.cli.options import force_option, number, step_option, whole_number
+from arcosim.cli.options import add_command, force_option, number, step_option, whole_number
 from arcosim.identification.excitation_design import DURATION, LINES, design_excitation
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
@@ -24,11 +24,21 @@ from arcosim.outputs import check_output
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim excite``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "excite",
-        help="design the excitation to play on a drive for identification",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="design the excitation to play on a drive for identification",
+        description="""
+Design the multi-sine to play on your drive before recording a log for
+identification: log-spaced lines over --band (rad/s) within --current-limit (A),
+written as a CSV (time, i_ref; or omega_ref with --kind speed), and the
+ExcitationSource FMU's parameters that play it. Give the drive's figures (--k-t,
+--f-c, --J-total, --encoder-cpr, --g-dist) and the design is checked against
+friction, encoder and observer band, with a warning saying what to change.""",
+        examples="""
+arcosim excite --band 3 150 --current-limit 3 --out excitation.csv
+arcosim excite --band 3 150 --current-limit 3 --out excitation.csv \\
+    --k-t 0.04 --f-c 0.02 --encoder-cpr 2000""",
     )
     rate = number(0.0, low_open=True, unit="rad/s")
     p.add_argument(

@@ -12,6 +12,10 @@ Contract (scripts rely on it)::
   converts, e.g. ``--scale i_a=0.001`` for mA), one row per sample (timing contract
   of docs/method.md); the step may vary, and the observer gets the step taken;
 * ``--set NAME=VALUE``: an observer parameter, e.g. ``--set "J[1]=5e-4"``;
+* ``--chain FIT.json`` (observer, output-error, load-torque; refused with whole-chain):
+  the chain ``J[i]``, ``k[i]``, ``B[i]``, the friction ``D_m``, ``f_c`` and ``--masses``
+  from a whole-chain report (:func:`arcosim.read_chain`), as if given with ``--set``
+  before the user's own (which win);
 * ``--json``: one JSON object, the final value of every observer output keyed by its
   FMU name (Booleans as true/false);
 * ``--out FILE``: every output over time as CSV (``time`` first); with
@@ -63,28 +67,56 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arcosim.cli.identify_load_torque import chain_option, run_load_torque
+from arcosim.cli.identify_load_torque import run_load_torque
 from arcosim.cli.identify_observer import run_observer
-from arcosim.cli.identify_options import check_method_options, check_out, masses_option
+from arcosim.cli.identify_options import (
+    chain_assignments,
+    chain_option,
+    check_method_options,
+    check_out,
+    masses_option,
+)
 from arcosim.cli.identify_output_error import run_output_error
 from arcosim.cli.identify_whole_chain import run_whole_chain
-from arcosim.cli.options import add_fmus_option, force_option, log_options, number
+from arcosim.cli.options import add_command, add_fmus_option, force_option, log_options, number
 from arcosim.errors import UserError
 from arcosim.logs import parse_scales, read_log
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim identify``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "identify",
-        help="a drive from its log: replay the observer FMU, fit the chain, or the load torque",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="a drive from its log: replay the observer FMU, fit the chain, or the load torque",
+        description="""
+Identify a drive from a log of its motor: columns time (s), i_a (A), omega_m
+(rad/s), theta_m (rad), one row per sample. --method chooses what to do:
+  observer      replay the observer FMU over the log (default)
+  whole-chain   fit every load inertia, stiffness and damping, and n (--masses auto)
+  output-error  fit the uniform chain's k and B, the J[i] known
+  load-torque   the torque on one load mass over time (--set load_mass=I)
+
+Give first what you know of the motor (anything not given takes the paper bench's
+value, and the output names it on a line "assumption, defaults"):
+  --set k_to=VALUE        torque constant, N.m/A
+  --set J_mo=VALUE        motor inertia, kg.m2
+  --set encoder_cpr=N     encoder counts per revolution, after quadrature
+  --set D_m=, --set f_c=  motor friction (N.m.s/rad, N.m) if known, else fitted
+  --scale COLUMN=FACTOR   the log's units to SI: --scale i_a=0.001 for mA
+  --chain chain.json      the chain a whole-chain fit wrote (--out chain.json):
+                          J[i], k[i], B[i], D_m, f_c and --masses; --set wins""",
+        examples="""
+M="--set k_to=0.0406 --set J_mo=2.09e-5 --set encoder_cpr=2000"
+arcosim identify log.csv $M --method whole-chain --masses auto --out chain.json
+arcosim identify log.csv $M --chain chain.json --set estimator=1 --out states.csv
+arcosim identify log.csv $M --chain chain.json --method load-torque --set load_mass=2""",
     )
     log_options(p, "observer parameter, repeatable")
     p.add_argument(
         "--masses",
         default="3",
+        metavar="N",
         help="number of load masses (default 3); with --method whole-chain also 'auto'",
     )
     p.add_argument(
@@ -94,6 +126,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--out",
         type=Path,
+        metavar="FILE",
         help="observer, load-torque: every output over time as CSV; output-error, "
         "whole-chain: the report as a .json file",
     )
@@ -109,8 +142,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--chain",
         type=Path,
-        help="load-torque: JSON with J[i], k[i], B[i] (the output of --method whole-chain "
-        "--json); sets --masses",
+        metavar="FILE",
+        help="observer, output-error, load-torque: the chain J[i], k[i], B[i], the friction "
+        "D_m, f_c and --masses from the JSON of --method whole-chain --out FILE (--set wins)",
     )
     p.add_argument(
         "--fit-inertia-scale",
@@ -127,6 +161,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--start-k",
         type=number(0.0, low_open=True, unit="N.m/rad"),
+        metavar="K",
         help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
         "it must put the chain's first mode in the band the log shows",
     )
@@ -138,17 +173,20 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
+    if args.chain and args.method == "whole-chain":
+        raise UserError(
+            "--chain is for the methods that use a chain (observer, output-error, "
+            "load-torque); --method whole-chain fits it"
+        )
+    chain = chain_option(args.chain) if args.chain else {}
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else masses_option(args.masses)
         return run_whole_chain(args, log, masses)
+    n = int(chain.pop("masses")) if chain else masses_option(args.masses)
+    args.set = chain_assignments(chain, args.set) + list(args.set)  # --set wins
     if args.method == "load-torque":
-        chain = chain_option(args.chain) if args.chain else {}
-        n = int(chain.pop("masses")) if "masses" in chain else masses_option(args.masses)
-        return run_load_torque(args, log, n, chain)
-    if args.chain:
-        raise UserError("--chain is for --method load-torque")
-    n = masses_option(args.masses)
+        return run_load_torque(args, log, n)
     if args.method == "output-error":
         return run_output_error(args, log, n)
     return run_observer(args, log, n)

@@ -1,6 +1,6 @@
 """``arcosim identify --method load-torque``: the external torque on one load mass over
 time, from the motor alone (the observer's estimator 1 with ``load_mass``, run offline),
-the chain from ``--chain`` (a whole-chain report) and ``--set``.
+the chain from ``--set`` (``--chain``, a whole-chain report, adds its values there).
 """
 
 from __future__ import annotations
@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.chainfile import ChainFileError, read_chain
 from arcosim.cli.parameters import (
     actuator_of,
     defaults_note,
@@ -26,35 +25,7 @@ from arcosim.identification import load_torque
 from arcosim.logs import DriveLog, write_csv
 
 
-def chain_option(path: Path) -> dict[str, float]:
-    """``--chain FILE``: the chain of a whole-chain report (:func:`arcosim.read_chain`).
-
-    Parameters
-    ----------
-    path : Path
-        The option's file.
-
-    Returns
-    -------
-    dict of str to float
-        ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad), ``masses`` (a
-        count) and, when there, ``D_m`` (N·m·s/rad) and ``f_c`` (N·m).
-
-    Raises
-    ------
-    UserError
-        What :func:`arcosim.read_chain` raises; a problem with the file's content
-        names the option.
-    """
-    try:
-        return read_chain(path)
-    except ChainFileError as error:
-        raise UserError(f"--chain {error}") from None
-
-
-def run_load_torque(
-    args: argparse.Namespace, log: DriveLog, n: int, chain: dict[str, float]
-) -> int:
+def run_load_torque(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     """Estimate the load torque on mass ``load_mass`` over ``log``; print a summary.
 
     Parameters
@@ -65,9 +36,6 @@ def run_load_torque(
         The checked log, SI units; the step may vary.
     n : int
         Number of load masses (a count).
-    chain : dict of str to float
-        The chain from ``--chain`` (:func:`chain_option`, ``masses`` taken out);
-        ``--set`` wins over it.
 
     Returns
     -------
@@ -80,9 +48,7 @@ def run_load_torque(
         No ``load_mass`` in 1 … n, a chain or tuning no estimator can be designed for.
     """
     values = known_parameters(n, args.set)
-    given = set_names(args.set)
-    values.update({k: v for k, v in chain.items() if k not in given})
-    defaults = defaults_note(values, drive_parameters(n), given | set(chain))
+    defaults = defaults_note(values, drive_parameters(n), set_names(args.set))
     settings = _settings(values, n)
     c = log.columns
     try:

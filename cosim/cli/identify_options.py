@@ -1,6 +1,7 @@
 """The options every method of ``arcosim identify`` shares, checked where they enter:
-which options go with which method, ``--masses``, ``--out`` (refused before any work)
-and the report an offline fit writes.
+which options go with which method, ``--masses``, ``--chain`` (a whole-chain report
+read back as ``--set`` assignments), ``--out`` (refused before any work) and the report
+an offline fit writes.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from arcosim.build.recipes import check_masses
+from arcosim.chainfile import ChainFileError, read_chain
+from arcosim.cli.parameters import set_names
 from arcosim.errors import UserError
 from arcosim.outputs import check_output, write_text
 
@@ -73,6 +76,57 @@ def masses_option(text: str) -> int:
         what = " ('auto' needs --method whole-chain)" if text == "auto" else ""
         raise UserError(f"--masses {text}: not a whole number{what}") from None
     return check_masses(n)
+
+
+def chain_option(path: Path) -> dict[str, float]:
+    """``--chain FILE``: the chain of a whole-chain report (:func:`arcosim.read_chain`).
+
+    Parameters
+    ----------
+    path : Path
+        The option's file.
+
+    Returns
+    -------
+    dict of str to float
+        ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad), ``masses`` (a
+        count) and, when there, ``D_m`` (N·m·s/rad) and ``f_c`` (N·m).
+
+    Raises
+    ------
+    UserError
+        What :func:`arcosim.read_chain` raises; a problem with the file's content
+        names the option.
+    """
+    try:
+        return read_chain(path)
+    except ChainFileError as error:
+        raise UserError(f"--chain {error}") from None
+
+
+def chain_assignments(chain: Mapping[str, float], assignments: Sequence[str]) -> list[str]:
+    """The ``--set`` assignments of a chain's values that ``assignments`` do not give.
+
+    Parameters
+    ----------
+    chain : mapping of str to float
+        The chain of :func:`chain_option` without ``masses``: ``J[i]`` (kg·m²),
+        ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad), ``D_m`` (N·m·s/rad), ``f_c`` (N·m).
+    assignments : sequence of str
+        The user's ``--set`` texts, which win.
+
+    Returns
+    -------
+    list of str
+        ``"NAME=VALUE"`` texts, the value written to round-trip exactly.
+
+    Examples
+    --------
+    >>> chain_assignments({"J[1]": 3e-4, "k[1]": 0.45}, ["k[1]=0.5"])
+    ['J[1]=0.0003']
+    """
+    given = set_names(assignments)
+    return [f"{name}={value!r}" for name, value in chain.items() if name not in given]
 
 
 def check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:

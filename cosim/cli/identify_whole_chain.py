@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from arcosim.cli.identify_options import write_report
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
 from arcosim.identification.drive import DriveIdentification, identify_drive
+from arcosim.identification.whole_chain import MAX_AUTO_MASSES
 from arcosim.logs import DriveLog
 
 
@@ -43,6 +45,7 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
     actuator = actuator_of(values)
     c = log.columns
+    print(_status(masses, len(log)), file=sys.stderr, flush=True)
     result = identify_drive(
         log.time,
         c["i_a"],
@@ -66,6 +69,18 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     else:
         _print_report(result, report, len(log))
     return 0
+
+
+def _status(masses: int | str, samples: int) -> str:
+    """The line on stderr before the fit, which takes seconds (stdout stays the report's).
+
+    Examples
+    --------
+    >>> _status("auto", 20001)
+    'arcosim identify: fitting the whole chain to 20001 samples, n = 1 … 8 tried (seconds)…'
+    """
+    tried = f"n = 1 … {MAX_AUTO_MASSES} tried" if masses == "auto" else f"n = {masses}"
+    return f"arcosim identify: fitting the whole chain to {samples} samples, {tried} (seconds)…"
 
 
 def _print_report(result: DriveIdentification, report: dict, samples: int) -> None:

@@ -1,16 +1,18 @@
 """Options several commands share, and the checks every CLI input gets where it enters.
 
-Numbers are parsed by :func:`number` / :func:`whole_number` (argparse ``type=``): a
-value that is not a finite number in its range is refused with one line naming the
-option and the range. :func:`check_steps` refuses a step and a length that give no
-sample or more than :data:`MAX_STEPS`. Outputs are checked by
-:mod:`arcosim.outputs` before any work starts.
+Every subcommand's parser is made by :func:`add_command`: a description and examples
+written for a terminal (the contract in detail is docs/cli.md). Numbers are parsed by
+:func:`number` / :func:`whole_number` (argparse ``type=``): a value that is not a finite
+number in its range is refused with one line naming the option and the range.
+:func:`check_steps` refuses a step and a length that give no sample or more than
+:data:`MAX_STEPS`. Outputs are checked by :mod:`arcosim.outputs` before any work starts.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -18,6 +20,50 @@ from arcosim.build.builder import ensure_built
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.master import MAX_STEPS, MAX_TIME, MIN_STEP
+
+
+def add_command(
+    subparsers: argparse._SubParsersAction,
+    name: str,
+    *,
+    summary: str,
+    description: str,
+    examples: str,
+) -> argparse.ArgumentParser:
+    """A subcommand's parser whose ``--help`` reads in a terminal.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The ``arcosim`` parser's subcommands.
+    name : str
+        The subcommand, e.g. ``"identify"``.
+    summary : str
+        One line for ``arcosim --help``'s list of commands.
+    description : str
+        Plain text, no markup: what the command does and what to give first.
+    examples : str
+        Command lines, one a line (a long one continued with `` \\`` on lines indented
+        further); shown indented under ``examples:`` at the end of the help.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The subcommand's parser, to add its options to.
+    """
+    lines = textwrap.dedent(examples).strip("\n").splitlines()
+    epilog = "examples:\n" + "\n".join(f"  {line}" if line.strip() else "" for line in lines)
+    epilog += (
+        "\n\nEvery option, output and exit status: the documentation's page\n"
+        f'"The command line", section "arcosim {name}".'
+    )
+    return subparsers.add_parser(
+        name,
+        help=summary,
+        description=description.strip(),
+        epilog=epilog,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
 
 
 def number(
@@ -85,6 +131,7 @@ def step_option(parser: argparse.ArgumentParser, default: float = STEP) -> None:
         "--step",
         type=number(MIN_STEP, MAX_TIME, unit="s"),
         default=default,
+        metavar="H",
         help=f"communication step in s, {MIN_STEP:g} to {MAX_TIME:g} (default {default:g})",
     )
 

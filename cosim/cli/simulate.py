@@ -31,6 +31,7 @@ from arcosim.build.builder import fmu_variables
 from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.cli.options import (
     MAX_TIME,
+    add_command,
     add_fmus_option,
     check_steps,
     fmu_folder,
@@ -56,11 +57,18 @@ from arcosim.outputs import check_output
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim simulate``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "simulate",
-        help="run one scenario (plant + observer)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="run one scenario (plant + observer)",
+        description="""
+Run one scenario of the plant and observer FMUs and print the observer's final
+outputs; any parameter of either FMU can be changed with --set FMU.NAME=VALUE. The
+CSV written by --out is also a log that arcosim identify accepts (time, i_a,
+omega_m, theta_m, then every recorded signal).""",
+        examples="""
+arcosim simulate --scenario identification --out identification.csv
+arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --json""",
     )
     names = ", ".join(f"{s.name} ({s.description})" for s in SCENARIOS.values())
     p.add_argument("--scenario", default="flexible", help=f"one of: {names}")
@@ -68,6 +76,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--masses",
         type=whole_number(MIN_MASSES, MAX_MASSES),
         default=3,
+        metavar="N",
         help=f"number of load masses, {MIN_MASSES} to {MAX_MASSES} (default 3)",
     )
     p.add_argument(
@@ -85,9 +94,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--duration",
         type=number(0.0, MAX_TIME, low_open=True, unit="s"),
+        metavar="S",
         help=f"length in s, up to {MAX_TIME:g} (default: the scenario's)",
     )
-    p.add_argument("--out", type=Path, help="CSV of every recorded signal (a log for identify)")
+    p.add_argument(
+        "--out", type=Path, metavar="FILE", help="CSV of every recorded signal (a log for identify)"
+    )
     force_option(p)
     p.add_argument("--json", action="store_true", help="print the final observer outputs as JSON")
     add_fmus_option(p)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arcosim.cli.options import MAX_TIME, force_option, number, step_option
+from arcosim.cli.options import MAX_TIME, add_command, force_option, number, step_option
 from arcosim.host.ssp import run_ssp
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
@@ -15,8 +15,17 @@ from arcosim.outputs import check_output
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim ssp``."""
-    p = subparsers.add_parser(
-        "ssp", help="run an SSP system (e.g. dist/ActionReaction.ssp)", description=__doc__
+    p = add_command(
+        subparsers,
+        "ssp",
+        summary="run an SSP system (e.g. dist/ActionReaction.ssp)",
+        description="""
+Run an SSP system (a folder of FMUs and their connections, as arcosim build writes
+ActionReaction.ssp) with one of its parameter sets, and write every output of every
+component over time as CSV.""",
+        examples="""
+arcosim ssp fmus/ActionReaction.ssp --stop 2 --out run.csv
+arcosim ssp fmus/ActionReaction.ssp --parameter-set bench --step 1e-4 --stop 1""",
     )
     p.add_argument("path", type=Path, help="the .ssp file")
     p.add_argument(

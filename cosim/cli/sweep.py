@@ -15,7 +15,7 @@ import argparse
 import time
 from pathlib import Path
 
-from arcosim.cli.options import add_fmus_option, whole_number
+from arcosim.cli.options import add_command, add_fmus_option, whole_number
 from arcosim.errors import UserError
 from arcosim.outputs import same_file
 from arcosim.sweeps.runner import RESULTS, SUMMARY, sweep
@@ -25,23 +25,33 @@ from arcosim.sweeps.summary import read_results
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim sweep``."""
-    p = subparsers.add_parser(
+    p = add_command(
+        subparsers,
         "sweep",
-        help="run a parameter sweep on Dask",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        summary="run a parameter sweep on Dask",
+        description="""
+Run a Monte Carlo or grid sweep of co-simulations described by a TOML spec, on a
+local Dask cluster of --workers processes or on the cluster at --scheduler. Rows are
+appended to results.csv in --out as runs finish; --resume runs only the missing
+ones. A second sweep into the same folder is refused while the first runs.""",
+        examples="""
+arcosim sweep examples/sweep_noise_encoder_gdist.toml --workers 2 --out sweeps/noise
+arcosim sweep spec.toml --out sweeps/noise --resume""",
     )
     p.add_argument("spec", type=Path, help="the sweep specification (TOML)")
     p.add_argument(
-        "--scheduler", help="address of an existing Dask scheduler (default: a local cluster)"
+        "--scheduler",
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler (default: a local cluster)",
     )
     p.add_argument(
         "--workers",
         type=whole_number(1, 1024),
         default=2,
+        metavar="N",
         help="worker processes of the local cluster, 1 to 1024 (default 2)",
     )
-    p.add_argument("--out", type=Path, help="output folder (default sweeps/<name>)")
+    p.add_argument("--out", type=Path, metavar="DIR", help="output folder (default sweeps/<name>)")
     p.add_argument("--resume", action="store_true", help="finish an interrupted sweep in --out")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_fmus_option(p)

@@ -12,14 +12,25 @@ import argparse
 from pathlib import Path
 
 from arcosim.build.builder import ensure_built
+from arcosim.cli.options import add_command
 from arcosim.errors import UserError
 from arcosim.host.validate import not_an_fmu, validate
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register ``arcosim validate``."""
-    p = subparsers.add_parser(
-        "validate", help="check built FMUs for FMI compliance and behaviour", description=__doc__
+    p = add_command(
+        subparsers,
+        "validate",
+        summary="check built FMUs for FMI compliance and behaviour",
+        description="""
+Check FMUs the way a strict FMI host would (model description, instantiation,
+stepping, state save and restore); default: the FMUs for 3 masses in the per-user
+cache, built if needed. Prints the problems and exits 1 if there are any; a file
+that is not an FMU is refused with exit status 2 before any FMU runs.""",
+        examples="""
+arcosim validate
+arcosim validate fmus/*.fmu""",
     )
     p.add_argument(
         "fmus",

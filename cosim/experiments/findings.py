@@ -261,7 +261,7 @@ def report_markdown(results: Results, ideal: bool, k_mean: float, b_mean: float)
     )
     return f"""# The paper's experiments, reproduced (arcosim {__version__})
 
-Bench of Khalil & Sabanovic in SI units (docs/method.md), n = 3, 1 ms steps,
+Bench of Khalil & Sabanovic in SI units (the docs' page "The method"), n = 3, 1 ms steps,
 Gauss–Seidel co-simulation of `MotorChainPlant.fmu` and `ReactionTorqueObserver.fmu`,
 g_dist = g_lpf = 100 rad/s, sensors {sensors}. Re-run: `{rerun}`.
 
@@ -278,7 +278,7 @@ A 3 A maneuver at 2.1 rad/s (an eighth of the first mode) under raised-cosine
 ramps, 24 s, noise seeds 1–5 (`rigid_seed*.csv`), with the actuator terms of
 experiment 1 and the multi-mass correction κ = 1.614. True k = {TRUE["k"]} N·m/rad,
 B = {TRUE["B"]} N·m·s/rad. The paper's rows are converted to SI at a 10 mm lever
-(docs/method.md); its errors are against its stated 1.627 kN/m and 0.0888 N·s/m.
+(the docs' page "The method"); its errors are against its stated 1.627 kN/m and 0.0888 N·s/m.
 
 {markdown_table(TABLE_II_HEADER, table_ii_rows(results))}
 
@@ -295,7 +295,7 @@ rms(θ̂_i − θ_i) / rms(θ_i − θ_m) (0 is perfect; the naive "θ_i = θ_m"
 {markdown_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(results))}
 
 The recursion differentiates along the chain, so errors grow from mass to mass
-(docs/method.md); it also inherits the DOB's lag at g_dist = 100 rad/s.
+(the docs' page "The method"); it also inherits the DOB's lag at g_dist = 100 rad/s.
 
 ![Fig. 5](fig5_flexible_response.png)
 

@@ -16,8 +16,8 @@
    experiment 4's chain: settling time, settled error, lag of the sine (scenario
    ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
 
-:func:`reproduce` writes ``report.md``, the CSV of every run and the PNG figures into
-a folder; ``arcosim reproduce`` is the command line.
+:func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
+``arcosim reproduce`` is the command line.
 """
 
 from __future__ import annotations
@@ -68,6 +68,10 @@ from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, write_text
 
+#: The runs written by default, each its log only (``all_csv``: every run, every signal).
+DEFAULT_CSV = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
+DEFAULT_CSV += ("load_true_chain.csv",)
+
 #: The files :func:`reproduce` writes into its folder.
 OUTPUTS = (
     "selfid.csv",
@@ -92,6 +96,7 @@ def reproduce(
     show_progress: bool = True,
     fmu_dir: Path | None = None,
     force: bool = False,
+    all_csv: bool = False,
 ) -> Results:
     """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
 
@@ -103,11 +108,14 @@ def reproduce(
         Ideal sensors (exact angle, true velocity, no noise) instead of the realistic
         2000-count encoder and 5 mA rms current noise.
     show_progress : bool
-        Whether to show a progress bar over the co-simulation steps.
+        Whether to show a progress bar on stderr (what runs, then the figures).
     fmu_dir : Path, optional
         Folder of the FMUs, built there if missing or stale (default: the per-user cache).
     force : bool
         Whether the files of :data:`OUTPUTS` may be replaced.
+    all_csv : bool
+        Whether to write every run with every signal rather than :data:`DEFAULT_CSV`,
+        each with the log's columns only.
 
     Returns
     -------
@@ -135,21 +143,20 @@ def reproduce(
         disable=not show_progress,
         desc="reproduce",
     ) as bar:
-        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str)
+        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str, all_csv)
         actuator = _self_identification(bench)
         rigid, k_mean, b_mean = _rigid_maneuvers(bench, actuator)
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
         identification, estimated = _whole_chain(bench, actuator, flexible)
         loaded = _load_torque(bench, actuator) if estimated is not None else None
-    if loaded is not None:
-        results.files.append(_load_torque_figure(out, loaded))
-    results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
-    if estimated is not None:
-        results.files.append(_whole_chain_figure(out, identification, results))
-    report = write_text(
-        out / "report.md", report_markdown(results, ideal, k_mean, b_mean), force=True
-    )
-    results.files.append(report)
+        bar.set_postfix_str(f"writing the figures and report.md into {out}")
+        if loaded is not None:
+            results.files.append(_load_torque_figure(out, loaded))
+        results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
+        if estimated is not None:
+            results.files.append(_whole_chain_figure(out, identification, results))
+        report = report_markdown(results, ideal, k_mean, b_mean)
+        results.files.append(write_text(out / "report.md", report, force=True))
     return results
 
 
@@ -175,6 +182,7 @@ class _Bench:
     results: Results
     progress: Callable[[int], object]
     status: Callable[[str], object]
+    all_csv: bool = False
 
     def run(self, name: str, **settings: dict) -> Recording:
         """Co-simulate the scenario ``name`` on the bench (``plant=``, ``observer=``)."""
@@ -189,9 +197,11 @@ class _Bench:
         )
 
     def keep(self, name: str, recording: Recording) -> None:
-        """Write ``recording`` as the CSV ``name`` in the output folder."""
-        path = write_csv(self.out / name, recording_columns(recording), force=True)
-        self.results.files.append(path)
+        """Write ``recording`` as the CSV ``name`` in the output folder: with
+        ``all_csv`` every signal, else only a run of :data:`DEFAULT_CSV`, its log."""
+        if self.all_csv or name in DEFAULT_CSV:
+            columns = recording_columns(recording, log_only=not self.all_csv)
+            self.results.files.append(write_csv(self.out / name, columns, force=True))
 
     @functools.cached_property
     def encoder_cpr(self) -> int:

@@ -359,13 +359,15 @@ def run_scenario(
         )
 
 
-def recording_columns(recording: Recording) -> dict[str, np.ndarray]:
+def recording_columns(recording: Recording, log_only: bool = False) -> dict[str, np.ndarray]:
     """Columns for a CSV: ``time``, the log columns (plant's measured signals under
-    the observer's input names), then every signal by its qualified name."""
+    the observer's input names), then, unless ``log_only``, every signal by its
+    qualified name."""
     columns = {"time": recording.time}
     for name in ("i_a", "omega_m", "theta_m"):
         key = f"plant.{name}"
         if key in recording.signals:
             columns[name] = recording.signals[key]
-    columns.update(recording.signals)
+    if not log_only:
+        columns.update(recording.signals)
     return columns

@@ -275,6 +275,11 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
     from tqdm import tqdm
 
     cluster = None
+    if show_progress:  # Dask takes seconds to start, before the bar's first run
+        how = f"starting a local Dask cluster ({workers} workers)"
+        if scheduler is not None:
+            how = f"connecting to the Dask scheduler at {scheduler}"
+        print(f"{spec.name}: {how} for {len(pending)} runs…", file=sys.stderr)
     if scheduler is None:
         cluster = LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
