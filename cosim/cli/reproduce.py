@@ -13,7 +13,7 @@ import argparse
 import time
 from pathlib import Path
 
-from arcosim.cli.options import add_fmus_option
+from arcosim.cli.options import add_fmus_option, tool_names_option
 from arcosim.experiments import reproduce as experiments
 from arcosim.experiments.findings import (
     LOAD_HEADER,
@@ -47,6 +47,7 @@ def add_parser(
     p.add_argument("--ideal", action="store_true", help="ideal sensors")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--force", action="store_true", help="replace the report's files if they exist")
+    tool_names_option(p)
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
@@ -59,6 +60,7 @@ def _execute(args: argparse.Namespace) -> int:
         show_progress=not args.no_progress,
         fmu_dir=args.fmus,
         force=args.force,
+        tool_names=args.tool_names,
     )
     print("\n1. Actuator self-identification (load detached)")
     print(text_table(["term", "identified", "true", "error"], actuator_rows(results)))

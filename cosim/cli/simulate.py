@@ -123,7 +123,13 @@ def _execute(args: argparse.Namespace) -> int:
     plant.update({**scenario.plant, **(IDEAL_SENSORS if args.ideal else {}), **overrides["plant"]})
     check_passive(recording, scenario, plant, n, args.step, args.set)
     if args.out:
-        write_csv(args.out, recording_columns(recording), force=args.force)
+        write_csv(
+            args.out,
+            recording_columns(recording),
+            units=recording.units,
+            tool_names=args.tool_names,
+            force=args.force,
+        )
     final = {
         key.split(".", 1)[1]: float(series[-1])
         for key, series in recording.signals.items()

@@ -92,6 +92,7 @@ def reproduce(
     show_progress: bool = True,
     fmu_dir: Path | None = None,
     force: bool = False,
+    tool_names: bool = False,
 ) -> Results:
     """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
 
@@ -108,6 +109,9 @@ def reproduce(
         Folder of the FMUs, built there if missing or stale (default: the per-user cache).
     force : bool
         Whether the files of :data:`OUTPUTS` may be replaced.
+    tool_names : bool
+        Whether the CSV columns are named for other tools (``theta_hat_1``;
+        :func:`arcosim.logs.tool_name`); each CSV's units are in its ``.units.json``.
 
     Returns
     -------
@@ -135,7 +139,9 @@ def reproduce(
         disable=not show_progress,
         desc="reproduce",
     ) as bar:
-        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str)
+        bench = _Bench(
+            out, folder, ideal, results, bar.update, bar.set_postfix_str, tool_names=tool_names
+        )
         actuator = _self_identification(bench)
         rigid, k_mean, b_mean = _rigid_maneuvers(bench, actuator)
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
@@ -175,6 +181,7 @@ class _Bench:
     results: Results
     progress: Callable[[int], object]
     status: Callable[[str], object]
+    tool_names: bool = False
 
     def run(self, name: str, **settings: dict) -> Recording:
         """Co-simulate the scenario ``name`` on the bench (``plant=``, ``observer=``)."""
@@ -190,7 +197,13 @@ class _Bench:
 
     def keep(self, name: str, recording: Recording) -> None:
         """Write ``recording`` as the CSV ``name`` in the output folder."""
-        path = write_csv(self.out / name, recording_columns(recording), force=True)
+        path = write_csv(
+            self.out / name,
+            recording_columns(recording),
+            units=recording.units,
+            tool_names=self.tool_names,
+            force=True,
+        )
         self.results.files.append(path)
 
     @functools.cached_property
