@@ -18,6 +18,7 @@ from arcosim.experiments import reproduce as experiments
 from arcosim.experiments.findings import (
     LOAD_HEADER,
     TABLE_II_HEADER,
+    TABLE_II_NOTE,
     WHOLE_CHAIN_HEADER,
     actuator_rows,
     load_angle_rows,
@@ -66,6 +67,7 @@ def _execute(args: argparse.Namespace) -> int:
     print(text_table(["term", "identified", "true", "error"], actuator_rows(results)))
     print("\n2. Table II: five rigid maneuvers (ours) next to the paper's")
     print(text_table(TABLE_II_HEADER, table_ii_rows(results)))
+    print(TABLE_II_NOTE)
     print("\n3. State estimation (recursion), score rms(θ̂_i − θ_i) / rms(θ_i − θ_m)")
     print(text_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(results)))
     print(f"\n4. Whole chain from the motor alone (n = {results.masses} read from the record)")

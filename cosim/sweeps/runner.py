@@ -281,14 +281,15 @@ def result_units(
     spec: SweepSpec, variables: Mapping[str, Mapping[str, object]], columns: Sequence[str]
 ) -> dict[str, str]:
     """The unit of each column of ``results.csv`` (its sidecar ``results.units.json``):
-    a varied parameter's as its FMU declares it, ``%`` for the parameter errors, ``1``
-    for the run's number and the θ scores (ratios), ``""`` for the error message."""
+    a varied parameter's as its FMU declares it, ``%`` for the parameter errors, ``s``
+    for the runtime, ``1`` for the run's number and the θ scores (ratios), ``""`` for
+    the error message."""
     units = {"run": "1", "error": ""}
     for name in spec.vary:
         fmu, variable = name.split(".", 1)
         units[name] = getattr(variables[fmu][variable], "unit", None) or "1"
     for name in metric_columns(spec):
-        units[name] = "1" if name.startswith("theta_error") else "%"
+        units[name] = {"runtime": "s"}.get(name, "1" if name.startswith("theta_") else "%")
     return {column: units[column] for column in columns}
 
 
