@@ -112,21 +112,48 @@ ROLE = re.compile(
 )
 
 
-def convert_roles(obj: griffe.Object, collection: griffe.ModulesCollection) -> None:
-    """Rewrite the Sphinx roles of the docstrings of ``obj`` and its members as Markdown.
+#: A line of a package's catalogue: ``name   -- what it holds`` (continued below,
+#: indented to the text).
+CATALOGUE = re.compile(r"^(?P<name>[A-Za-z_][\w.]*(?:, [A-Za-z_][\w.]*)*) +-- (?P<text>.*)$")
 
-    A role whose target griffe finds becomes an optional cross-reference (a link when
-    the target has a page, its name in code otherwise); any other becomes code. The
-    docstrings keep their roles in the sources: help() and numpydoc read them there.
+
+def convert_roles(obj: griffe.Object, collection: griffe.ModulesCollection) -> None:
+    """Rewrite the docstrings of ``obj`` and its members for Markdown, in the loaded copy.
+
+    A Sphinx role whose target griffe finds becomes an optional cross-reference (a
+    link when the target has a page, its name in code otherwise); any other becomes
+    code. A package's catalogue (``name -- text`` lines) becomes a list, where
+    Markdown would run its lines together into one paragraph. The sources keep both
+    as they are: ``help()`` and the terminal read them there.
     """
-    if obj.docstring is not None and ROLE.search(obj.docstring.value):
-        obj.docstring.value = ROLE.sub(
-            lambda m: markdown_role(m, obj, collection), obj.docstring.value
+    docstring = obj.docstring
+    if docstring is not None:
+        text = catalogue_lists(
+            ROLE.sub(lambda m: markdown_role(m, obj, collection), docstring.value)
         )
-        obj.docstring.__dict__.pop("parsed", None)  # parsed again from the new text
+        if text != docstring.value:
+            docstring.value = text
+            docstring.__dict__.pop("parsed", None)  # parsed again from the new text
     for member in obj.members.values():
         if not member.is_alias:
             convert_roles(member, collection)
+
+
+def catalogue_lists(text: str) -> str:
+    """Catalogue lines (``name -- text`` and their indented continuations) as a list."""
+    out: list[str] = []
+    item = False
+    for line in text.split("\n"):
+        match = CATALOGUE.match(line)
+        if match:
+            out.append(f"- `{match['name']}` — {match['text']}")
+            item = True
+        elif item and line.startswith("    ") and line.strip():
+            out[-1] += " " + line.strip()
+        else:
+            out.append(line)
+            item = False
+    return "\n".join(out)
 
 
 def markdown_role(match: re.Match, obj: griffe.Object, collection: griffe.ModulesCollection) -> str:
