@@ -27,7 +27,7 @@ def _legend_above(fig, ax, ncol: int) -> None:
     handles, labels = ax.get_legend_handles_labels()
     fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.955), ncol=ncol,
                fontsize=8, frameon=False)  # fmt: skip
-    fig.tight_layout(rect=(0, 0, 1, 0.91))
+    fig.tight_layout(rect=(0, 0, 1, 0.935))
 
 
 def _symlog_if_diverging(ax, truth: np.ndarray, estimate: np.ndarray) -> None:
@@ -35,7 +35,9 @@ def _symlog_if_diverging(ax, truth: np.ndarray, estimate: np.ndarray) -> None:
     recursion): linear over the truth's range, decades beyond it, so both show."""
     scale = float(np.max(np.abs(truth))) if truth.size else 0.0
     if scale > 0 and estimate.size and float(np.max(np.abs(estimate))) > 5 * scale:
-        ax.set_yscale("symlog", linthresh=scale, linscale=1.5)
+        ax.set_yscale("symlog", linthresh=scale, linscale=4.0)
+        for line in ax.get_lines()[1:]:
+            line.set(alpha=0.45, lw=0.5, ls="-")
         ax.axhspan(-scale, scale, color="0.92", zorder=0)
 
 
@@ -158,8 +160,8 @@ def figure_state_estimates(
         motor = run["plant.theta_m_true"][shown]
         truth = (run[f"plant.theta[{i}]"][shown] - motor) * 1e3
         estimate = (run[f"observer.theta_hat[{i}]"][shown] - motor) * 1e3
-        ax.plot(t, truth, color="C0", lw=1.4, label="true")
-        ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label)
+        ax.plot(t, truth, color="C0", lw=1.4, label="true", zorder=3)  # over a diverged θ̂
+        ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label, zorder=2)
         ax.set_ylabel(f"θ_{i} − θ_m (mrad)")
         ax.grid(True, alpha=0.3)
         return truth, estimate
