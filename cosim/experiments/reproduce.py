@@ -110,8 +110,7 @@ def reproduce(
     force : bool
         Whether the files of :data:`OUTPUTS` may be replaced.
     tool_names : bool
-        Whether the CSV columns are named for other tools (``theta_hat_1``;
-        :func:`arcosim.logs.tool_name`); each CSV's units are in its ``.units.json``.
+        Whether the CSV columns are named for other tools (:func:`arcosim.logs.tool_name`).
 
     Returns
     -------
@@ -139,9 +138,7 @@ def reproduce(
         disable=not show_progress,
         desc="reproduce",
     ) as bar:
-        bench = _Bench(
-            out, folder, ideal, results, bar.update, bar.set_postfix_str, tool_names=tool_names
-        )
+        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str, tool_names)
         actuator = _self_identification(bench)
         rigid, k_mean, b_mean = _rigid_maneuvers(bench, actuator)
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
@@ -197,12 +194,9 @@ class _Bench:
 
     def keep(self, name: str, recording: Recording) -> None:
         """Write ``recording`` as the CSV ``name`` in the output folder."""
+        columns, units = recording_columns(recording), recording.units
         path = write_csv(
-            self.out / name,
-            recording_columns(recording),
-            units=recording.units,
-            tool_names=self.tool_names,
-            force=True,
+            self.out / name, columns, units=units, tool_names=self.tool_names, force=True
         )
         self.results.files.append(path)
 
