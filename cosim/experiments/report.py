@@ -36,8 +36,16 @@ def _symlog_if_diverging(ax, truth: np.ndarray, estimate: np.ndarray) -> None:
     scale = float(np.max(np.abs(truth))) if truth.size else 0.0
     if scale > 0 and estimate.size and float(np.max(np.abs(estimate))) > 5 * scale:
         ax.set_yscale("symlog", linthresh=scale, linscale=4.0)
-        for line in ax.get_lines()[1:]:
+        truth_line, *others = ax.get_lines()
+        truth_line.set_zorder(3)  # the truth over the diverged estimate
+        for line in others:
             line.set(alpha=0.45, lw=0.5, ls="-")
+        top = int(np.ceil(np.log10(float(np.max(np.abs(estimate))))))
+        low = int(np.floor(np.log10(scale)))
+        decades = range(top, low + 1, -max(1, (top - low) // 3))  # at most ~4 a side
+        ticks = [*(10.0**k for k in decades), float(f"{scale:.1g}")]  # and the band's edge
+        ax.set_yticks([*(-x for x in ticks), 0.0, *ticks[::-1]])
+        ax.set_ylim(-(10.0**top), 10.0**top)
         ax.axhspan(-scale, scale, color="0.92", zorder=0)
 
 
@@ -160,8 +168,8 @@ def figure_state_estimates(
         motor = run["plant.theta_m_true"][shown]
         truth = (run[f"plant.theta[{i}]"][shown] - motor) * 1e3
         estimate = (run[f"observer.theta_hat[{i}]"][shown] - motor) * 1e3
-        ax.plot(t, truth, color="C0", lw=1.4, label="true", zorder=3)  # over a diverged θ̂
-        ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label, zorder=2)
+        ax.plot(t, truth, color="C0", lw=1.4, label="true")
+        ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label)
         ax.set_ylabel(f"θ_{i} − θ_m (mrad)")
         ax.grid(True, alpha=0.3)
         return truth, estimate
