@@ -62,7 +62,7 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
         "",
     ]
     if seeds:
-        lines[-1:-1] = [
+        lines += [
             f"{', '.join(seeds)} draws a new noise each run, not a factor: no rows or plots "
             "of its own.",
             "",
