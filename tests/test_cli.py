@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -85,8 +86,11 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     runs = ("selfid.csv", "flexible.csv", "identification.csv", "whole_chain.csv")
     for name in (*runs, *(f"rigid_seed{s}.csv" for s in range(1, 6))):
         assert (out / name).stat().st_size > 100_000, name
+    units = json.loads((out / "flexible.units.json").read_text())  # every CSV's units
+    assert units["time"] == "s" and units["observer.theta_hat[1]"] == "rad" and all(units.values())
     report = (out / "report.md").read_text()
     assert "Table II" in report and "fig6_state_estimates.png" in report
+    assert "B err: B is weakly identifiable" in result.stdout  # why −2395 %, under the table
     assert "Table II" in result.stdout and "spread (std)" in result.stdout
     mean_row = next(line for line in result.stdout.splitlines() if line.strip().startswith("mean"))
     k_error = float(mean_row.split()[2])  # "k err" column, in %

@@ -50,7 +50,7 @@ from arcosim.experiments.scenarios import (
 )
 from arcosim.host.master import ORDERINGS, Recording
 from arcosim.host.overrides import split_overrides
-from arcosim.logs import write_csv
+from arcosim.logs import tool_keys, write_csv
 from arcosim.outputs import check_output
 
 
@@ -136,7 +136,7 @@ def _execute(args: argparse.Namespace) -> int:
         if key.startswith("observer.")
     }
     if args.json:
-        print(json.dumps(final, indent=2))
+        print(json.dumps(tool_keys(final) if args.tool_names else final, indent=2))
     else:
         print(
             f"{scenario.name}: {len(recording.time) - 1} steps of {args.step:g} s ({args.ordering})"
