@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 from arcosim.build.recipes import check_masses
@@ -74,6 +75,8 @@ def read_chain(path: str | Path) -> dict[str, float]:
         raise ChainFileError(f"{path}: cannot read it as JSON ({error})") from None
     if not isinstance(data, dict):
         raise ChainFileError(f"{path}: expected a JSON object with J[i], k[i], B[i]")
+    # a report written with --tool-names: J_1 for J[1]
+    data = {re.sub(r"^([JkB])_(\d+)$", r"\1[\2]", k): v for k, v in data.items()}
     chain = {k: v for k, v in data.items() if _is_chain_value(k)}
     for key, value in chain.items():
         _check_number(path, key, value)

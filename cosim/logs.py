@@ -4,6 +4,15 @@ A log is a CSV file with a header row and at least the columns ``time`` (s),
 ``i_a`` (A), ``omega_m`` (rad/s) and ``theta_m`` (rad), one row per sample as the
 timing contract of docs/method.md defines it: the angle and velocity at ``time``
 and the current that acted over the step ending at ``time``.
+
+Every CSV file arcosim writes (``write_csv``) has a sidecar ``FILE.units.json``,
+``{column: unit}`` (FMI unit names: ``"rad/s"``, ``"N.m"``; ``"1"`` for a count or a
+code; ``"%"`` for a percent error), so the CSV itself stays a plain header and numbers
+that any reader takes. Asked for tool-safe names (``tool_names=True``, the CLI's
+``--tool-names``), the columns are written as ``theta_hat_1`` for ``theta_hat[1]`` and
+``plant_i_noise_std`` for ``plant.i_noise_std``, names MATLAB, R or a spreadsheet keep as
+they are (``tool_name``); the log columns are such names already, so ``read_log`` reads
+either form, and files without a sidecar as before.
 """
 
 from __future__ import annotations
@@ -11,7 +20,9 @@ from __future__ import annotations
 import codecs
 import csv
 import io
+import json
 import math
+import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,9 +30,24 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.errors import UserError
-from arcosim.outputs import atomic_output
+from arcosim.outputs import atomic_output, write_text
 
 LOG_COLUMNS = ("time", "i_a", "omega_m", "theta_m")
+#: Units of the columns arcosim writes that no recording states (a recording carries
+#: its FMUs' units), by name without its ``fmu.`` prefix and ``[i]`` index.
+COLUMN_UNITS = {
+    "time": "s",
+    "i_a": "A",
+    "omega_m": "rad/s",
+    "theta_m": "rad",
+    "i_ref": "A",
+    "omega_ref": "rad/s",
+    "tau_load_hat": "N.m",
+    "tau_reac_hat": "N.m",
+    "theta_hat": "rad",
+    "omega_hat": "rad/s",
+    "innovation": "N.m",
+}
 
 
 @dataclass(frozen=True)
@@ -230,10 +256,13 @@ def write_csv(
     path: str | Path,
     columns: Mapping[str, np.ndarray],
     *,
+    units: Mapping[str, str] | None = None,
+    tool_names: bool = False,
     force: bool = False,
     option: str = "--out",
 ) -> Path:
-    """Write columns of equal length as a CSV file with a header, at full precision.
+    """Write columns of equal length as a CSV file with a header, at full precision,
+    and their units beside it (``FILE.units.json``, ``{column: unit}``).
 
     Parameters
     ----------
@@ -241,9 +270,16 @@ def write_csv(
         The file to write (its folder is created if needed). Written atomically
         (:func:`arcosim.outputs.atomic_output`): never left half-written.
     columns : mapping of str to ndarray
-        Column name → values (any unit; the name should say it), each of shape ``(N,)``.
+        Column name → values, each of shape ``(N,)``.
+    units : mapping of str to str, optional
+        Column name → unit (a recording's ``units``); a column it lacks takes its unit
+        from :data:`COLUMN_UNITS`.
+    tool_names : bool
+        Whether to write the names tool-safe (:func:`tool_name`: ``theta_hat_1``), in
+        the CSV and in its sidecar.
     force : bool
-        Whether an existing file may be replaced (else :class:`UserError`).
+        Whether an existing file may be replaced (else :class:`UserError`); the
+        sidecar belongs to the file and is replaced with it.
     option : str
         The option that named ``path``, for messages.
 
@@ -260,10 +296,82 @@ def write_csv(
     >>> _ = arcosim.write_csv(path, {"time": np.array([0.0, 0.001]), "i_a": np.array([0.0, 0.5])})
     >>> path.read_text().splitlines()[0]
     'time,i_a'
+    >>> from arcosim.logs import read_units
+    >>> read_units(path)
+    {'time': 's', 'i_a': 'A'}
     """
     path = Path(path)
     names = list(columns)
+    found = column_units(names, units)
+    written = [tool_name(n) for n in names] if tool_names else names
+    if len(set(written)) != len(written):
+        raise UserError(f"{option} {path}: --tool-names gives two columns one name; drop one")
     data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     with atomic_output(path, "w", force=force, option=option) as f:
-        np.savetxt(f, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+        np.savetxt(f, data, delimiter=",", header=",".join(written), comments="", fmt="%.17g")
+    sidecar = {w: found[n] for w, n in zip(written, names)}
+    write_text(units_path(path), json.dumps(sidecar, indent=1) + "\n", force=True, option=option)
     return path
+
+
+def tool_name(name: str) -> str:
+    """A column or key name as other tools keep it: letters, digits and ``_`` only.
+
+    Parameters
+    ----------
+    name : str
+        A name as arcosim writes it: ``"theta_hat[1]"``, ``"plant.i_noise_std"``.
+
+    Returns
+    -------
+    str
+        Every run of other characters as one ``_``, none at the ends, and an ``x`` in
+        front of a leading digit: ``"theta_hat_1"``, ``"plant_i_noise_std"``.
+
+    Examples
+    --------
+    >>> tool_name("theta_hat[1]"), tool_name("plant.i_noise_std"), tool_name("J[2]")
+    ('theta_hat_1', 'plant_i_noise_std', 'J_2')
+    """
+    safe = re.sub(r"[^0-9A-Za-z_]+", "_", name).strip("_") or "x"
+    return f"x{safe}" if safe[0].isdigit() else safe
+
+
+def tool_keys(value: object) -> object:
+    """``value`` (JSON data) with every dict key made tool-safe (:func:`tool_name`), at any
+    depth; refuse two keys that become one."""
+    if isinstance(value, dict):
+        renamed = {tool_name(str(k)): tool_keys(v) for k, v in value.items()}
+        if len(renamed) != len(value):
+            raise UserError(f"--tool-names: two keys of {list(value)[:8]} give one name")
+        return renamed
+    if isinstance(value, list):
+        return [tool_keys(v) for v in value]
+    return value
+
+
+def units_path(path: str | Path) -> Path:
+    """The units sidecar of a CSV file: ``FILE.csv`` → ``FILE.units.json``."""
+    path = Path(path)
+    return path.with_name(f"{path.stem if path.suffix == '.csv' else path.name}.units.json")
+
+
+def column_units(names: Iterable[str], units: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The unit of each column: from ``units``, else :data:`COLUMN_UNITS` by the name
+    without its ``fmu.`` prefix and ``[i]`` index; ``""`` when neither knows it."""
+    units = units or {}
+    found = {}
+    for name in names:
+        base = re.sub(r"\[\d+\]$", "", name.rpartition(".")[2] if "." in name else name)
+        found[name] = units.get(name) or COLUMN_UNITS.get(base, "")
+    return found
+
+
+def read_units(path: str | Path) -> dict[str, str]:
+    """The units of a CSV file's columns from its sidecar (:func:`units_path`); ``{}``
+    for a file written without one."""
+    sidecar = units_path(path)
+    if not sidecar.is_file():
+        return {}
+    units = json.loads(read_text_file(sidecar, "units file"))
+    return {str(k): str(v) for k, v in units.items()}

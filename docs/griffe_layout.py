@@ -14,6 +14,7 @@ Used by mkdocstrings (``mkdocs.yml``: ``extensions: [docs/griffe_layout.py:Insta
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -96,8 +97,95 @@ class InstalledLayout(griffe.Extension):
         loader.modules_collection.set_member(package.path, package)
         loader.expand_exports(package)
         loader.expand_wildcards(package, external=False)
+        convert_roles(package, loader.modules_collection)
         self.replacing = True
         try:  # the other extensions (griffe's dataclasses) see the package read here
             loader.extensions.call("on_package", pkg=package, loader=loader)
         finally:
             self.replacing = False
+
+
+#: A Sphinx role in a docstring: ``:func:`name```, ``:class:`~arcosim.x.Name```,
+#: ``:ref:`text <target>```.
+ROLE = re.compile(
+    r":(?:py:)?(?P<role>func|mod|class|data|meth|attr|ref|obj|exc|const):`(?P<target>[^`]+)`"
+)
+
+
+#: A line of a package's catalogue: ``name   -- what it holds`` (continued below,
+#: indented to the text).
+CATALOGUE = re.compile(r"^(?P<name>[A-Za-z_][\w.]*(?:, [A-Za-z_][\w.]*)*) +-- (?P<text>.*)$")
+
+
+def convert_roles(obj: griffe.Object, collection: griffe.ModulesCollection) -> None:
+    """Rewrite the docstrings of ``obj`` and its members for Markdown, in the loaded copy.
+
+    A Sphinx role whose target griffe finds becomes an optional cross-reference (a
+    link when the target has a page, its name in code otherwise); any other becomes
+    code. A package's catalogue (``name -- text`` lines) becomes a list, where
+    Markdown would run its lines together into one paragraph. The sources keep both
+    as they are: ``help()`` and the terminal read them there.
+    """
+    docstring = obj.docstring
+    if docstring is not None:
+        text = catalogue_lists(
+            ROLE.sub(lambda m: markdown_role(m, obj, collection), docstring.value)
+        )
+        if text != docstring.value:
+            docstring.value = text
+            docstring.__dict__.pop("parsed", None)  # parsed again from the new text
+    for member in obj.members.values():
+        if not member.is_alias:
+            convert_roles(member, collection)
+
+
+def catalogue_lists(text: str) -> str:
+    """Catalogue lines (``name -- text`` and their indented continuations) as a list."""
+    out: list[str] = []
+    item = False
+    for line in text.split("\n"):
+        match = CATALOGUE.match(line)
+        if match:
+            out.append(f"- `{match['name']}` — {match['text']}")
+            item = True
+        elif item and line.startswith("    ") and line.strip():
+            out[-1] += " " + line.strip()
+        else:
+            out.append(line)
+            item = False
+    return "\n".join(out)
+
+
+def markdown_role(match: re.Match, obj: griffe.Object, collection: griffe.ModulesCollection) -> str:
+    """One role as Markdown: ``<autoref optional …><code>name</code></autoref>`` or code."""
+    target = match["target"].strip()
+    if match["role"] == "ref":
+        text, _, _ = target.partition("<")
+        return text.strip()
+    short = target.startswith("~")
+    target = target.lstrip("~!.")
+    shown = target.rpartition(".")[2] if short else target
+    path = resolved(target, obj, collection)
+    code = f"<code>{shown}</code>"
+    if path is None:
+        return f"`{shown}`"
+    return f'<autoref identifier="{path}" optional>{code}</autoref>'
+
+
+def resolved(target: str, obj: griffe.Object, collection: griffe.ModulesCollection) -> str | None:
+    """The full path of ``target`` as seen from ``obj``, if griffe has that object."""
+    head, _, rest = target.partition(".")
+    candidates = [target]
+    scope = obj if obj.is_module or obj.is_class else obj.parent
+    try:
+        first = scope.resolve(head) if scope is not None else head
+        candidates.insert(0, f"{first}.{rest}" if rest else first)
+    except (griffe.NameResolutionError, AttributeError):
+        pass
+    for path in candidates:
+        try:
+            collection[path]
+        except (KeyError, ValueError, AttributeError, griffe.AliasResolutionError):
+            continue
+        return path
+    return None

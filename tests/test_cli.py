@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -91,8 +92,11 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     for name in ("rigid_seed2.csv", "whole_chain.csv", "load_identified_chain.csv"):
         assert not (out / name).exists(), name
     assert sum(p.stat().st_size for p in out.iterdir()) < 10_000_000  # measured 6.6 MB
+    units = json.loads((out / "flexible.units.json").read_text())  # every CSV's units
+    assert units == {"time": "s", "i_a": "A", "omega_m": "rad/s", "theta_m": "rad"}, units
     report = (out / "report.md").read_text()
     assert "Table II" in report and "fig6_state_estimates.png" in report
+    assert "B err: B is weakly identifiable" in result.stdout  # why −2395 %, under the table
     assert "Table II" in result.stdout and "spread (std)" in result.stdout
     mean_row = next(line for line in result.stdout.splitlines() if line.strip().startswith("mean"))
     k_error = float(mean_row.split()[2])  # "k err" column, in %

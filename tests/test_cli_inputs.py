@@ -80,7 +80,8 @@ def test_out_never_replaces_a_file_without_force(capsys, fmus, log, tmp_path, co
     code, stdout, err = run(capsys, *argv, "--out", out, "--force")
     assert code == 0, err
     assert out.read_text().startswith("time,") and f"wrote {out}" in stdout
-    assert [p.name for p in tmp_path.iterdir()] == ["result.csv"]  # no temporary left
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == ["result.csv", "result.units.json"]  # no temporary left; the units beside
 
 
 def test_simulate_never_writes_over_an_fmu_it_runs(capsys, fmus) -> None:

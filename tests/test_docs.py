@@ -1,4 +1,5 @@
-"""The docs check fails on a broken link (issue 27), and the docs pass it.
+"""The docs check fails on a broken link (issue 27), and the docs pass it; the API pages
+show no raw Sphinx role and no docstring section left as a paragraph.
 
 ``make test`` and ``make docs`` run ``$(MKDOCS)`` from the Makefile; these tests run that
 very command on a copy of the docs, the package's folders and ``pyproject.toml`` (the
@@ -9,10 +10,12 @@ as they are and once with a link to a page that is not there. ``mkdocs build --s
 
 from __future__ import annotations
 
+import re
 import shlex
 import shutil
 import subprocess
 import sys
+from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
@@ -20,6 +23,15 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 #: What the docs build reads.
 INPUTS = ("mkdocs.yml", "pyproject.toml", "docs", "cosim", "fmu_src", "plant_models")
+#: A Sphinx role left as text (``:func:`read_log```): the API pages must show none.
+RAW_ROLE = re.compile(r":(func|mod|class|data|meth|attr|ref|obj):")
+#: A docstring section header the numpydoc parser did not take (Google style, or a
+#: section it did not recognise), at the start of a line of a paragraph.
+SECTION = re.compile(
+    r"^\s*(Args|Arguments|Attributes|Returns|Raises|Yields|Parameters|Examples|Notes|"
+    r"Keyword Args|Other Parameters|See Also|Warns)\s*:",
+    re.MULTILINE,
+)
 
 
 def docs_command() -> list[str]:
@@ -53,12 +65,76 @@ def test_the_docs_check_is_strict_and_not_quiet() -> None:
     assert command[1:] == ["-m", "mkdocs", "build", "--strict"]
 
 
+class Paragraphs(HTMLParser):
+    """The text of every ``<p>`` of a page but mkdocstrings' own section titles."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.texts: list[str] = []
+        self.depth = 0
+
+    def handle_starttag(self, tag: str, attrs: list) -> None:
+        if tag == "p":
+            self.depth += 1
+            self.texts.append("")
+        elif self.depth and "doc-section-title" in (dict(attrs).get("class") or ""):
+            self.texts[-1] += "\x00"  # a title mkdocstrings rendered: not a paragraph
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "p" and self.depth:
+            self.depth -= 1
+
+    def handle_data(self, data: str) -> None:
+        if self.depth:
+            self.texts[-1] += data
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess]:
+    """The docs as they are, built once: the copy's folder and the build's result."""
+    folder = copy_of_the_docs(tmp_path_factory.mktemp("docs"))
+    return folder, build(folder)
+
+
 @pytest.mark.system
-def test_the_docs_pass_the_check(tmp_path: Path) -> None:
-    result = build(copy_of_the_docs(tmp_path))
+def test_the_docs_pass_the_check(built: tuple[Path, subprocess.CompletedProcess]) -> None:
+    folder, result = built
     assert result.returncode == 0, result.stderr[-3000:]
     assert "WARNING" not in result.stderr, result.stderr[-3000:]
-    assert (tmp_path / ".site" / "api" / "fmu" / "index.html").is_file()
+    assert (folder / ".site" / "api" / "fmu" / "index.html").is_file()
+
+
+@pytest.mark.system
+def test_the_api_pages_show_no_raw_markup(built: tuple[Path, subprocess.CompletedProcess]) -> None:
+    folder, result = built
+    assert result.returncode == 0, result.stderr[-3000:]
+    pages = sorted((folder / ".site" / "api").rglob("*.html"))
+    assert len(pages) >= 7
+    roles, sections = [], []
+    for page in pages:
+        html = page.read_text(encoding="utf-8")
+        name = page.relative_to(folder / ".site")
+        roles += [
+            f"{name}: {html[m.start() - 40 : m.end() + 40]!r}" for m in RAW_ROLE.finditer(html)
+        ]
+        parser = Paragraphs()
+        parser.feed(html)
+        sections += [
+            f"{name}: {text[:80]!r}"
+            for text in parser.texts
+            if "\x00" not in text and SECTION.search(text)
+        ]
+    assert not roles, f"{len(roles)} raw Sphinx roles, e.g. " + "; ".join(roles[:5])
+    assert not sections, f"{len(sections)} sections left as paragraphs: " + "; ".join(sections[:5])
+
+
+@pytest.mark.system
+def test_wide_tables_wrap(built: tuple[Path, subprocess.CompletedProcess]) -> None:
+    folder, _ = built
+    css = (folder / ".site" / "css" / "extra.css").read_text(encoding="utf-8")
+    assert "white-space: normal" in css and "overflow-x: auto" in css
+    page = (folder / ".site" / "index.html").read_text(encoding="utf-8")
+    assert "css/extra.css" in page
 
 
 @pytest.mark.system

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from arcosim.build.builder import fmu_variables
 from arcosim.cli import main
 from arcosim.errors import UserError
 from arcosim.sweeps.runner import draw_runs, load_spec, read_results, sweep
+from arcosim.sweeps.spec import metric_columns
 
 SMALL = """
 name = "small"
@@ -179,3 +182,42 @@ def test_example_spec_is_valid() -> None:
     }
     with open(Path(__file__).parents[1] / "examples" / "sweep_noise_encoder_gdist.toml") as f:
         assert "arcosim sweep" in f.read()
+
+
+def test_summary_plots_carry_units_and_leave_the_seed_out(fmus, tmp_path, monkeypatch) -> None:
+    """Issue 27: the plots' axes say their units; ``plant.seed`` is no factor."""
+    import csv
+    import json
+
+    from arcosim.sweeps import summary
+    from arcosim.sweeps.runner import result_units
+
+    spec = load_spec(Path(__file__).parents[1] / "examples" / "sweep_noise_encoder_gdist.toml")
+    variables = fmu_variables(fmus)
+    columns = ["run", *spec.vary, *metric_columns(spec), "error"]
+    results = tmp_path / "results.csv"
+    rng = np.random.default_rng(1)
+    with open(results, "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=columns)
+        writer.writeheader()
+        for run in range(12):
+            row = {"run": run, "error": "", "plant.encoder_cpr": 2000, "plant.seed": run + 7}
+            row |= {"plant.i_noise_std": rng.uniform(0, 0.02), "observer.g_dist": 100.0}
+            row |= {"k_error": rng.normal(), "B_error": rng.normal(), "runtime": 1.0}
+            writer.writerow(row)
+    units = result_units(spec, variables, columns)
+    assert units["plant.i_noise_std"] == "A" and units["observer.g_dist"] == "rad/s"
+    assert units["k_error"] == "%" and units["runtime"] == "s" and units["plant.seed"] == "1"
+    (tmp_path / "results.units.json").write_text(json.dumps(units))
+    labels = []
+
+    def keep_labels(figure, path, **_):
+        labels.extend(ax.get_xlabel() for ax in figure.axes)
+        return path
+
+    monkeypatch.setattr(summary, "save_figure", keep_labels)
+    text = summary.write_summary(spec, results, tmp_path).read_text()
+    assert "plant.i_noise_std (A)" in labels and "k_error (%)" in labels
+    assert "observer.g_dist (rad/s)" in labels and "runtime (s)" in labels
+    assert not any("seed" in label for label in labels)
+    assert "| plant.seed" not in text and "plant.seed draws a new noise" in text

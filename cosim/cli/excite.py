@@ -96,7 +96,7 @@ def _execute(args: argparse.Namespace) -> int:
         g_dist=args.g_dist,
         speed_gain=args.speed_gain,
     )
-    write_csv(args.out, design.columns(), force=args.force)
+    write_csv(args.out, design.columns(), tool_names=args.tool_names, force=args.force)
     if args.json:
         print(
             json.dumps(

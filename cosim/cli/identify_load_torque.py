@@ -61,7 +61,7 @@ def run_load_torque(args: argparse.Namespace, log: DriveLog, n: int) -> int:
             "torque_noise_std, tau_noise_std, load_torque_bandwidth and the chain"
         ) from None
     if args.out:
-        write_csv(args.out, result.columns(), force=args.force)
+        write_csv(args.out, result.columns(), tool_names=args.tool_names, force=args.force)
     last = log.time >= log.time[-1] - 1.0
     report = {
         "method": "load-torque",

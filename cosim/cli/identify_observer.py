@@ -16,7 +16,7 @@ from arcosim.cli.parameters import defaults_note, drive_parameters, known_parame
 from arcosim.fmu.flexchain.codes import Mode
 from arcosim.host.instance import FmuInstance
 from arcosim.host.replay import final_values, observer_parameters, replay_log
-from arcosim.logs import DriveLog, write_csv
+from arcosim.logs import DriveLog, tool_keys, write_csv
 
 
 def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
@@ -56,9 +56,10 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     if args.out:
         columns = {"time": recording.time}
         columns.update({k.split(".", 1)[1]: v for k, v in recording.signals.items()})
-        write_csv(args.out, columns, force=args.force)
+        units = {k.split(".", 1)[1]: v for k, v in recording.units.items()}
+        write_csv(args.out, columns, units=units, tool_names=args.tool_names, force=args.force)
     if args.json:
-        print(json.dumps(final, indent=2))
+        print(json.dumps(tool_keys(final) if args.tool_names else final, indent=2))
         if defaults:
             print(f"arcosim identify: assumption, defaults: {defaults}", file=sys.stderr)
     else:

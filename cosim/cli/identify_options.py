@@ -16,6 +16,7 @@ from arcosim.build.recipes import check_masses
 from arcosim.chainfile import ChainFileError, read_chain
 from arcosim.cli.parameters import set_names
 from arcosim.errors import UserError
+from arcosim.logs import tool_keys
 from arcosim.outputs import check_output, write_text
 
 #: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
@@ -190,4 +191,5 @@ def write_report(args: argparse.Namespace, report: Mapping[str, object]) -> None
             "does not determine them; check --set and the excitation"
         )
     if args.out:
-        write_text(args.out, json.dumps(report, indent=2) + "\n", force=args.force)
+        shown = tool_keys(report) if args.tool_names else report
+        write_text(args.out, json.dumps(shown, indent=2) + "\n", force=args.force)

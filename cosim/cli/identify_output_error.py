@@ -15,7 +15,7 @@ from arcosim.errors import UserError
 from arcosim.identification.output_error import ParameterFit
 from arcosim.identification.records import MotorRecord, motor_record
 from arcosim.identification.uniform_fit import clamped_frequencies, uniform_chain
-from arcosim.logs import DriveLog
+from arcosim.logs import DriveLog, tool_keys
 
 #: The report's names of the fit's parameters.
 REPORT_NAMES = {"k": "k_hat", "B": "B_hat", "J_scale": "J_scale"}
@@ -65,7 +65,7 @@ def run_output_error(args: argparse.Namespace, log: DriveLog, n: int) -> int:
         report["assumptions"] = {"defaults": defaults}
     write_report(args, report)
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(tool_keys(report) if args.tool_names else report, indent=2))
     else:
         _print_report(report, len(log), n, defaults)
     return 0

@@ -13,7 +13,7 @@ from arcosim.cli.identify_options import write_report
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
 from arcosim.identification.drive import DriveIdentification, identify_drive
 from arcosim.identification.whole_chain import MAX_AUTO_MASSES
-from arcosim.logs import DriveLog
+from arcosim.logs import DriveLog, tool_keys
 
 
 def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
@@ -65,7 +65,7 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     report = result.report()
     write_report(args, report)
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(tool_keys(report) if args.tool_names else report, indent=2))
     else:
         _print_report(result, report, len(log))
     return 0

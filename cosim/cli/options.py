@@ -178,8 +178,21 @@ def log_options(parser: argparse.ArgumentParser, set_help: str) -> None:
 
 
 def force_option(parser: argparse.ArgumentParser) -> None:
-    """``--force``: replace an existing output file."""
+    """The options of a command that writes a file: ``--force`` (replace an existing
+    output file) and ``--tool-names`` (:func:`tool_names_option`)."""
     parser.add_argument("--force", action="store_true", help="replace the output file if it exists")
+    tool_names_option(parser)
+
+
+def tool_names_option(parser: argparse.ArgumentParser) -> None:
+    """``--tool-names``: write CSV columns and JSON keys as names other tools keep
+    (``theta_hat_1`` for ``theta_hat[1]``, :func:`arcosim.logs.tool_name`)."""
+    parser.add_argument(
+        "--tool-names",
+        action="store_true",
+        help="name CSV columns and JSON keys for MATLAB/R/spreadsheets: theta_hat_1, not "
+        "theta_hat[1] (units are always in FILE.units.json beside each CSV)",
+    )
 
 
 def add_fmus_option(parser: argparse.ArgumentParser) -> None:

@@ -14,10 +14,11 @@ import argparse
 import time
 from pathlib import Path
 
-from arcosim.cli.options import add_command, add_fmus_option
+from arcosim.cli.options import add_command, add_fmus_option, tool_names_option
 from arcosim.experiments.findings import (
     LOAD_HEADER,
     TABLE_II_HEADER,
+    TABLE_II_NOTE,
     WHOLE_CHAIN_HEADER,
     actuator_rows,
     load_angle_rows,
@@ -69,6 +70,7 @@ arcosim reproduce --out reports --ideal --all-csv --force""",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar, no status lines")
     p.add_argument("--force", action="store_true", help="replace the report's files if they exist")
+    tool_names_option(p)
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
@@ -82,11 +84,13 @@ def _execute(args: argparse.Namespace) -> int:
         fmu_dir=args.fmus,
         force=args.force,
         all_csv=args.all_csv,
+        tool_names=args.tool_names,
     )
     print("\n1. Actuator self-identification (load detached)")
     print(text_table(["term", "identified", "true", "error"], actuator_rows(results)))
     print("\n2. Table II: five rigid maneuvers (ours) next to the paper's")
     print(text_table(TABLE_II_HEADER, table_ii_rows(results)))
+    print(TABLE_II_NOTE)
     print("\n3. State estimation (recursion), score rms(θ̂_i − θ_i) / rms(θ_i − θ_m)")
     print(text_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(results)))
     print(f"\n4. Whole chain from the motor alone (n = {results.masses} read from the record)")

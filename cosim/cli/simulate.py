@@ -51,7 +51,7 @@ from arcosim.experiments.scenarios import (
 )
 from arcosim.host.master import ORDERINGS, Recording
 from arcosim.host.overrides import split_overrides
-from arcosim.logs import write_csv
+from arcosim.logs import tool_keys, write_csv
 from arcosim.outputs import check_output
 
 
@@ -135,14 +135,20 @@ def _execute(args: argparse.Namespace) -> int:
     plant.update({**scenario.plant, **(IDEAL_SENSORS if args.ideal else {}), **overrides["plant"]})
     check_passive(recording, scenario, plant, n, args.step, args.set)
     if args.out:
-        write_csv(args.out, recording_columns(recording), force=args.force)
+        write_csv(
+            args.out,
+            recording_columns(recording),
+            units=recording.units,
+            tool_names=args.tool_names,
+            force=args.force,
+        )
     final = {
         key.split(".", 1)[1]: float(series[-1])
         for key, series in recording.signals.items()
         if key.startswith("observer.")
     }
     if args.json:
-        print(json.dumps(final, indent=2))
+        print(json.dumps(tool_keys(final) if args.tool_names else final, indent=2))
     else:
         print(
             f"{scenario.name}: {len(recording.time) - 1} steps of {args.step:g} s ({args.ordering})"

@@ -47,7 +47,13 @@ def _execute(args: argparse.Namespace) -> int:
         check_output(args.out, inputs=[args.path], force=args.force)
     recording = run_ssp(args.path, args.parameter_set, args.stop, args.step)
     if args.out:
-        write_csv(args.out, {"time": recording.time, **recording.signals}, force=args.force)
+        write_csv(
+            args.out,
+            {"time": recording.time, **recording.signals},
+            units=recording.units,
+            tool_names=args.tool_names,
+            force=args.force,
+        )
     print(f"{args.path}: {len(recording.time) - 1} steps of {args.step:g} s (Jacobi)")
     for key in ("observer.tau_reac_hat", "observer.theta_hat[1]", "plant.theta[1]"):
         if key in recording.signals:

@@ -7,9 +7,11 @@ current_commands -- current commands (A) over arrays of step times: multi-sine, 
 scenarios        -- a current command, a duration and FMU settings, run as one co-simulation
 paper            -- the paper's own Table II, in SI units
 metrics          -- how estimates are scored against the plant's truth
+load_scores      -- how a load torque estimate is scored (settling, settled error, lag)
 reproduce        -- the five experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
-report           -- the figures, and tables as Markdown or text
+reproduce_figures -- Figs. 4–8 from the runs and what they found
+report           -- the figures drawn, and tables as Markdown or text
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """

@@ -21,6 +21,34 @@ def _pyplot():
     return plt
 
 
+def _legend_above(fig, ax, ncol: int) -> None:
+    """One legend for the figure, of ``ax``'s lines, between the title and the plots
+    (never over the data), and the layout made around it."""
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.955), ncol=ncol,
+               fontsize=8, frameon=False)  # fmt: skip
+    fig.tight_layout(rect=(0, 0, 1, 0.935))
+
+
+def _symlog_if_diverging(ax, truth: np.ndarray, estimate: np.ndarray) -> None:
+    """A symmetric-log y axis when ``estimate`` runs far beyond ``truth`` (a diverging
+    recursion): linear over the truth's range, decades beyond it, so both show."""
+    scale = float(np.max(np.abs(truth))) if truth.size else 0.0
+    if scale > 0 and estimate.size and float(np.max(np.abs(estimate))) > 5 * scale:
+        ax.set_yscale("symlog", linthresh=scale, linscale=4.0)
+        truth_line, *others = ax.get_lines()
+        truth_line.set_zorder(3)  # the truth over the diverged estimate
+        for line in others:
+            line.set(alpha=0.45, lw=0.5, ls="-")
+        top = int(np.ceil(np.log10(float(np.max(np.abs(estimate))))))
+        low = int(np.floor(np.log10(scale)))
+        decades = range(top, low + 1, -max(1, (top - low) // 3))  # at most ~4 a side
+        ticks = [*(10.0**k for k in decades), float(f"{scale:.1g}")]  # and the band's edge
+        ax.set_yticks([*(-x for x in ticks), 0.0, *ticks[::-1]])
+        ax.set_ylim(-(10.0**top), 10.0**top)
+        ax.axhspan(-scale, scale, color="0.92", zorder=0)
+
+
 def figure_reaction_torque(
     recording: Recording, reconstructed: np.ndarray, path: Path, k_hat: float, B_hat: float
 ) -> Path:
@@ -60,9 +88,8 @@ def figure_reaction_torque(
     zoom.set_xlim(t[window][0], t[window][-1])
     ax.set_xlabel("time (s)")
     zoom.set_xlabel("time (s), magnified")
-    ax.legend(loc="upper right", fontsize=8)
     fig.suptitle("Fig. 4 — reaction torque and its reconstruction from the identified k, B")
-    fig.tight_layout()
+    _legend_above(fig, ax, ncol=2)
     save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
@@ -104,9 +131,8 @@ def figure_flexible_response(recording: Recording, n: int, path: Path) -> Path:
         zoom.set_ylim(low - pad, high + pad)
     ax.set_xlabel("time (s)")
     zoom.set_xlabel("time (s), magnified")
-    ax.legend(loc="upper left", fontsize=8, ncol=n + 1)
     fig.suptitle("Fig. 5 — flexible response of the chain (plant truth)")
-    fig.tight_layout()
+    _legend_above(fig, ax, ncol=n + 1)
     save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
@@ -123,10 +149,12 @@ def figure_state_estimates(
 ) -> Path:
     """Fig. 6: estimated against true angle of every mass, relative to the motor.
 
-    Left, the paper's recursion (``recording``) on its own scale (it diverges from
-    the second mass on); right, the model-based observer (``model_based``, the same
-    maneuver) on the truth's scale. Both over ``window`` (s) of the run; the scores
-    (rms error / rms flexible motion) are over the whole run.
+    Left, the paper's recursion (``recording``): it diverges from the second mass on,
+    so a panel whose estimate runs far beyond the truth has a symmetric-log axis,
+    linear over the truth's range (shaded) and in decades beyond; right, the
+    model-based observer (``model_based``, the same maneuver) on the truth's scale.
+    Both over ``window`` (s) of the run; each panel's score (rms error / rms flexible
+    motion, over the whole run) is written above it, the legend above the plots.
     """
     plt = _pyplot()
     columns = 1 if model_based is None else 2
@@ -144,20 +172,30 @@ def figure_state_estimates(
         ax.plot(t, estimate, color=color, lw=0.8, ls="--", label=label)
         ax.set_ylabel(f"θ_{i} − θ_m (mrad)")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize=7)
+        return truth, estimate
 
     for i in range(1, n + 1):
-        panel(axes[i - 1, 0], recording, i, f"recursion (score {scores[i - 1]:.3g})", "C1")
+        left = axes[i - 1, 0]
+        truth, estimate = panel(left, recording, i, "the paper's recursion (eq. 22–26)", "C1")
+        _symlog_if_diverging(left, truth, estimate)
+        diverged = left.get_yscale() == "symlog"
+        note = f", up to {np.max(np.abs(estimate)):.1e} mrad: symlog axis" if diverged else ""
+        left.set_title(f"mass {i}: recursion, score {scores[i - 1]:.3g}{note}", fontsize=8)
         if model_based is not None:
-            score = f" (score {model_scores[i - 1]:.3g})" if model_scores else ""
-            panel(axes[i - 1, 1], model_based, i, f"model-based{score}", "C3")
-    axes[0, 0].set_title("the paper's recursion (eq. 22–26), own scale", fontsize=9)
-    if model_based is not None:
-        axes[0, 1].set_title("model-based observer, chain identified from the motor", fontsize=9)
+            right = axes[i - 1, 1]
+            panel(right, model_based, i, "model-based, chain identified from the motor", "C3")
+            score = f", score {model_scores[i - 1]:.3g}" if model_scores else ""
+            right.set_title(f"mass {i}: model-based{score}", fontsize=8)
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
     fig.suptitle("Fig. 6 — angle of each mass relative to the motor, estimated and true")
-    fig.tight_layout()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if model_based is not None:
+        more, more_labels = axes[0, 1].get_legend_handles_labels()
+        handles, labels = handles + more[1:], labels + more_labels[1:]
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.96), ncol=3,
+               fontsize=8, frameon=False)  # fmt: skip
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     save_figure(fig, path, dpi=110, force=True)
     plt.close(fig)
     return path
@@ -251,10 +289,12 @@ def figure_load_torque(
         a.set_ylabel("torque (mN·m)")
     for bound in (-0.05 * size, 0.05 * size):
         err.axhline(bound * 1e3, color="0.5", ls="--", lw=0.8)
-    err.set_ylim(-0.3 * size * 1e3, 0.3 * size * 1e3)
+    largest = max((float(np.max(np.abs(e - truth))) for e in estimates.values()), default=0.0)
+    reach = 1.1 * max(largest, 0.1 * size) * 1e3  # the whole error, the sine's lag included
+    err.set_ylim(-reach, reach)
     err.set_xlabel("time (s)")
     err.set_title("estimate − applied (grey: ±5 % of the step)", fontsize=9)
-    err.legend(loc="lower left", fontsize=8)
+    err.legend(loc="upper left", fontsize=8)
     ax.legend(loc="lower left", fontsize=8)
     fig.suptitle("Fig. 8 — load torque on mass 3 from the motor alone (model-based observer)")
     fig.tight_layout()

@@ -37,18 +37,14 @@ from arcosim.experiments.findings import (
     Results,
     report_markdown,
 )
-from arcosim.experiments.load_scores import score_profile, step_truth
+from arcosim.experiments.load_scores import score_profile
 from arcosim.experiments.metrics import flexible_score
-from arcosim.experiments.report import (
-    figure_flexible_response,
-    figure_load_torque,
-    figure_reaction_torque,
-    figure_state_estimates,
-    figure_whole_chain,
-    measured_response,
+from arcosim.experiments.reproduce_figures import (
+    load_torque_figure,
+    paper_figures,
+    whole_chain_figure,
 )
 from arcosim.experiments.scenarios import (
-    IDENTIFICATION_LINES,
     LOAD_PROFILE,
     SCENARIOS,
     recording_columns,
@@ -60,9 +56,7 @@ from arcosim.fmu.flexchain.defaults import G_DIST, STEP
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import ObserverSettings
 from arcosim.host.master import Recording
-from arcosim.identification.chain_modes import driving_point_response
 from arcosim.identification.offline_observer import estimate_states
-from arcosim.identification.output_error import through_g
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
@@ -97,6 +91,7 @@ def reproduce(
     fmu_dir: Path | None = None,
     force: bool = False,
     all_csv: bool = False,
+    tool_names: bool = False,
 ) -> Results:
     """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
 
@@ -116,6 +111,8 @@ def reproduce(
     all_csv : bool
         Whether to write every run with every signal rather than :data:`DEFAULT_CSV`,
         each with the log's columns only.
+    tool_names : bool
+        Whether the CSV columns are named for other tools (:func:`arcosim.logs.tool_name`).
 
     Returns
     -------
@@ -143,7 +140,9 @@ def reproduce(
         disable=not show_progress,
         desc="reproduce",
     ) as bar:
-        bench = _Bench(out, folder, ideal, results, bar.update, bar.set_postfix_str, all_csv)
+        bench = _Bench(
+            out, folder, ideal, results, bar.update, bar.set_postfix_str, all_csv, tool_names
+        )
         actuator = _self_identification(bench)
         rigid, k_mean, b_mean = _rigid_maneuvers(bench, actuator)
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
@@ -151,10 +150,10 @@ def reproduce(
         loaded = _load_torque(bench, actuator) if estimated is not None else None
         bar.set_postfix_str(f"writing the figures and report.md into {out}")
         if loaded is not None:
-            results.files.append(_load_torque_figure(out, loaded))
-        results.files += _figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
+            results.files.append(load_torque_figure(out, loaded))
+        results.files += paper_figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
         if estimated is not None:
-            results.files.append(_whole_chain_figure(out, identification, results))
+            results.files.append(whole_chain_figure(out, identification, results))
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
     return results
@@ -183,6 +182,7 @@ class _Bench:
     progress: Callable[[int], object]
     status: Callable[[str], object]
     all_csv: bool = False
+    tool_names: bool = False
 
     def run(self, name: str, **settings: dict) -> Recording:
         """Co-simulate the scenario ``name`` on the bench (``plant=``, ``observer=``)."""
@@ -201,7 +201,14 @@ class _Bench:
         ``all_csv`` every signal, else only a run of :data:`DEFAULT_CSV`, its log."""
         if self.all_csv or name in DEFAULT_CSV:
             columns = recording_columns(recording, log_only=not self.all_csv)
-            self.results.files.append(write_csv(self.out / name, columns, force=True))
+            path = write_csv(
+                self.out / name,
+                columns,
+                units=recording.units,
+                tool_names=self.tool_names,
+                force=True,
+            )
+            self.results.files.append(path)
 
     @functools.cached_property
     def encoder_cpr(self) -> int:
@@ -384,67 +391,3 @@ def _fit_whole_chain(
     if cpr > 0:  # ideal sensors: no counts
         encoder = encoder_record(identification.time, signals[0], signals[2], terms, cpr)
     return identify_whole_chain(record, "auto", encoder)
-
-
-def _figures(
-    out: Path,
-    rigid: Recording,
-    flexible: Recording,
-    results: Results,
-    k_hat: float,
-    b_hat: float,
-    model_based: Recording | None,
-) -> list[Path]:
-    """Figs. 4, 5 and 6: the reaction torque of a rigid maneuver against the one
-    rebuilt from k̂ (N·m/rad) and B̂ (N·m·s/rad), the flexible response, the angles."""
-    raw = k_hat * (rigid["plant.theta_m_true"] - rigid["plant.theta[1]"]) + b_hat * (
-        rigid["plant.omega_m_true"] - rigid["plant.omega[1]"]
-    )
-    rebuilt = through_g(raw, G_DIST, float(rigid.time[1] - rigid.time[0]))
-    return [
-        figure_reaction_torque(rigid, rebuilt, out / "fig4_reaction_torque.png", k_hat, b_hat),
-        figure_flexible_response(flexible, N_MASSES, out / "fig5_flexible_response.png"),
-        figure_state_estimates(
-            flexible,
-            N_MASSES,
-            results.scores,
-            out / "fig6_state_estimates.png",
-            model_based,
-            results.whole_scores,
-        ),
-    ]
-
-
-def _whole_chain_figure(out: Path, identification: Recording, results: Results) -> Path:
-    """Fig. 7: experiment 4's parameters against the truth, and its model's response."""
-    true = dict(TRUE_CHAIN)
-    lines = IDENTIFICATION_LINES
-    measured = measured_response(
-        identification.time,
-        identification["plant.theta_m"],
-        identification["observer.tau_reac_hat"],
-        lines,
-    )
-    w = np.geomspace(lines[0], lines[-1], 1500)
-    g = G_DIST / (1j * w + G_DIST)  # what τ̂_reac carries: τ_reac through G(s)
-
-    def model(values: dict[str, float]) -> np.ndarray:
-        J, k, B = ([values[f"{p}[{i}]"] for i in range(1, N_MASSES + 1)] for p in "JkB")
-        return g * driving_point_response(J, k, B, w)
-
-    fitted = results.whole_chain
-    return figure_whole_chain(
-        fitted,
-        results.whole_chain_std,
-        true,
-        (lines, measured, w, model(fitted), model(true)),
-        out / "fig7_whole_chain.png",
-    )
-
-
-def _load_torque_figure(out: Path, runs: dict[str, Recording]) -> Path:
-    """Fig. 8: experiment 5's load torque estimates by chain against the truth."""
-    estimates = {label: rec["observer.tau_load_hat"] for label, rec in runs.items()}
-    rec = runs["true chain"]
-    truth = step_truth(rec.time, LOAD_PROFILE.torque(rec.time))
-    return figure_load_torque(rec.time, truth, estimates, out / "fig8_load_torque.png")

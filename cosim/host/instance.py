@@ -246,6 +246,11 @@ class FmuInstance:
         """Every output of the FMU, in declaration order."""
         return [v.name for v in self.description.modelVariables if v.causality == "output"]
 
+    def unit(self, name: str) -> str:
+        """The unit of variable ``name`` as its model description declares it (``"1"`` for
+        an Integer, a Boolean or a Real without a unit)."""
+        return getattr(self._variable(name), "unit", None) or "1"
+
     def vrs(self, names: Iterable[str]) -> list[int]:
         """Value references of ``names``; unknown names raise :class:`UserError`."""
         return [self._variable(n).valueReference for n in names]

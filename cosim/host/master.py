@@ -48,6 +48,9 @@ class Recording:
     signals : dict of str to ndarray
         ``"plant.theta[1]"``, ``"observer.tau_reac_hat"`` … → values (in the FMU
         variable's unit), each of shape ``(N,)``.
+    units : dict of str to str
+        Signal name → its unit as the FMU declares it (``"rad"``, ``"N.m"``; ``"1"``
+        for a count, a code or a flag); filled by the runs that record.
 
     Examples
     --------
@@ -58,6 +61,7 @@ class Recording:
 
     time: np.ndarray
     signals: dict[str, np.ndarray] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]
@@ -199,6 +203,8 @@ def cosimulate(
     recording = Recording(time=t0 + np.array(recorded) * h)
     recording.signals.update(_signals("plant", record_plant, plant_log))
     recording.signals.update(_signals("observer", record_observer, observer_log))
+    recording.units.update({f"plant.{name}": plant.unit(name) for name in record_plant})
+    recording.units.update({f"observer.{name}": observer.unit(name) for name in record_observer})
     return recording
 
 

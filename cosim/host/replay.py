@@ -88,6 +88,7 @@ def replay_log(
     recording = Recording(time=t.copy())
     for j, name in enumerate(outputs):
         recording.signals[f"observer.{name}"] = samples[:, j]
+        recording.units[f"observer.{name}"] = observer.unit(name)
     return recording
 
 

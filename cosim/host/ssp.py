@@ -174,6 +174,9 @@ def run_ssp(
         for name, fmu in instances.items():
             fmu.initialize({**chosen.get(name, {}), **(extra or {}).get(name, {})}, system.start)
         outputs, logs = _run_steps(system, instances, steps, h)
+        units = {
+            name: [instances[name].unit(out) for out in outs] for name, outs in outputs.items()
+        }
     finally:
         for fmu in instances.values():
             fmu.close()
@@ -182,6 +185,7 @@ def run_ssp(
     for name, outs in outputs.items():
         for j, out in enumerate(outs):
             recording.signals[f"{name}.{out}"] = logs[name][:, j]
+            recording.units[f"{name}.{out}"] = units[name][j]
     return recording
 
 

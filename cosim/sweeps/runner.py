@@ -25,6 +25,7 @@ import dataclasses
 import datetime
 import fcntl
 import hashlib
+import json
 import os
 import socket
 import sys
@@ -39,7 +40,8 @@ from arcosim.build.recipes import OBSERVER, PLANT
 from arcosim.errors import UserError
 from arcosim.experiments.metrics import flexible_score, percent_error
 from arcosim.host.overrides import typed_value
-from arcosim.outputs import check_output_folder
+from arcosim.logs import units_path
+from arcosim.outputs import check_output_folder, write_text
 from arcosim.sweeps.spec import SweepSpec, check_names, draw_runs, load_spec, metric_columns
 from arcosim.sweeps.summary import complete, read_results, write_summary
 
@@ -254,6 +256,11 @@ def sweep(
             raise UserError(
                 f"{results} exists: add --resume to finish that sweep, or choose another --out"
             )
+        write_text(
+            units_path(results),
+            json.dumps(result_units(spec, variables, columns), indent=1) + "\n",
+            force=True,
+        )
         pending = [(i, v) for i, v in enumerate(runs) if i not in done]
         blobs = {name: path.read_bytes() for name, path in fmus.items()}
         if results.exists() and _last_byte(results) not in (b"", b"\n"):
@@ -268,6 +275,22 @@ def sweep(
                 _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress)
         write_summary(spec, results, out)
     return results
+
+
+def result_units(
+    spec: SweepSpec, variables: Mapping[str, Mapping[str, object]], columns: Sequence[str]
+) -> dict[str, str]:
+    """The unit of each column of ``results.csv`` (its sidecar ``results.units.json``):
+    a varied parameter's as its FMU declares it, ``%`` for the parameter errors, ``s``
+    for the runtime, ``1`` for the run's number and the θ scores (ratios), ``""`` for
+    the error message."""
+    units = {"run": "1", "error": ""}
+    for name in spec.vary:
+        fmu, variable = name.split(".", 1)
+        units[name] = getattr(variables[fmu][variable], "unit", None) or "1"
+    for name in metric_columns(spec):
+        units[name] = {"runtime": "s"}.get(name, "1" if name.startswith("theta_") else "%")
+    return {column: units[column] for column in columns}
 
 
 def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress) -> None:

@@ -1,4 +1,9 @@
-"""The summary of a sweep: metric quantiles per varied parameter, and plots."""
+"""The summary of a sweep: metric quantiles per varied parameter, and plots.
+
+A varied seed (``plant.seed``) draws another noise, not another drive: it is no factor,
+so it has no quantiles of its own and no plot, only a word in the summary. The plots'
+axes carry the units of ``results.units.json``.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arcosim.logs import read_units
 from arcosim.outputs import save_figure, write_text
 from arcosim.sweeps.spec import SweepSpec, metric_columns
 
@@ -16,6 +22,20 @@ from arcosim.sweeps.spec import SweepSpec, metric_columns
 def complete(row: Mapping[str, str | None]) -> bool:
     """A row written in full (an interrupted write leaves a short last line)."""
     return row.get("error") is not None and (row.get("run") or "").strip().isdigit()
+
+
+def is_seed(name: str) -> bool:
+    """Whether a varied parameter is a noise seed (``plant.seed``): no factor."""
+    return name.rpartition(".")[2] == "seed"
+
+
+def axis_label(name: str, units: Mapping[str, str]) -> str:
+    """``name (unit)``: a percent error ``(%)``, a θ score ``(rms ratio)``, a count or
+    code (unit ``1``) bare."""
+    unit = units.get(name, "")
+    if name.startswith("theta_error"):
+        return f"{name} (rms ratio)"
+    return f"{name} ({unit})" if unit and unit != "1" else name
 
 
 def read_results(results: Path) -> list[dict[str, str]]:
@@ -31,6 +51,9 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
     rows = read_results(results)
     ok = [r for r in rows if not r["error"]]
     metrics = metric_columns(spec)
+    units = read_units(results)
+    factors = [name for name in spec.vary if not is_seed(name)]
+    seeds = [name for name in spec.vary if is_seed(name)]
     lines = [
         f"# Sweep {spec.name}: {len(rows)} runs, {len(rows) - len(ok)} failed",
         "",
@@ -38,6 +61,12 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
         "Quantiles 5 % / 50 % / 95 % of each metric.",
         "",
     ]
+    if seeds:
+        lines += [
+            f"{', '.join(seeds)} draws a new noise each run, not a factor: no rows or plots "
+            "of its own.",
+            "",
+        ]
     table = []
     for metric in metrics:
         x = np.array([float(r[metric]) for r in ok if r.get(metric)])
@@ -45,7 +74,7 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
             table.append(
                 ["all runs", metric, x.size, *(f"{q:.4g}" for q in np.percentile(x, [5, 50, 95]))]
             )
-        for name in spec.vary:
+        for name in factors:
             for label, members in _groups(ok, name):
                 y = np.array([float(r[metric]) for r in members if r.get(metric)])
                 if y.size:
@@ -65,7 +94,11 @@ def write_summary(spec: SweepSpec, results: Path, out: Path) -> Path:
         ]
     lines += [
         "",
-        *(f"![{m}]({_plot(spec, ok, m, out).name})" for m in metrics if any(r.get(m) for r in ok)),
+        *(
+            f"![{m}]({_plot(spec, ok, m, out, factors, units).name})"
+            for m in metrics
+            if any(r.get(m) for r in ok)
+        ),
     ]
     summary = out / "summary.md"
     write_text(summary, "\n".join(lines) + "\n", force=True)
@@ -84,23 +117,29 @@ def _groups(rows: list[dict[str, str]], name: str) -> list[tuple[str, list[dict[
     return groups
 
 
-def _plot(spec: SweepSpec, rows: list[dict[str, str]], metric: str, out: Path) -> Path:
+def _plot(
+    spec: SweepSpec,
+    rows: list[dict[str, str]],
+    metric: str,
+    out: Path,
+    names: list[str],
+    units: Mapping[str, str],
+) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = list(spec.vary)
     fig, axes = plt.subplots(1, 1 + len(names), figsize=(4 * (1 + len(names)), 3.4), squeeze=False)
     y = np.array([float(r[metric]) for r in rows if r.get(metric)])
     axes[0, 0].hist(y, bins=min(30, max(5, len(y) // 5)))
-    axes[0, 0].set_xlabel(metric)
+    axes[0, 0].set_xlabel(axis_label(metric, units))
     axes[0, 0].set_ylabel("runs")
     for ax, name in zip(axes[0, 1:], names):
         x = np.array([float(r[name]) for r in rows if r.get(metric)])
         ax.plot(x, y, ".", alpha=0.6)
-        ax.set_xlabel(name)
-        ax.set_ylabel(metric)
+        ax.set_xlabel(axis_label(name, units))
+        ax.set_ylabel(axis_label(metric, units))
         ax.grid(True, alpha=0.3)
     fig.suptitle(f"{spec.name}: {metric} ({len(y)} runs)")
     fig.tight_layout()
