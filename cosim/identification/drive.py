@@ -19,6 +19,7 @@ import numpy as np
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.log_check import log_plausibility
 from arcosim.identification.records import LOADS, MotorRecord, encoder_record, motor_record
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 
@@ -183,7 +184,9 @@ def identify_drive(
     ------
     IdentificationError
         A record that cannot support the chain (the message names the missing or weak
-        mode and what would fix the record), or settings the fit cannot use.
+        mode and what would fix the record, after the log's implausible units or length
+        when :func:`~arcosim.identification.log_check.log_plausibility` found any), or
+        settings the fit cannot use.
 
     Examples
     --------
@@ -225,7 +228,13 @@ def identify_drive(
             "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
             "(D_m and f_c) and no load torque model"
         )
-    choice = identify_whole_chain(record, masses, encoder)
+    plausibility = log_plausibility(time, i_a, omega_m, theta_m, k_t, J_m)
+    try:
+        choice = identify_whole_chain(record, masses, encoder)
+    except IdentificationError as error:
+        if not plausibility:
+            raise
+        raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
     fit = choice.fit
     parameters = fit.as_dict()
     return DriveIdentification(
@@ -233,7 +242,7 @@ def identify_drive(
         parameters=parameters,
         std=fit.std_dict(),
         assumptions=dict(fit.extra["assumptions"]),
-        warnings=list(fit.extra["warnings"]),
+        warnings=plausibility + list(fit.extra["warnings"]),
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}
