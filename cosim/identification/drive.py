@@ -20,8 +20,9 @@ from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import log_plausibility
+from arcosim.identification.noise_floor import floor_warning, noise_floor
 from arcosim.identification.records import LOADS, MotorRecord, encoder_record, motor_record
-from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
+from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
 
 @dataclass(frozen=True)
@@ -237,12 +238,15 @@ def identify_drive(
         raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
     fit = choice.fit
     parameters = fit.as_dict()
+    chain = split(fit.values, choice.n)
+    floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist)
+    above = floor_warning(fit.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
         std=fit.std_dict(),
         assumptions=dict(fit.extra["assumptions"]),
-        warnings=plausibility + list(fit.extra["warnings"]),
+        warnings=plausibility + list(fit.extra["warnings"]) + ([above] if above else []),
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}
