@@ -62,7 +62,8 @@ def test_current_scaled_by_1000_too_little_names_the_current_scale() -> None:
 
 
 def test_a_short_record_names_its_length() -> None:
-    """3 s of the README's excitation (lowest line 3.2 rad/s): 1.5 periods."""
+    """3 s of the README's excitation (its lowest line, off the 3 s grid, read at 2.6 rad/s):
+    1.2 periods."""
     report = check_log(*sample(3001), **MOTOR)
     assert any(w.startswith("the record lasts 3 s") for w in report.warnings), report.warnings
 

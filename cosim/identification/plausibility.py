@@ -187,7 +187,7 @@ def record_length(time: np.ndarray, lowest: float | None) -> str | None:
     time : ndarray
         Sample times (s), shape ``(N,)``.
     lowest : float or None
-        The lowest excitation line or mode the record shows (rad/s); None: none.
+        The lowest excitation line the record shows (rad/s); None: none.
 
     Returns
     -------
@@ -207,8 +207,8 @@ def record_length(time: np.ndarray, lowest: float | None) -> str | None:
     if periods >= LEAST_PERIODS:
         return None
     return (
-        f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest line or "
-        f"mode ({lowest:.3g} rad/s; fewer than {LEAST_PERIODS:g}): the lowest mode is "
+        f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest excitation "
+        f"line ({lowest:.3g} rad/s; fewer than {LEAST_PERIODS:g}): modes that low are "
         f"poorly resolved; record at least {LEAST_PERIODS * 2 * np.pi / lowest:.3g} s"
     )
 
