@@ -99,7 +99,8 @@ def test_identify_warns_of_a_good_log_nothing() -> None:
 
 
 def test_k_t_ten_percent_high_is_above_the_noise_floor() -> None:
-    """k_t 10 % high: J, k 5–7 % off with small σ, the residual 4.3 × the floor."""
+    """k_t 10 % high: J, k 5–7 % off with small σ, the residual 4.3 × the floor (warns
+    above 4 ×)."""
     result = identify_drive(*sample(), **{**MOTOR, "k_t": 1.1 * MOTOR["k_t"]})
     assert any("noise floor" in w and "k_to" in w for w in result.warnings), result.warnings
 

@@ -43,7 +43,10 @@ class DriveIdentification:
         What the result is conditional on (k_t and J_m given, the encoder's counts,
         friction given or fitted, the load model), one sentence each.
     warnings : list of str
-        What may limit the result (a weakly determined mode), one sentence each.
+        What may limit the result, one sentence each: the log's implausible units or
+        length (:func:`~arcosim.identification.log_check.log_plausibility`, as
+        ``check`` gives them), a weakly determined mode, a residual well above the
+        noise floor (:mod:`arcosim.identification.noise_floor`).
     choice : ChainChoice
         The whole-chain fit's evidence (modes, criterion per n, refusals).
     record : MotorRecord
@@ -238,9 +241,11 @@ def identify_drive(
         raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
     fit = choice.fit
     parameters = fit.as_dict()
-    chain = split(fit.values, choice.n)
-    floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist)
-    above = floor_warning(fit.rms_residual, floor, sigma_i)
+    above = None
+    if load == "none":  # a modelled load's torque is in the τ̂ residual, not in the noise
+        chain = split(fit.values, choice.n)
+        floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist)
+        above = floor_warning(fit.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
