@@ -42,6 +42,18 @@ def current_noise(i_a: np.ndarray) -> float:
     noise's third difference has 20 times its variance; a line at ω moves it by
     (ω·h)³ of its amplitude only, 0.3 % at 150 rad/s and 1 kHz).
 
+    Parameters
+    ----------
+    i_a : ndarray
+        The logged current (A), shape ``(N,)``.
+
+    Returns
+    -------
+    float
+        The noise's standard deviation (A); an overestimate when the current holds
+        fast content of its own (a control loop's ripple): the floor errs high, never
+        into a false warning.
+
     Examples
     --------
     >>> rng = np.random.default_rng(1)
@@ -119,8 +131,8 @@ def floor_warning(rms_residual: float, floor: float, sigma_i: float) -> str | No
     --------
     >>> floor_warning(1e-3, 5e-4, 0.01) is None
     True
-    >>> floor_warning(2e-3, 5e-4, 0.01)[:40]
-    'the residual (0.002 N·m) is 4 × the nois'
+    >>> floor_warning(2.5e-3, 5e-4, 0.01)[:40]
+    'the residual (0.0025 N·m) is 5 × the noi'
     """
     if not (floor > 0 and rms_residual > FLOOR_FACTOR * floor):
         return None

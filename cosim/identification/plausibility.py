@@ -197,8 +197,8 @@ def record_length(time: np.ndarray, lowest: float | None) -> str | None:
 
     Examples
     --------
-    >>> record_length(np.arange(3001) * 1e-3, 3.0)[:30]
-    'the record lasts 3 s, 1.4 perio'
+    >>> record_length(np.arange(3001) * 1e-3, 3.0)[:32]
+    'the record lasts 3 s, 1.4 period'
     """
     if not lowest or lowest <= 0:
         return None
