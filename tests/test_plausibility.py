@@ -123,3 +123,26 @@ def test_check_warnings_are_among_identify_warnings(rows, scales) -> None:
     except IdentificationError as error:
         assert all(w in str(error) for w in checked), (checked, str(error))
         assert not checked or str(error).startswith(checked[0])
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "five-mass, friction fitted",
+        # 4 kHz: 11 s of simulation
+        pytest.param("belt-like two-mass, 4 kHz, friction", marks=pytest.mark.slow),
+    ],
+)
+def test_the_independent_simulator_s_logs(name) -> None:
+    """On logs of benchmarks.field_sim (written apart from the plant; 10 s): nothing on the
+    log as simulated; time in ms names the time column, the current 1000 × low its scale."""
+    from benchmarks import field_accuracy
+
+    row = field_accuracy.ROWS[name]
+    log, d = row.log(0, 10.0), row.drive
+    signals = [log.time, log.i_a, log.omega_m, log.theta_m]
+    assert log_plausibility(*signals, d.k_t, d.J_m) == []
+    in_ms = log_plausibility(1e3 * log.time, *signals[1:], d.k_t, d.J_m)
+    assert any("--scale time=0.001" in w for w in in_ms), in_ms
+    low = log_plausibility(log.time, 1e-3 * log.i_a, *signals[2:], d.k_t, d.J_m)
+    assert any("--scale i_a" in w for w in low), low
