@@ -30,6 +30,7 @@ encoder_fit       -- the prediction-error fit from the current to the encoder (r
 motor_friction    -- the motor's friction when only k_t and J_m are given: its start
 whole_chain       -- every J_i, k_i, B_i and n from the motor alone (identify_whole_chain,
                      ChainChoice)
+noise_floor       -- the residual the encoder's counts and the current's noise explain
 
 Drive
 -----
@@ -39,6 +40,8 @@ offline_observer  -- the observer FMU's algorithms run over a log
 
 Checks
 ------
+plausibility      -- are the log's units and length plausible? (the step against the
+                     motion, the torque balance, the record's length)
 log_check         -- can a log support identification? (check_log, CheckReport)
 
 Excitation

@@ -19,8 +19,10 @@ import numpy as np
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.log_check import log_plausibility
+from arcosim.identification.noise_floor import floor_warning, noise_floor
 from arcosim.identification.records import LOADS, MotorRecord, encoder_record, motor_record
-from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
+from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
 
 @dataclass(frozen=True)
@@ -41,7 +43,10 @@ class DriveIdentification:
         What the result is conditional on (k_t and J_m given, the encoder's counts,
         friction given or fitted, the load model), one sentence each.
     warnings : list of str
-        What may limit the result (a weakly determined mode), one sentence each.
+        What may limit the result, one sentence each: the log's implausible units or
+        length (:func:`~arcosim.identification.log_check.log_plausibility`, as
+        ``check`` gives them), a weakly determined mode, a residual well above the
+        noise floor (:mod:`arcosim.identification.noise_floor`).
     choice : ChainChoice
         The whole-chain fit's evidence (modes, criterion per n, refusals).
     record : MotorRecord
@@ -183,7 +188,9 @@ def identify_drive(
     ------
     IdentificationError
         A record that cannot support the chain (the message names the missing or weak
-        mode and what would fix the record), or settings the fit cannot use.
+        mode and what would fix the record, after the log's implausible units or length
+        when :func:`~arcosim.identification.log_check.log_plausibility` found any), or
+        settings the fit cannot use.
 
     Examples
     --------
@@ -225,15 +232,26 @@ def identify_drive(
             "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
             "(D_m and f_c) and no load torque model"
         )
-    choice = identify_whole_chain(record, masses, encoder)
+    plausibility = log_plausibility(time, i_a, omega_m, theta_m, k_t, J_m)
+    try:
+        choice = identify_whole_chain(record, masses, encoder)
+    except IdentificationError as error:
+        if not plausibility:
+            raise
+        raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
     fit = choice.fit
     parameters = fit.as_dict()
+    above = None
+    if load == "none":  # a modelled load's torque is in the τ̂ residual, not in the noise
+        chain = split(fit.values, choice.n)
+        floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist)
+        above = floor_warning(fit.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
         std=fit.std_dict(),
         assumptions=dict(fit.extra["assumptions"]),
-        warnings=list(fit.extra["warnings"]),
+        warnings=plausibility + list(fit.extra["warnings"]) + ([above] if above else []),
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}

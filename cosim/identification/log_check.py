@@ -7,8 +7,10 @@ still), the excitation's band (its lines, found in the current by
 :func:`excitation_lines`, against the band 0.3/h and 3·g_dist leave,
 :mod:`arcosim.identification.band`, and how well the encoder sees them), and the modes
 the record shows (:func:`arcosim.identification.modal_start.detect_modes`: stable, with
-residues above their standard errors; the weak ones named). One helper per check, each
-adding its findings to the :class:`CheckReport`.
+residues above their standard errors; the weak ones named), and the log's plausibility
+(:func:`log_plausibility`: its units and length, warnings that
+:func:`~arcosim.identification.drive.identify_drive` gives too). One helper per check,
+each adding its findings to the :class:`CheckReport`.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from arcosim.identification.errors import IdentificationError
 from arcosim.identification.excitation_design import LINE_T
 from arcosim.identification.modal_start import DetectedModes, detect_modes
 from arcosim.identification.motor_friction import friction_cleaned
+from arcosim.identification.plausibility import plausibility_warnings
 from arcosim.identification.records import encoder_record, motor_record, smooth_velocity
 from arcosim.identification.whole_chain import MAX_AUTO_MASSES
 
@@ -204,6 +207,7 @@ def check_log(
         report.problems.append("the log needs increasing times and at least 16 samples")
         return report
     h = _check_step(report, steps)
+    report.warnings += log_plausibility(time, i_a, omega_m, theta_m, k_t, J_m)
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0
     theta = np.asarray(theta_m, dtype=float)
     _check_range(report, theta, count)
@@ -354,6 +358,26 @@ def _modes(
         )
         detected = friction_cleaned(record, encoder, detected.modes(), MAX_AUTO_MASSES)[3]
     return detected
+
+
+def log_plausibility(
+    time: np.ndarray,
+    i_a: np.ndarray,
+    omega_m: np.ndarray,
+    theta_m: np.ndarray,
+    k_t: float,
+    J_m: float,
+) -> list[str]:
+    """The log's plausibility warnings
+    (:func:`~arcosim.identification.plausibility.plausibility_warnings`) with the lowest
+    excitation line :func:`excitation_lines` finds: what ``check`` and ``identify``
+    both warn of. Arguments as :func:`check_log`'s; returns one line per finding."""
+    time = np.asarray(time, dtype=float)
+    i_a = np.asarray(i_a, dtype=float)
+    lines = excitation_lines(i_a, float(np.mean(np.diff(time))))
+    lowest = float(min(lines)) if len(lines) else None
+    args = (np.asarray(omega_m, dtype=float), np.asarray(theta_m, dtype=float))
+    return plausibility_warnings(time, i_a, *args, k_t, J_m, lowest)
 
 
 def line_visibility(theta: np.ndarray, h: float, lines: np.ndarray, count: float) -> list[float]:

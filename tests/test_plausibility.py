@@ -1,0 +1,148 @@
+"""Plausibility at the door and the residual's noise floor: field mistakes (time in ms, a
+current scaled by 1000 too little, k_t 10 % high, a short record) end in a warning or a
+refusal naming the cause, on the sample log (examples/data/belt_drive.csv, simulated
+apart from the project's plant); a good log gets none; ``check`` and ``identify`` warn
+alike."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arcosim.identification.drive import identify_drive
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.log_check import check_log, log_plausibility
+from arcosim.identification.noise_floor import FLOOR_FACTOR, current_noise, floor_warning
+from arcosim.identification.plausibility import (
+    INERTIA_HIGH,
+    balance_inertia,
+    record_length,
+    step_against_motion,
+    torque_balance,
+)
+from arcosim.logs import read_log
+
+SAMPLE = Path(__file__).parents[1] / "examples" / "data" / "belt_drive.csv"
+COUNT = 0.0031415926535897933  # README quick start 2: the log's angle in counts of 2000/rev
+SCALES = {"i_a": 1e-3, "theta_m": COUNT, "omega_m": COUNT}  # the log's current in mA
+MOTOR = dict(k_t=0.0406, J_m=2.09e-5, encoder_cpr=2000)
+TOTAL = 2.09e-5 + 3e-4 + 9e-4  # the sample's J_m + J_1 + J_2 (benchmarks/sample_log.py)
+
+
+def sample(rows: int | None = None, **scales: float) -> list[np.ndarray]:
+    """The sample log's time, i_a, omega_m, theta_m read with the README's scales
+    changed by ``scales``; its first ``rows`` rows."""
+    columns = read_log(SAMPLE, {**SCALES, **scales}).columns
+    return [columns[c][:rows] for c in ("time", "i_a", "omega_m", "theta_m")]
+
+
+def test_the_sample_log_is_plausible() -> None:
+    """The README's sample with its scales: no warning, and the torque balance at the
+    lowest line (3.2 rad/s, under the first mode) finds the total inertia within 15 %
+    (the friction and the modes' share at 3 rad/s)."""
+    log = sample()
+    assert log_plausibility(*log, MOTOR["k_t"], MOTOR["J_m"]) == []
+    J = balance_inertia(log[0], log[1], log[3], MOTOR["k_t"], 3.23)
+    assert J == pytest.approx(TOTAL, rel=0.15)
+
+
+def test_time_in_ms_names_the_time_column() -> None:
+    report = check_log(*sample(time=1e3), **MOTOR)
+    step = [w for w in report.warnings if w.startswith("the sample step")]
+    assert len(step) == 1 and "--scale time=0.001" in step[0], report.warnings
+
+
+def test_current_scaled_by_1000_too_little_names_the_current_scale() -> None:
+    """The current logged in A but read with ``--scale i_a=0.001``: J = 0.06 J_m."""
+    report = check_log(*sample(i_a=1e-6), **MOTOR)
+    balance = [w for w in report.warnings if w.startswith("the torque balance")]
+    assert len(balance) == 1 and "--scale i_a" in balance[0] and "k_to" in balance[0]
+
+
+def test_a_short_record_names_its_length() -> None:
+    """3 s of the README's excitation (its lowest line, off the 3 s grid, read at 2.6 rad/s):
+    1.2 periods."""
+    report = check_log(*sample(3001), **MOTOR)
+    assert any(w.startswith("the record lasts 3 s") for w in report.warnings), report.warnings
+
+
+def test_the_checks_on_synthetic_motion() -> None:
+    """One rigid body J = 1e-3 kg·m² on a 2 rad/s sine, k_t = 0.04 N·m/A."""
+    t = np.arange(4000) * 1e-3
+    theta = 0.1 * np.sin(2 * t)
+    current = -1e-3 * 0.4 * np.sin(2 * t) / 0.04
+    assert balance_inertia(t, current, theta, 0.04, 2.0) == pytest.approx(1e-3, rel=1e-3)
+    assert torque_balance(t, current, theta, 0.04, 1e-4, 2.0) is None
+    assert "--scale i_a" in torque_balance(t, current, theta, 0.04, 1e-3 / INERTIA_HIGH / 2, 2.0)
+    assert step_against_motion(t, np.gradient(theta, t), theta) is None
+    assert "--scale omega_m" in step_against_motion(t, 9.55 * np.gradient(theta, t), theta)
+    assert record_length(t, 2.0) is not None  # 4 s: 1.3 periods
+    assert record_length(t, 20.0) is None
+
+
+def test_the_current_noise_and_the_floor_warning() -> None:
+    rng = np.random.default_rng(3)
+    t = np.arange(20000) * 1e-3
+    lines = sum(0.1 * np.sin(w * t + w) for w in np.geomspace(3, 150, 40))
+    noisy = lines + 0.005 * rng.standard_normal(len(t))
+    assert current_noise(noisy) == pytest.approx(0.005, rel=0.05)
+    assert floor_warning(FLOOR_FACTOR * 0.99e-3, 1e-3, 0.005) is None
+    warning = floor_warning(FLOOR_FACTOR * 1.01e-3, 1e-3, 0.005)
+    assert "k_to" in warning and "--load slow" in warning and "estimated from the record" in warning
+
+
+def test_identify_warns_of_a_good_log_nothing() -> None:
+    """The README's sample, friction fitted: no warning at all (1.4 × the floor)."""
+    assert identify_drive(*sample(), **MOTOR).warnings == []
+
+
+def test_k_t_ten_percent_high_is_above_the_noise_floor() -> None:
+    """k_t 10 % high: J, k 5–7 % off with small σ, the residual 4.3 × the floor (warns
+    above 4 ×)."""
+    result = identify_drive(*sample(), **{**MOTOR, "k_t": 1.1 * MOTOR["k_t"]})
+    assert any("noise floor" in w and "k_to" in w for w in result.warnings), result.warnings
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "rows, scales", [(None, {}), (3001, {}), (None, {"time": 1e3}), (None, {"i_a": 1e-6})]
+)
+def test_check_warnings_are_among_identify_warnings(rows, scales) -> None:
+    """The plausibility warnings ``check`` gives (one or two on each mistake: the short
+    record, time in ms, the current 1000 × low), ``identify`` gives too: among its
+    warnings, or at the head of its refusal. Four fits: slow."""
+    log = sample(rows, **scales)
+    checked = log_plausibility(*log, MOTOR["k_t"], MOTOR["J_m"])
+    assert all(w in check_log(*log, **MOTOR).warnings for w in checked)
+    assert bool(checked) == bool(rows or scales)
+    try:
+        warnings = identify_drive(*log, **MOTOR).warnings
+        assert all(w in warnings for w in checked), (checked, warnings)
+    except IdentificationError as error:
+        assert all(w in str(error) for w in checked), (checked, str(error))
+        assert not checked or str(error).startswith(checked[0])
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "five-mass, friction fitted",
+        # 4 kHz: 11 s of simulation
+        pytest.param("belt-like two-mass, 4 kHz, friction", marks=pytest.mark.slow),
+    ],
+)
+def test_the_independent_simulator_s_logs(name) -> None:
+    """On logs of benchmarks.field_sim (written apart from the plant; 10 s): nothing on the
+    log as simulated; time in ms names the time column, the current 1000 × low its scale."""
+    from benchmarks import field_accuracy
+
+    row = field_accuracy.ROWS[name]
+    log, d = row.log(0, 10.0), row.drive
+    signals = [log.time, log.i_a, log.omega_m, log.theta_m]
+    assert log_plausibility(*signals, d.k_t, d.J_m) == []
+    in_ms = log_plausibility(1e3 * log.time, *signals[1:], d.k_t, d.J_m)
+    assert any("--scale time=0.001" in w for w in in_ms), in_ms
+    low = log_plausibility(log.time, 1e-3 * log.i_a, *signals[2:], d.k_t, d.J_m)
+    assert any("--scale i_a" in w for w in low), low
