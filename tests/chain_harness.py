@@ -12,6 +12,7 @@ from pathlib import Path
 from arcosim.build.ssp import BENCH, CONNECTIONS
 
 RUNNER = Path(__file__).parent / "hosts" / "chain_run.py"
+C_HOST = Path(__file__).parent / "hosts" / "chain_host.c"
 COMPONENTS = {
     "source": "ExcitationSource",
     "plant": "MotorChainPlant",
@@ -66,3 +67,16 @@ def run_chain(
         result = launch(command, env, workdir)
     assert result.returncode == 0, result.stderr[-3000:]
     return json.loads((workdir / "out.json").read_text())
+
+
+def compile_c_host(folder: Path) -> Path:
+    """tests/hosts/chain_host.c compiled into ``folder`` (strict C99, no Python linked);
+    the compiler's stderr in the assertion when it fails."""
+    from arcosim.build.cplant import compiler, fmi_headers
+
+    binary = folder / "chain_host"
+    command = [compiler(), "-std=c99", "-O1", "-Wall", "-Wextra", f"-I{fmi_headers()}"]
+    command += [str(C_HOST), "-o", str(binary), "-ldl"]
+    result = subprocess.run(command, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return binary

@@ -38,7 +38,7 @@ import numpy as np
 import pytest
 
 from arcosim.build.ssp import BENCH, CONNECTIONS
-from tests.chain_harness import chain_fmus, chain_spec, run_chain
+from tests.chain_harness import chain_fmus, chain_spec, compile_c_host, run_chain
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only"),
@@ -238,25 +238,8 @@ def c_host(tmp_path_factory) -> Callable[[], Path]:
     def get() -> Path:
         if compiled:
             return compiled[0]
-        from arcosim.build.cplant import fmi_headers
-
-        binary = tmp_path_factory.mktemp("c_host") / "chain_host"
-        command = [
-            shutil.which("cc") or "gcc",
-            "-std=c99",
-            "-O1",
-            "-Wall",
-            "-Wextra",
-            f"-I{fmi_headers()}",
-            str(HERE / "chain_host.c"),
-            "-o",
-            str(binary),
-            "-ldl",
-        ]
-        result = subprocess.run(command, capture_output=True, text=True)
-        assert result.returncode == 0, result.stderr
-        compiled.append(binary)
-        return binary
+        compiled.append(compile_c_host(tmp_path_factory.mktemp("c_host")))
+        return compiled[0]
 
     return get
 

@@ -22,6 +22,7 @@ import pytest
 from arcosim.build.ssp import BENCH, CONNECTIONS
 from arcosim.fmu.fmukit.checks import SMALLEST_STEP
 from arcosim.host.instance import FmuInstance
+from tests.chain_harness import compile_c_host
 
 #: C test programs and hosts compiled and run in subprocesses (the system tier).
 pytestmark = pytest.mark.system
@@ -270,27 +271,6 @@ def test_a_plant_step_of_a_femtosecond_from_rest_is_exact(fmus) -> None:
 # -- a C host that sums its time -------------------------------------------------------
 
 
-def _c_host(tmp_path: Path) -> Path:
-    from arcosim.build.cplant import compiler, fmi_headers
-
-    binary = tmp_path / "chain_host"
-    command = [
-        compiler(),
-        "-std=c99",
-        "-O1",
-        "-Wall",
-        "-Wextra",
-        f"-I{fmi_headers()}",
-        str(HERE / "chain_host.c"),
-        "-o",
-        str(binary),
-        "-ldl",
-    ]
-    result = subprocess.run(command, capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    return binary
-
-
 def test_c_host_that_sums_its_time_ends_on_a_sub_nanosecond_step(fmus, tmp_path) -> None:
     from fmpy import read_model_description
 
@@ -320,7 +300,7 @@ def test_c_host_that_sums_its_time_ends_on_a_sub_nanosecond_step(fmus, tmp_path)
     lines += ["run 10 0.001", "sum"]
     (tmp_path / "spec.txt").write_text("\n".join(lines) + "\n")
     result = subprocess.run(
-        [str(_c_host(tmp_path)), "spec.txt", "out.txt"],
+        [str(compile_c_host(tmp_path)), "spec.txt", "out.txt"],
         capture_output=True,
         text=True,
         cwd=tmp_path,
