@@ -10,8 +10,9 @@ designs. Columns as a drive records them: ``time`` (s), ``i_a`` (mA), ``omega_m`
 (counts/s, the encoder's backward difference), ``theta_m`` (counts), and the truth the
 drive could not measure, ``theta_1_true``, ``theta_2_true`` (rad).
 
-Run: ``python -m benchmarks.sample_log`` (from the repository root); it also copies the
-log into ``cosim/example-files/data/``, the package data ``arcosim example`` writes out.
+Run: ``python -m benchmarks.sample_log`` (from the repository root). The file itself is
+``cosim/example-files/data/belt_drive.csv``, the package data ``arcosim example`` writes
+out; ``examples/data/belt_drive.csv`` is a link to it.
 """
 
 from __future__ import annotations
@@ -25,9 +26,8 @@ from arcosim.identification.excitation_design import design_excitation
 from benchmarks import field_sim
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "examples" / "data" / "belt_drive.csv"
-#: The packaged copy of :data:`OUT` (``arcosim example``).
-PACKAGED = ROOT / "cosim" / "example-files" / "data" / "belt_drive.csv"
+#: The sample log: package data (``arcosim example``), linked from ``examples/data/``.
+OUT = ROOT / "cosim" / "example-files" / "data" / "belt_drive.csv"
 COUNTS = 2000
 J, K = (3e-4, 9e-4), (0.45, 0.3)
 
@@ -78,9 +78,6 @@ def main(out: Path = OUT) -> None:
                 ]
             )
     print(f"wrote {out} ({out.stat().st_size / 1e3:.0f} kB)")
-    if out == OUT:
-        PACKAGED.write_bytes(out.read_bytes())
-        print(f"copied it to {PACKAGED}")
 
 
 if __name__ == "__main__":

@@ -69,7 +69,8 @@ def test_identify_help_names_the_drive_first() -> None:
 
 
 def test_the_packaged_examples_are_the_checkouts() -> None:
-    """``cosim/example-files`` (package data) holds copies of ``examples/``: the same bytes."""
+    """``cosim/example-files`` (package data) holds what ``examples/`` links to: the same
+    bytes."""
     for name in FILES:
         packaged = ROOT / "cosim" / "example-files" / name
         assert packaged.read_bytes() == (ROOT / "examples" / name).read_bytes(), name
