@@ -3,7 +3,7 @@ Euler–Bernoulli beam and an independent finite-element model.
 
 Frequencies are read off the FMU's free responses (its whole state is among its outputs)
 and compared with the roots of the continuous boundary-value problem
-(tests/flexlink_harness.py), hub locked (clamped–free) and hub free (coupled). The
+(benchmarks/link_frequencies.py), hub locked (clamped–free) and hub free (coupled). The
 tolerance is the consistent-mass Hermite element's own: its frequencies bound the exact
 ones from above (Rayleigh–Ritz), and the leading relative error is (β ℓ)⁴ / 1440 for an
 element of length ℓ and mode wavenumber β (eigenvalue error (β ℓ)⁴ / 720), allowed once
@@ -21,13 +21,18 @@ from scipy.linalg import expm, matrix_balance
 from arcosim.build.clink import build_link
 from arcosim.fmu.flexchain import defaults
 from arcosim.host.instance import FmuInstance
-from tests.flexlink_harness import IDEAL, beam_frequencies, modes_of_free_response, run, states
+from benchmarks.link_frequencies import (
+    BETA,
+    IDEAL,
+    LINK,
+    H,
+    beam_frequencies,
+    clamped_modes,
+    coupled_modes,
+    eq7_from_the_root_element,
+    run,
+)
 
-H = 1e-3
-LINK = {"EI": defaults.LINK_EI, "rhoA": defaults.LINK_RHOA, "L": defaults.LINK_L}
-#: Light damping: it leaves the modes' natural frequencies |λ| exact and removes the
-#: element modes above the sampling's Nyquist frequency (π / H) before the fit.
-BETA = 5e-5
 #: (m_tip, J_tip): the bare beam, a tip mass, a tip mass with its own inertia
 TIPS = [(0.0, 0.0), (defaults.LINK_M_TIP, 0.0), (defaults.LINK_M_TIP, 2e-5)]
 
@@ -36,27 +41,6 @@ def tolerance(omega: np.ndarray, elements: int) -> np.ndarray:
     """The relative frequency error allowed (see the module docstring); inf past β ℓ = 2.5."""
     beta_l = np.sqrt(omega / np.sqrt(LINK["EI"] / LINK["rhoA"])) * LINK["L"] / elements
     return np.where(beta_l <= 2.5, 1.5 * beta_l**4 / 1440.0, np.inf)
-
-
-def clamped_modes(fmu: Path, elements: int, m_tip: float, J_tip: float) -> np.ndarray:
-    """The first three modes of the link with its hub held by Coulomb friction: a current
-    pulse breaks the hub away, it sticks again, the beam rings on a still hub."""
-    current = np.zeros(800)
-    current[:15] = 40.0
-    parameters = {**IDEAL, "f_c": 1.0, "beta": BETA, "m_tip": m_tip, "J_tip": J_tip}
-    x = run(fmu, parameters, current, H, states(elements))
-    start = np.flatnonzero(x[:, 1] != 0.0).max() + 150  # stuck for good, element modes gone
-    assert len(x) - start >= 300, "the hub did not stay stuck"
-    return modes_of_free_response(x[start:, 2:], H)[:3]
-
-
-def coupled_modes(fmu: Path, elements: int, parameters: dict) -> np.ndarray:
-    """The first three modes of hub and link, hub free (no friction): a short pulse, then
-    the free response."""
-    current = np.zeros(500)
-    current[:5] = 1.0
-    x = run(fmu, {**IDEAL, "beta": BETA, **parameters}, current, H, states(elements))
-    return modes_of_free_response(x[150:], H)[:3]
 
 
 def relative_errors(got: np.ndarray, exact: np.ndarray, elements: int) -> np.ndarray:
@@ -174,27 +158,16 @@ def j_link(m_tip: float, J_tip: float, r: float) -> float:
 
 def test_reaction_torque_of_a_steady_acceleration_is_the_rigid_links(link_fmu) -> None:
     """A constant current: once the vibration has died out the link turns as a rigid
-    body, τ_reac = J_link dω/dt = k_t i J_link / (J_m + J_link). The coupled first mode
-    decays at β ω₁² / 2 ≈ 2 /s: 4 s leave e⁻⁸ ≈ 3e-4 of the start's ringing, averaged
-    over the last second's 30 periods."""
+    body, τ_reac = J_link dω/dt = k_t i J_link / (J_m + J_link). With β = 2e-4 s the
+    coupled first mode (about 200 rad/s) decays at β ω₁² / 2 ≈ 4 /s: 4 s leave e⁻¹⁶ of
+    the start's ringing."""
     m_tip, J_tip, r = defaults.LINK_M_TIP, 2e-5, 0.03
-    parameters = {**IDEAL, "J_tip": J_tip, "r_hub": r}
+    parameters = {**IDEAL, "J_tip": J_tip, "r_hub": r, "beta": 2e-4}
     x = run(link_fmu, parameters, np.full(5000, 0.2), H, ["tau_reac_mean", "tau_reac"])
     J = j_link(m_tip, J_tip, r)
     expected = defaults.K_T * 0.2 * J / (defaults.J_M + J)
     assert abs(x[-1000:, 0].mean() / expected - 1.0) < 1e-3
     assert abs(x[-1, 1] / expected - 1.0) < 1e-3
-
-
-def eq7_from_the_root_element(x: np.ndarray, elements: int, r: float, beta: float) -> np.ndarray:
-    """−EI (w''(0) + β ẇ''(0)) + r EI (w'''(0) + β ẇ'''(0)) of the root element's cubic,
-    from the nodal outputs w[1], w_slope[1], w_rate[1], w_slope_rate[1] (columns 0–3)."""
-    le, EI = LINK["L"] / elements, LINK["EI"]
-    w = x[:, 0] + beta * x[:, 2]
-    s = x[:, 1] + beta * x[:, 3]
-    curvature = 6.0 * w / le**2 - 2.0 * s / le
-    third = -12.0 * w / le**3 + 6.0 * s / le**2
-    return -EI * curvature + r * EI * third
 
 
 @pytest.mark.slow

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from arcosim.fmu.flexchain import defaults
+from benchmarks.link_frequencies import run
 from tests.chain_harness import compile_c_host
-from tests.flexlink_harness import run
 from tests.test_hosts import run_ecos_csv
 
 pytestmark = [
