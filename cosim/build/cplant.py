@@ -25,7 +25,13 @@ from arcosim.errors import BuildError
 from arcosim.version import __version__
 
 SOURCES = ("physics.c", "fmu.c")
-HEADERS = ("physics.h", "matrix_exp.h", "friction_events.h", "sensor_noise.h")
+HEADERS = (
+    "physics.h",
+    "fmi_shell.h",
+    "matrix_exp.h",
+    "friction_events.h",
+    "sensor_noise.h",
+)
 #: ISO C99, no GNU extensions: the sources also build with MSVC or any C99 compiler,
 #: against the FMI 2.0 (2014) headers as well as 2.0.1-2.0.4 (tests/test_cplant_sources.py).
 CFLAGS = (
