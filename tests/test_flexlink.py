@@ -319,3 +319,15 @@ def test_bad_parameters_are_refused_with_their_reason(link_fmu, parameters, mess
         with pytest.raises(Exception):  # noqa: B017 - fmpy raises its FMICallException
             link.initialize(parameters)
         assert any(message in m for m in link.messages), link.messages
+
+
+@pytest.mark.parametrize("elements", ["0", "17"])
+def test_build_refuses_an_element_count_out_of_range(tmp_path, capsys, elements) -> None:
+    from arcosim.cli import main
+
+    assert main(["build", "--elements", elements, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"--elements {elements}: the number of the link's Hermite elements must be 1 to 16" in err
+    )
+    assert not list(tmp_path.iterdir())  # nothing built
