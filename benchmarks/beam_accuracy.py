@@ -10,7 +10,7 @@ modes. Only k_t, J_m, the encoder's counts, L, m_tip (J_tip, r_hub) and the fric
 are given; the fit (:func:`arcosim.identification.beam_fit.fit_link`) finds EI, ρA and
 the damping. Per link, over the seeds: the largest |error| of the first two clamped
 modes, of EI and ρA, and rms(α̂ − α)/rms(α) of the tip angle after the first second
-(:func:`arcosim.identification.beam_fit.tip_motion`).
+(:func:`arcosim.identification.beam_motion.tip_motion`).
 
 Run: ``python -m benchmarks.beam_accuracy [--seeds 20] [--out FILE.json]`` (prints the
 markdown table), or ``arcosim bench accuracy --beam-only``.
@@ -29,8 +29,9 @@ import numpy as np
 
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.beam_fit import Geometry, fit_link, modal_of, tip_motion
+from arcosim.identification.beam_fit import Geometry, fit_link, modal_of
 from arcosim.identification.beam_model import Link, ModalModel, modal_model
+from arcosim.identification.beam_motion import tip_motion
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.records import encoder_record, motor_record
 from benchmarks import field_sim

@@ -16,7 +16,8 @@ import pytest
 
 from arcosim.chainfile import read_chain
 from arcosim.cli import main
-from arcosim.identification.beam_fit import fit_link, fit_modes, modal_of, tip_motion
+from arcosim.identification.beam_fit import fit_link, fit_modes, modal_of
+from arcosim.identification.beam_motion import tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.logs import units_path, write_csv

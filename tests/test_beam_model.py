@@ -60,18 +60,20 @@ def test_participations_sum_to_the_link_inertia():
     link = Link(0.02, 0.03, 0.4, m_tip=0.02, J_tip=2e-6, r_hub=0.02)
     every = modal_model(link, modes=48, elements=24)
     assert np.all(every.participation > 0)
-    np.testing.assert_allclose(np.sum(every.participation**2), link.rigid_inertia(), rtol=1e-5)
+    # every mode of the mesh: the rigid motion (r + x)θ projected on the clamped modes,
+    # exact as the mesh refines (1.7e-5 short at 24 elements)
+    np.testing.assert_allclose(np.sum(every.participation**2), link.rigid_inertia(), rtol=5e-5)
     rigid = 0.03 * (0.42**3 - 0.02**3) / 3 + 0.02 * 0.42**2 + 2e-6
     np.testing.assert_allclose(link.rigid_inertia(), rigid, rtol=1e-12)
 
 
 def test_the_star_form_is_the_finite_element_link_seen_from_the_hub():
-    """τ_reac/θ for a prescribed hub angle: the FE model against the star of four modes
+    """τ_reac/θ for a prescribed hub angle: the FE model against the star of ten modes
     with the rest rigid (J_rest), below, between and above the first modes; the rigid
     limit is J_link θ̈ (this project's sign: the torque the link exerts on the hub)."""
     link = Link(0.02, 0.03, 0.4, m_tip=0.02, J_tip=2e-6, r_hub=0.02)
     K, M, coupling = assemble(link, 24)
-    model = modal_model(link, modes=4)
+    model = modal_model(link, modes=10)  # the rest (J_rest) rigid: 1e-4 at 300 rad/s
     J, k, _ = model.star()
     for w in (0.05, 20.0, 150.0, 300.0):
         deflection = np.linalg.solve(K - w**2 * M, w**2 * coupling)  # per unit θ

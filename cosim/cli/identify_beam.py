@@ -23,16 +23,9 @@ import numpy as np
 from arcosim.cli.identify_options import write_report
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
 from arcosim.errors import UserError
-from arcosim.identification.beam_fit import (
-    Geometry,
-    fit_link,
-    fit_modes,
-    link_assumptions,
-    modal_of,
-    stiffening_warning,
-    tip_motion,
-)
+from arcosim.identification.beam_fit import Geometry, fit_link, fit_modes, modal_of
 from arcosim.identification.beam_model import ModalModel
+from arcosim.identification.beam_motion import link_assumptions, stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import log_plausibility
 from arcosim.identification.noise_floor import floor_warning, noise_floor

@@ -21,9 +21,8 @@ Start: the record's first clamped mode (the subspace stabilization diagram,
 opening picks ρA; the fit then runs on openings twice as long each time, up to the
 whole record (a lightly damped mode's cost has local minima spaced π/T).
 
-:func:`tip_motion` runs the Kalman smoother of the fitted model over the record: the
-tip deflection ``w_tip`` (m), its angle ``alpha_tip`` (rad) and the link's reaction
-torque on the hub ``tau_reac`` (N·m, eq. 7).
+:func:`arcosim.identification.beam_motion.tip_motion` runs the Kalman smoother of the
+fitted model over the record: the tip's deflection and the link's reaction torque.
 """
 
 from __future__ import annotations
@@ -59,9 +58,6 @@ MAX_ZETA = 0.5
 MAX_ITERATIONS = 40
 #: Modes beyond the fitted ones whose quasi-static tip deflection the tip estimate keeps.
 STATIC_MODES = 8
-#: The hub's speed over the first clamped mode above which centrifugal stiffening
-#: (outside the linear model) is warned of (dimensionless).
-STIFFENING_RATIO = 0.3
 
 
 @dataclass(frozen=True)
@@ -415,91 +411,6 @@ def _least_squares(
     )
     runs = int(result.nfev * (len(first) + 1))
     return result.x * scale, result.fun, result.jac / scale, runs
-
-
-@dataclass(frozen=True)
-class TipMotion:
-    """The link's motion over a record, from the Kalman smoother of its modal model.
-
-    Attributes
-    ----------
-    w_tip : ndarray
-        Tip deflection (m), shape ``(N,)``.
-    alpha_tip : ndarray
-        Tip deflection angle w_tip / L (rad), shape ``(N,)``.
-    tau_reac : ndarray
-        Torque the link exerts on the hub (N·m, eq. 7), shape ``(N,)``.
-    q : ndarray
-        Modal coordinates (mass-normalized units), shape ``(N, M)``.
-    """
-
-    w_tip: np.ndarray
-    alpha_tip: np.ndarray
-    tau_reac: np.ndarray
-    q: np.ndarray
-
-
-@single_threaded
-def tip_motion(record: EncoderRecord, model: ModalModel, D_m: float, f_c: float) -> TipMotion:
-    """The tip's deflection and the reaction torque over ``record`` (offline, smoothed).
-
-    Parameters
-    ----------
-    record : EncoderRecord
-        The current in (N·m), the encoder out (rad).
-    model : ModalModel
-        The link's modes (:func:`~arcosim.identification.beam_model.modal_model` of the
-        fitted EI, ρA, with the fitted damping).
-    D_m, f_c : float
-        The motor's friction (N·m·s/rad, N·m).
-
-    Returns
-    -------
-    TipMotion
-        ``w_tip`` (m), ``alpha_tip`` (rad), ``tau_reac`` (N·m), ``q`` over the record.
-    """
-    drive = drive_of(model, D_m, f_c)
-    states = Kalman.of(record, drive).smoothed(record, drive)
-    m = len(drive.J) + 1
-    angles, rates = states[:, :m], states[:, m : 2 * m]
-    q = model.participation * (angles[:, 1:] - angles[:, :1])
-    springs = angles @ drive.coupling(drive.k)[0] + rates @ drive.coupling(drive.B)[0]
-    friction = drive.D_m * rates[:, 0] + drive.f_c * record.sign
-    acceleration = (record.drive - friction - springs) / (record.J_m + drive.J_hub)
-    w_tip = q @ model.tip + model.tip_static * acceleration
-    return TipMotion(w_tip, w_tip / model.L, drive.J_hub * acceleration + springs, q)
-
-
-def stiffening_warning(omega_m: np.ndarray, first_mode: float) -> str | None:
-    """A warning when the hub turns faster than :data:`STIFFENING_RATIO` × the first
-    clamped mode (centrifugal stiffening, outside the linear model), else None."""
-    peak = float(np.max(np.abs(omega_m))) if len(omega_m) else 0.0
-    if peak <= STIFFENING_RATIO * first_mode:
-        return None
-    return (
-        f"the hub turns at up to {peak:.1f} rad/s, more than {STIFFENING_RATIO:g} × the first "
-        f"clamped mode ({first_mode:.1f} rad/s): centrifugal stiffening, outside the linear "
-        "beam model, raises the modes; the fit's EI absorbs it (record slower motion)"
-    )
-
-
-def link_assumptions(geometry: Geometry | None) -> dict[str, str]:
-    """What a flexible-link result is conditional on, one line each."""
-    out = {
-        "model": "Euler–Bernoulli beam clamped to the hub, small deflection in the rotating "
-        "frame, no centrifugal stiffening, no gravity, no torsion; modes above the record's "
-        "band rigid on the hub",
-        "actuator": "k_t and J_m are given, not fitted: an error ε in both scales EI, ρA and the "
-        "friction by 1 + ε",
-    }
-    if geometry is not None:
-        out["geometry"] = (
-            f"given: L = {geometry.L:g} m, m_tip = {geometry.m_tip:g} kg, "
-            f"J_tip = {geometry.J_tip:g} kg.m², r_hub = {geometry.r_hub:g} m"
-        )
-    else:
-        out["geometry"] = "not given: a modal model (frequencies, damping, hub participation)"
-    return out
 
 
 def modal_of(result: ParameterFit, geometry: Geometry, count: int | None = None) -> ModalModel:
