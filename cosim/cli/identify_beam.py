@@ -28,6 +28,7 @@ from arcosim.identification.beam_model import ModalModel
 from arcosim.identification.beam_motion import link_assumptions, stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import log_plausibility
+from arcosim.identification.motor_friction import without_friction
 from arcosim.identification.noise_floor import floor_warning, noise_floor
 from arcosim.identification.output_error import ParameterFit, predict
 from arcosim.identification.records import encoder_record, motor_record
@@ -141,10 +142,12 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
     chain = result.extra["chain"]
     n = int(chain["masses"])
     J, k, B = ([chain[f"{p}[{i}]"] for i in range(1, n + 1)] for p in "JkB")
+    if not friction_given:  # τ̂ was computed without it: the fitted friction out
+        motor = without_friction(motor, encoder, D_m, f_c)
     residual = predict(motor, J, k, B) - motor.tau_hat
     rms = float(np.sqrt(np.mean(residual**2)))
     floor, sigma_i = noise_floor(log.time, c["i_a"], (J, k, B), k_t, J_m, cpr, values["g_dist"])
-    warnings = list(plausibility)
+    warnings = list(plausibility) + list(result.extra.get("warnings", []))
     for text in (
         stiffening_warning(encoder.velocity, float(model.frequency[0])),
         floor_warning(rms, floor, sigma_i),

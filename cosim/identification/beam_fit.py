@@ -51,6 +51,8 @@ START_ZETA = 0.01
 SCAN_COUNT = 41
 #: Decades of ρA the start scans, centred where the beam's inertia equals J_m.
 SCAN_DECADES = 4.0
+#: A fitted mode whose hub participation is below this many standard errors is warned of.
+T_WEAK = 10.0
 #: Largest modal damping ratio the fit allows (dimensionless): a mode the record barely
 #: excites may otherwise run off to an overdamped pole.
 MAX_ZETA = 0.5
@@ -251,6 +253,13 @@ def fit_modes(record: EncoderRecord, motor: MotorRecord, modes: int | None = Non
     result = _fit(record, _Problem(names, model, lower, upper), start, note)
     result.extra.update(modal_report(model(result.values)))
     result.extra.pop("tip_shape_m")
+    b, std = result.values[2 * count : 3 * count], result.std[2 * count : 3 * count]
+    result.extra["warnings"] = [
+        f"the mode at {w:.1f} rad/s is weakly determined (hub participation {x:.3g} ± "
+        f"{e:.2g}): it may be no mode of the link; fit fewer (modes=…)"
+        for w, x, e in zip(result.values[:count], b, std)
+        if x < T_WEAK * e
+    ]
     return result
 
 
