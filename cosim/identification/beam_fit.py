@@ -33,13 +33,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import optimize
 
-from arcosim.identification.beam_model import Link, ModalModel, modal_model
+from arcosim.identification.beam_model import Link, ModalModel, modal_model, modal_report
 from arcosim.identification.blas import single_threaded
-from arcosim.identification.chain_modes import chain_from_modes
 from arcosim.identification.encoder_fit import innovation_criterion, stuck_aware_sign
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.kalman import Drive, Kalman, innovations
-from arcosim.identification.modal_start import Modes, detect_modes, modal_damping
+from arcosim.identification.modal_start import DetectedModes, detect_modes
 from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
 from arcosim.identification.output_error import SCAN_SECONDS, ParameterFit
 from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_opening
@@ -97,7 +96,7 @@ def drive_of(model: ModalModel, D_m: float, f_c: float) -> Drive:
 
 @dataclass(frozen=True)
 class _Problem:
-    """A parameterization of the link: names, ``model(p)`` and the lower bounds."""
+    """A parameterization of the link: names, ``model(p)`` and the bounds."""
 
     names: list[str]
     model: Callable[[np.ndarray], ModalModel]
@@ -142,47 +141,8 @@ def fit_link(
         When the record shows no clamped mode, or the fit diverges.
     """
     detected = detect_modes(motor, 8)
-    first = _first_mode(detected, motor)
-
-    def stiffness(rhoA: float) -> float:
-        """EI (N·m²) that puts the first clamped mode on the record's: the modes scale
-        as √EI at a fixed ρA."""
-        return (first / modal_model(geometry.link(1.0, rhoA), 1).frequency[0]) ** 2
-
-    def at(rhoA: float, count: int) -> ModalModel:
-        return modal_model(geometry.link(stiffness(rhoA), rhoA), count)
-
-    centre = record.J_m * 3.0 / ((geometry.r_hub + geometry.L) ** 3 - geometry.r_hub**3)
-    grid = centre * np.logspace(-SCAN_DECADES / 2, SCAN_DECADES / 2, SCAN_COUNT)
-    second = _second_mode(detected, first)
-    if second is not None and (geometry.m_tip > 0 or geometry.J_tip > 0):
-        # the tip's share of the link's mass sets ω₂/ω₁: ρA from the record's ratio
-        rhoA0 = _ratio_match(lambda x: at(x, 2).frequency, grid, second / first)
-        how = f"from the ratio of the second mode ({second:.4g} rad/s) to the first"
-    else:
-        short = encoder_opening(record, SCAN_SECONDS)
-        in_band = [max(1, int(np.sum(at(float(x), 8).frequency < detected.band))) for x in grid]
-        costs = [
-            _cost(short, at(float(x), n).with_damping(START_ZETA)) for x, n in zip(grid, in_band)
-        ]
-        best = int(np.argmin(costs))
-        logs = np.log(grid)
-        found = optimize.minimize_scalar(
-            lambda x: _cost(short, at(float(np.exp(x)), in_band[best]).with_damping(START_ZETA)),
-            bounds=(logs[max(best - 1, 0)], logs[min(best + 1, len(grid) - 1)]),
-            method="bounded",
-            options={"xatol": 1e-3},
-        )
-        rhoA0 = float(np.exp(found.x))
-        how = f"by a scan of the innovations on the first {short.duration:g} s"
-    if modes is None:
-        modes = max(1, int(np.sum(at(rhoA0, 8).frequency < detected.band)))
-    EI0 = stiffness(rhoA0)
-    note = (
-        f"first clamped mode {first:.4g} rad/s (subspace stabilization diagram), ρA {how}: "
-        f"EI = {EI0:.4g} N.m², ρA = {rhoA0:.4g} kg/m"
-    )
-    count = modes
+    EI0, rhoA0, count, note = _start(record, detected, geometry, _first_mode(detected, motor))
+    count = count if modes is None else modes
 
     def model(p: np.ndarray) -> ModalModel:
         return modal_model(geometry.link(p[0], p[1]), count).with_damping(p[2 : 2 + count])
@@ -263,36 +223,65 @@ def fit_modes(record: EncoderRecord, motor: MotorRecord, modes: int | None = Non
     return result
 
 
-def modal_report(model: ModalModel) -> dict:
-    """The modal model and its equivalent chain, JSON-able: ``modes_rad_s``,
-    ``damping_ratios``, ``participation`` (√kg·m), ``tip_shape_m`` (m), ``J_rest``
-    (kg·m²) and ``chain`` (``J[i]``, ``k[i]``, ``B[i]``, :func:`equivalent_chain`)."""
-    return {
-        "modes_rad_s": [float(w) for w in model.frequency],
-        "damping_ratios": [float(z) for z in model.damping],
-        "participation": [float(b) for b in model.participation],
-        "tip_shape_m": [float(p) for p in model.tip],
-        "J_rest": float(model.J_rest),
-        "chain": equivalent_chain(model),
-    }
+def _start(
+    record: EncoderRecord, detected: DetectedModes, geometry: Geometry, first: float
+) -> tuple[float, float, int, str]:
+    """The fit's start: EI (N·m²) and ρA (kg/m) with the record's first clamped mode
+    ``first`` (rad/s), the modes below the band (a count) and a note for the report.
+    With a tip, ρA from the record's ratio of the second mode to the first; without
+    one (the ratio is the bare beam's), from a scan of the innovations over ρA."""
+
+    def stiffness(rhoA: float) -> float:
+        """EI (N·m²) that puts the first clamped mode on the record's: the modes scale
+        as √EI at a fixed ρA."""
+        return (first / modal_model(geometry.link(1.0, rhoA), 1).frequency[0]) ** 2
+
+    def at(rhoA: float, count: int) -> ModalModel:
+        return modal_model(geometry.link(stiffness(rhoA), rhoA), count)
+
+    centre = record.J_m * 3.0 / ((geometry.r_hub + geometry.L) ** 3 - geometry.r_hub**3)
+    grid = centre * np.logspace(-SCAN_DECADES / 2, SCAN_DECADES / 2, SCAN_COUNT)
+    second = _second_mode(detected, first)
+    if second is not None and (geometry.m_tip > 0 or geometry.J_tip > 0):
+        # the tip's share of the link's mass sets ω₂/ω₁: ρA from the record's ratio
+        rhoA0 = _ratio_match(lambda x: at(x, 2).frequency, grid, second / first)
+        how = f"from the ratio of the second mode ({second:.4g} rad/s) to the first"
+    else:
+        short = encoder_opening(record, SCAN_SECONDS)
+        rhoA0 = _scanned(short, at, grid, detected.band)
+        how = f"by a scan of the innovations on the first {short.duration:g} s"
+    modes = max(1, int(np.sum(at(rhoA0, 8).frequency < detected.band)))
+    EI0 = stiffness(rhoA0)
+    note = (
+        f"first clamped mode {first:.4g} rad/s (subspace stabilization diagram), ρA {how}: "
+        f"EI = {EI0:.4g} N.m², ρA = {rhoA0:.4g} kg/m"
+    )
+    return EI0, rhoA0, modes, note
 
 
-def equivalent_chain(model: ModalModel) -> dict[str, float]:
-    """The lumped chain with the link's modes (the Lanczos inverse of their frequencies
-    and residues, :func:`~arcosim.identification.chain_modes.chain_from_modes`), its
-    spring dampers from the modal damping: ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad),
-    ``B[i]`` (N·m·s/rad), ``masses``. The link's inertia outside the modes is not in it
-    (it belongs to the hub)."""
-    J, k = chain_from_modes(model.frequency, model.residues())
-    modes = Modes(model.frequency, model.damping, model.residues(), np.ones(1), np.inf)
-    B = modal_damping(J, k, modes)
-    out: dict[str, float] = {"masses": len(J)}
-    for name, values in (("J", J), ("k", k), ("B", B)):
-        out.update({f"{name}[{i}]": float(v) for i, v in enumerate(values, start=1)})
-    return out
+def _scanned(
+    short: EncoderRecord,
+    at: Callable[[float, int], ModalModel],
+    grid: np.ndarray,
+    band: float,
+) -> float:
+    """The ρA (kg/m) whose link (``at(ρA, modes)``, every mode below ``band`` rad/s)
+    predicts the encoder of ``short`` best: the best of ``grid``, then refined between
+    its neighbours."""
+    in_band = [max(1, int(np.sum(at(float(x), 8).frequency < band))) for x in grid]
+    costs = [_cost(short, at(float(x), n).with_damping(START_ZETA)) for x, n in zip(grid, in_band)]
+    best = int(np.argmin(costs))
+    logs = np.log(grid)
+    found = optimize.minimize_scalar(
+        lambda x: _cost(short, at(float(np.exp(x)), in_band[best]).with_damping(START_ZETA)),
+        bounds=(logs[max(best - 1, 0)], logs[min(best + 1, len(grid) - 1)]),
+        method="bounded",
+        options={"xatol": 1e-3},
+    )
+    return float(np.exp(found.x))
 
 
-def _first_mode(detected, motor: MotorRecord) -> float:
+def _first_mode(detected: DetectedModes, motor: MotorRecord) -> float:
     """The lowest mode that counts (rad/s), or the refusal naming what is missing."""
     strong = detected.frequency[detected.t_value >= T_CONFIRM]
     if not strong.size:
@@ -300,7 +289,7 @@ def _first_mode(detected, motor: MotorRecord) -> float:
     return float(strong[0])
 
 
-def _second_mode(detected, first: float) -> float | None:
+def _second_mode(detected: DetectedModes, first: float) -> float | None:
     """The strongest detected mode above 2 × the first (rad/s), or None."""
     above = (detected.frequency > 2.0 * first) & (detected.t_value >= T_CONFIRM)
     if not np.any(above):

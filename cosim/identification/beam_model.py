@@ -21,6 +21,8 @@ as the drive models of :mod:`arcosim.identification.kalman` take it: each mode a
 b_i² on its own spring b_i² ω_i² and damper 2 ζ_i ω_i b_i² to the hub (then
 ``q_i = b_i (θ_i − θ)``), the modes left out of the model rigid on the hub
 (``J_rest = J_link − Σ b_i²``): exactly the modal equations above.
+:func:`equivalent_chain` is the lumped chain with the same modes seen from the hub (the
+cross-check a report carries), :func:`modal_report` the model as a report gives it.
 """
 
 from __future__ import annotations
@@ -30,7 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from arcosim.identification.chain_modes import chain_from_modes
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.modal_start import Modes, modal_damping
 
 #: Hermite elements the modal model uses by default: the first four clamped modes
 #: within 1e-4 (relative) of the analytic ones (tests/test_beam_model.py).
@@ -143,6 +147,35 @@ class ModalModel:
         ``τ/θ = k_1 − Σ r_i/(s² + ω_i²)`` (:mod:`arcosim.identification.chain_modes`),
         shape ``(M,)``."""
         return self.participation**2 * self.frequency**4
+
+
+def modal_report(model: ModalModel) -> dict:
+    """The modal model and its equivalent chain, JSON-able: ``modes_rad_s``,
+    ``damping_ratios``, ``participation`` (√kg·m), ``tip_shape_m`` (m), ``J_rest``
+    (kg·m²) and ``chain`` (``J[i]``, ``k[i]``, ``B[i]``, :func:`equivalent_chain`)."""
+    return {
+        "modes_rad_s": [float(w) for w in model.frequency],
+        "damping_ratios": [float(z) for z in model.damping],
+        "participation": [float(b) for b in model.participation],
+        "tip_shape_m": [float(p) for p in model.tip],
+        "J_rest": float(model.J_rest),
+        "chain": equivalent_chain(model),
+    }
+
+
+def equivalent_chain(model: ModalModel) -> dict[str, float]:
+    """The lumped chain with the link's modes (the Lanczos inverse of their frequencies
+    and residues, :func:`~arcosim.identification.chain_modes.chain_from_modes`), its
+    spring dampers from the modal damping: ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad),
+    ``B[i]`` (N·m·s/rad), ``masses``. The link's inertia outside the modes is not in it
+    (it belongs to the hub)."""
+    J, k = chain_from_modes(model.frequency, model.residues())
+    modes = Modes(model.frequency, model.damping, model.residues(), np.ones(1), np.inf)
+    B = modal_damping(J, k, modes)
+    out: dict[str, float] = {"masses": len(J)}
+    for name, values in (("J", J), ("k", k), ("B", B)):
+        out.update({f"{name}[{i}]": float(v) for i, v in enumerate(values, start=1)})
+    return out
 
 
 def modal_model(link: Link, modes: int = 4, elements: int = ELEMENTS) -> ModalModel:
