@@ -17,7 +17,7 @@ import pytest
 from arcosim.chainfile import read_chain
 from arcosim.cli import main
 from arcosim.identification.beam_fit import fit_link, fit_modes, modal_of
-from arcosim.identification.beam_motion import tip_motion
+from arcosim.identification.beam_motion import stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.logs import units_path, write_csv
@@ -130,3 +130,12 @@ def test_identify_method_beam_refuses_a_tip_without_a_length(capsys, tmp_path):
 def simulated_short() -> dict[str, np.ndarray]:
     t = np.arange(101) * 1e-3
     return {"time": t, "i_a": np.sin(t), "omega_m": np.cos(t), "theta_m": np.sin(t)}
+
+
+def test_a_hub_fast_against_the_first_mode_is_warned_of():
+    """Centrifugal stiffening is outside the linear model: above 0.3 × the first clamped
+    mode (hub rad/s against mode rad/s) the report warns, below it stays quiet."""
+    slow = 0.29 * 20.0 * np.sin(np.linspace(0, 10, 1000))
+    assert stiffening_warning(slow, 20.0) is None
+    text = stiffening_warning(-1.1 * slow, 20.0)
+    assert text is not None and "centrifugal stiffening" in text and "6.4 rad/s" in text
