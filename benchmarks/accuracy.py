@@ -25,7 +25,9 @@ within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accura
 three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
 Last, the load torque rows (``benchmarks/load_accuracy.py``: the two- and five-mass chains,
 the load on the last and on a middle mass, a model with springs 5 % off, the same
-seeds; and the bandwidth's trade-off on the bench).
+seeds; and the bandwidth's trade-off on the bench). Then the flexible-link rows
+(``benchmarks/beam_accuracy.py``: three links, EI, ρA, the first two clamped modes and
+the tip angle from the hub's current and encoder; ``--beam-only`` runs them alone).
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ from arcosim.identification.offline_observer import estimate_states, replay
 from arcosim.identification.output_error import ParameterFit
 from arcosim.identification.records import MotorRecord, motor_record
 from arcosim.identification.uniform_fit import uniform_chain
-from benchmarks import chain_accuracy, field_accuracy, load_accuracy
+from benchmarks import beam_accuracy, chain_accuracy, field_accuracy, load_accuracy
 from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
 #: Broadband lines (rad/s): the flexible scenario's plus 150 for the five-mass chain.
@@ -280,12 +282,16 @@ def run(
     quick: bool,
     progress: Callable[[str], None] = print,
     load_torque_only: bool = False,
+    beam_only: bool = False,
 ) -> dict[str, object]:
     """Run the benchmark, write ``accuracy.md`` and ``accuracy.json`` into ``out``
-    (``load_torque_only``: only the load torque rows, ``load_torque.md``/``.json``)."""
+    (``load_torque_only``: only the load torque rows, ``load_torque.md``/``.json``;
+    ``beam_only``: only the flexible-link rows, ``beam.md``/``.json``)."""
     started = time.perf_counter()
     if load_torque_only:
         return _load_torque_rows(out, max(b_seeds, seeds), quick, progress, started)
+    if beam_only:
+        return _beam_rows(out, max(b_seeds, seeds), quick, progress, started)
     cases = CASES[:1] if quick else CASES
     seed_list = list(range(1, seeds + 1))
     results = {case.name: score_case(case, seed_list, progress) for case in cases}
@@ -345,6 +351,9 @@ def run(
     load_text, load_summary = _load_torque_table(chain_seeds, quick, progress)
     text += load_text
     summary.update(load_summary)
+    beam_text, beam_summary = _beam_table(chain_seeds, quick, progress)
+    text += beam_text
+    summary.update(beam_summary)
     broadband_fit.cache_clear()
     summary["seconds"] = time.perf_counter() - started
     out.mkdir(parents=True, exist_ok=True)
@@ -373,6 +382,33 @@ def _load_torque_table(
             + load_accuracy.bandwidth_markdown(trade)
         )
     return text, summary
+
+
+def _beam_table(
+    seeds: Sequence[int], quick: bool, progress: Callable[[str], None]
+) -> tuple[str, dict[str, object]]:
+    """The flexible-link rows (:mod:`benchmarks.beam_accuracy`; quick: the first link)."""
+    links = beam_accuracy.LINKS[:1] if quick else beam_accuracy.LINKS
+    rows = {case.name: beam_accuracy.score(case, seeds, progress) for case in links}
+    text = (
+        "\nFlexible links from the hub alone (`--method beam`: logs from `benchmarks/"
+        f"field_sim.py` with the link's modes, {beam_accuracy.DURATION:g} s multi-sine, "
+        f"{len(seeds)} seeds; k_t, J_m, the counts, the friction, L, m_tip given):\n\n"
+        + beam_accuracy.markdown(rows)
+    )
+    return text, {"flexible_link": rows}
+
+
+def _beam_rows(
+    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
+) -> dict[str, object]:
+    seeds = list(range(1, (1 if quick else count) + 1))
+    text, summary = _beam_table(seeds, quick, progress)
+    summary["seconds"] = time.perf_counter() - started
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "beam.md").write_text(text, encoding="utf-8")
+    (out / "beam.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    return {"table": text, **summary, "files": ("beam.md", "beam.json")}
 
 
 def _load_torque_rows(
@@ -406,6 +442,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="only the load torque rows (as many seeds as the whole-chain rows: the larger "
         "of --seeds and --b-seeds), into load_torque.md/.json",
     )
+    p.add_argument(
+        "--beam-only",
+        action="store_true",
+        help="only the flexible-link rows (as many seeds as the whole-chain rows), into "
+        "beam.md/.json",
+    )
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
     p.set_defaults(execute=_execute)
 
@@ -420,6 +462,7 @@ def _execute(args: argparse.Namespace) -> int:
         args.quick,
         progress=_progress,
         load_torque_only=args.load_torque_only,
+        beam_only=args.beam_only,
     )
     print(result["table"])
     md, js = result.get("files", ("accuracy.md", "accuracy.json"))

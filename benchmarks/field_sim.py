@@ -49,6 +49,8 @@ class Drive:
             value acts on the load mass in the negative direction).
         load_sine: (amplitude N·m, frequency rad/s) of a sine load torque.
         load_mass: index (1…n) of the mass the load torque acts on.
+        star: each mass hangs on its own spring and damper from the motor (k[i], B[i]
+            between the motor and J[i]: a flexible link's modes) instead of the chain.
     """
 
     J_m: float
@@ -65,6 +67,7 @@ class Drive:
     load_torque: float = 0.0
     load_sine: tuple[float, float] = (0.0, 0.0)
     load_mass: int = 0  # 0: the last mass
+    star: bool = False  # each mass on its own spring to the motor (a flexible link's modes)
 
     @property
     def n(self) -> int:
@@ -114,11 +117,12 @@ class _Model:
         K = np.zeros((m, m))
         C = np.zeros((m, m))
         for j, (kj, bj) in enumerate(zip(drive.k, drive.B)):
+            a = 0 if drive.star else j  # the spring's motor-side end
             for M, v in ((K, kj), (C, bj)):
-                M[j, j] += v
+                M[a, a] += v
                 M[j + 1, j + 1] += v
-                M[j, j + 1] -= v
-                M[j + 1, j] -= v
+                M[a, j + 1] -= v
+                M[j + 1, a] -= v
         C[0, 0] += drive.D_m
         size = 2 * m + 2
         A = np.zeros((size, size))

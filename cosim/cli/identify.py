@@ -5,7 +5,7 @@ Contract (scripts rely on it)::
 
     arcosim identify LOG.csv [--masses N] [--mode 0|1|2] [--set NAME=VALUE ...]
                              [--scale COLUMN=FACTOR ...] [--json] [--out FILE]
-                             [--method observer|output-error|whole-chain|load-torque]
+                             [--method observer|output-error|whole-chain|load-torque|beam]
                              [--fit-inertia-scale] [--start-k K] [--chain FIT.json]
 
 * the log's columns ``time``, ``i_a``, ``omega_m``, ``theta_m`` (SI; ``--scale``
@@ -53,6 +53,15 @@ Contract (scripts rely on it)::
   ``tau_load_hat``, ``tau_reac_hat``, ``theta_hat[i]``, ``omega_hat[i]`` and the
   innovation; ``--json`` prints a summary. The step may vary.
 
+* ``--method beam --set L=M --set m_tip=KG [--set J_tip=… --set r_hub=…]``: a flexible
+  link on the hub (``arcosim.identification.beam_fit``): EI, ρA, the modal damping and,
+  unless given, the hub's friction, from the current and the encoder (``encoder_cpr``
+  needed); without ``L``, the link's modal model (frequencies, damping, hub
+  participation). ``--json`` prints ``EI``, ``rhoA``, ``modes_rad_s`` (hub-locked),
+  ``std``, the assumptions and the equivalent lumped chain; ``--out FILE.json`` writes
+  the report (``--chain`` reads its chain), ``--out FILE.csv`` the tip's motion over
+  time (``alpha_tip_hat``, ``w_tip_hat``, ``tau_reac_hat``).
+
 Every method names, on a line ``assumption, defaults``, the drive's parameters (J_mo,
 k_to, D_m, f_c, encoder_cpr, the chain) it left at the paper bench's default.
 
@@ -67,6 +76,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arcosim.cli.identify_beam import run_beam
 from arcosim.cli.identify_load_torque import run_load_torque
 from arcosim.cli.identify_observer import run_observer
 from arcosim.cli.identify_options import (
@@ -96,6 +106,7 @@ Identify a drive from a log of its motor: columns time (s), i_a (A), omega_m
   whole-chain   fit every load inertia, stiffness and damping, and n (--masses auto)
   output-error  fit the uniform chain's k and B, the J[i] known
   load-torque   the torque on one load mass over time (--set load_mass=I)
+  beam          a flexible link: EI, rhoA, its modes and the tip (--set L=, m_tip=)
 
 Give first what you know of the motor (anything not given takes the paper bench's
 value, and the output names it on a line "assumption, defaults"):
@@ -133,11 +144,12 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
     force_option(p)
     p.add_argument(
         "--method",
-        choices=("observer", "output-error", "whole-chain", "load-torque"),
+        choices=("observer", "output-error", "whole-chain", "load-torque", "beam"),
         default="observer",
         help="observer: replay the observer FMU (default); output-error: fit k and B "
         "offline; whole-chain: fit every J[i], k[i], B[i] offline; load-torque: estimate "
-        "the torque on load mass load_mass over time, offline",
+        "the torque on load mass load_mass over time, offline; beam: a flexible link's EI, "
+        "rhoA, damping and tip motion (--set L=M --set m_tip=KG), offline",
     )
     p.add_argument(
         "--chain",
@@ -173,13 +185,15 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
-    if args.chain and args.method == "whole-chain":
+    if args.chain and args.method in ("whole-chain", "beam"):
         raise UserError(
             "--chain is for the methods that use a chain (observer, output-error, "
-            "load-torque); --method whole-chain fits it"
+            f"load-torque); --method {args.method} fits it"
         )
     chain = chain_option(args.chain) if args.chain else {}
     log = read_log(args.log, parse_scales(args.scale))
+    if args.method == "beam":
+        return run_beam(args, log)
     if args.method == "whole-chain":
         masses = args.masses if args.masses == "auto" else masses_option(args.masses)
         return run_whole_chain(args, log, masses)

@@ -151,11 +151,17 @@ def check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:
     if args.out is None:
         return
     is_json = args.out.suffix.lower() == ".json"
-    if args.method in OFFLINE and not is_json:
+    if args.method == "beam":  # the report (.json) or the tip's motion (.csv)
+        if args.out.suffix.lower() not in (".json", ".csv"):
+            raise UserError(
+                f"--out {args.out}: --method beam writes its report (.json) or the tip's "
+                "motion over time (.csv); name a .json or .csv file"
+            )
+    elif args.method in OFFLINE and not is_json:
         raise UserError(
             f"--out {args.out}: --method {args.method} writes its report as JSON; name a .json file"
         )
-    if args.method not in OFFLINE and is_json:
+    elif is_json and args.method not in OFFLINE:
         raise UserError(
             f"--out {args.out}: --method {args.method} writes its outputs over time as CSV; "
             "name a .csv file (--json prints a summary)"

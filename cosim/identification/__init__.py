@@ -32,6 +32,15 @@ whole_chain       -- every J_i, k_i, B_i and n from the motor alone (identify_wh
                      ChainChoice)
 noise_floor       -- the residual the encoder's counts and the current's noise explain
 
+Flexible link
+-------------
+beam_model        -- a beam on a hub: its clamped modes, hub participations, tip shape
+                     (Link, ModalModel, modal_model)
+beam_fit          -- EI, ρA, damping (or the modal model) from current and encoder
+                     (fit_link, fit_modes, Geometry)
+beam_motion       -- the tip's deflection and eq. 7's reaction torque over a log
+                     (tip_motion), the linear model's limits
+
 Drive
 -----
 drive             -- the whole job from a log (identify_drive, DriveIdentification)

@@ -94,7 +94,8 @@ def stuck_aware_sign(record: EncoderRecord, drive: Drive, states: np.ndarray) ->
     n = len(drive.J)
     m = n + 1
     omega = states[:, m]
-    spring = drive.k[0] * (states[:, 0] - states[:, 1]) + drive.B[0] * (omega - states[:, m + 1])
+    K, C = drive.coupling(drive.k)[0], drive.coupling(drive.B)[0]
+    spring = states[:, :m] @ K + states[:, m : 2 * m] @ C  # the springs' torque on the motor
     other = record.drive - drive.D_m * omega - spring
     sign = mean_sign(omega)
     stuck = np.abs(omega) < STUCK_VELOCITY_COUNTS * record.count

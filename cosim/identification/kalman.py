@@ -40,6 +40,12 @@ class Drive:
         Motor Coulomb friction (N·m).
     tau_load : float
         Constant load torque on the last mass (N·m).
+    star : bool
+        The masses each hang on their own spring and damper from the motor (a flexible
+        link's modes, :meth:`arcosim.identification.beam_model.ModalModel.star`)
+        instead of the chain's k_1 from the motor to J_1, k_2 from J_1 to J_2, ….
+    J_hub : float
+        Inertia rigid on the motor besides the record's J_m (kg·m²).
     """
 
     J: np.ndarray
@@ -48,6 +54,18 @@ class Drive:
     D_m: float
     f_c: float
     tau_load: float = 0.0
+    star: bool = False
+    J_hub: float = 0.0
+
+    def coupling(self, values: np.ndarray) -> np.ndarray:
+        """Stiffness (``values`` = k) or damping (``values`` = B) matrix on the angles
+        ``[θ_m, θ_1…θ_n]``, shape ``(n + 1, n + 1)``: the chain's or the star's."""
+        values = np.asarray(values, dtype=float)
+        if not self.star:
+            return np.array(spring_matrix([float(x) for x in values]))
+        matrix = np.diag(np.concatenate([[np.sum(values)], values]))
+        matrix[0, 1:] = matrix[1:, 0] = -values
+        return matrix
 
 
 @dataclass(frozen=True)
@@ -176,9 +194,9 @@ def discrete_drive(record: EncoderRecord, drive: Drive) -> tuple[np.ndarray, np.
     slow load's random walk, N·m), inputs (motor torque, load torque on the last mass;
     N·m) held over the step. Returns ``(A, Bd)``, shapes ``(S, S)`` and ``(S, 2)``."""
     m = len(drive.J) + 1
-    inverse = 1.0 / np.array([record.J_m, *drive.J])
-    K = np.array(spring_matrix([float(x) for x in drive.k]))
-    C = np.array(spring_matrix([float(x) for x in drive.B]))
+    inverse = 1.0 / np.array([record.J_m + drive.J_hub, *drive.J])
+    K = drive.coupling(drive.k)
+    C = drive.coupling(drive.B)
     C[0, 0] += drive.D_m
     slow = record.load == "slow"
     size = 2 * m + slow

@@ -1,0 +1,424 @@
+"""Identify a flexible link from the hub alone: EI, ρA, its modes and damping (offline).
+
+The link is the modal model of :mod:`arcosim.identification.beam_model`: given its
+length L, tip mass m_tip (and tip inertia J_tip, hub radius r, else 0), the bending
+stiffness EI and mass per length ρA fix every clamped mode and its hub participation.
+Written as masses on their own springs to the hub (:meth:`ModalModel.star`), the link
+is a drive model of :mod:`arcosim.identification.kalman` (``Drive(star=True)``), so
+the fit is the chain's prediction-error fit from the motor current to the encoder
+(:mod:`arcosim.identification.encoder_fit`: the same Kalman predictor, friction sign
+passes and Newey–West standard errors), on these parameters:
+
+* ``EI`` (N·m²), ``rhoA`` (kg/m), the damping ratio ``zeta[i]`` of each mode below the
+  record's band, then the motor's ``D_m``, ``f_c`` when not given (:func:`fit_link`);
+* without the geometry, each mode's frequency ``omega[i]`` (rad/s), ``zeta[i]`` and
+  hub participation ``b[i]``, and the link's inertia outside the modes ``J_rest``
+  (:func:`fit_modes`).
+
+Start: the record's first clamped mode (the subspace stabilization diagram,
+:func:`arcosim.identification.modal_start.detect_modes`) fixes EI/ρA for each ρA
+(the modes scale as √EI), and a scan of the innovations over ρA on the record's
+opening picks ρA; the fit then runs on openings twice as long each time, up to the
+whole record (a lightly damped mode's cost has local minima spaced π/T).
+
+:func:`arcosim.identification.beam_motion.tip_motion` runs the Kalman smoother of the
+fitted model over the record: the tip's deflection and the link's reaction torque.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import optimize
+
+from arcosim.identification.beam_model import Link, ModalModel, modal_model, modal_report
+from arcosim.identification.blas import single_threaded
+from arcosim.identification.encoder_fit import innovation_criterion, stuck_aware_sign
+from arcosim.identification.errors import IdentificationError
+from arcosim.identification.kalman import Drive, Kalman, innovations
+from arcosim.identification.modal_start import DetectedModes, detect_modes
+from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
+from arcosim.identification.output_error import SCAN_SECONDS, ParameterFit
+from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_opening
+from arcosim.identification.whole_chain import T_CONFIRM, missing_modes
+
+#: Damping ratio every mode starts from (dimensionless).
+START_ZETA = 0.01
+#: ρA values the start scans (a count), log-spaced over :data:`SCAN_DECADES`.
+SCAN_COUNT = 41
+#: Decades of ρA the start scans, centred where the beam's inertia equals J_m.
+SCAN_DECADES = 4.0
+#: A fitted mode whose hub participation is below this many standard errors is warned of.
+T_WEAK = 10.0
+#: Largest modal damping ratio the fit allows (dimensionless): a mode the record barely
+#: excites may otherwise run off to an overdamped pole.
+MAX_ZETA = 0.5
+#: Iterations of each least-squares stage.
+MAX_ITERATIONS = 40
+#: Modes beyond the fitted ones whose quasi-static tip deflection the tip estimate keeps.
+STATIC_MODES = 8
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """What the user knows of the link: its length, tip mass, tip inertia, hub radius.
+
+    Attributes
+    ----------
+    L : float
+        Length (m), > 0.
+    m_tip : float
+        Tip mass (kg), ≥ 0.
+    J_tip : float
+        Tip inertia (kg·m²), ≥ 0.
+    r_hub : float
+        Clamp radius (m), ≥ 0.
+    """
+
+    L: float
+    m_tip: float = 0.0
+    J_tip: float = 0.0
+    r_hub: float = 0.0
+
+    def link(self, EI: float, rhoA: float) -> Link:
+        """The link of this geometry with ``EI`` (N·m²) and ``rhoA`` (kg/m)."""
+        return Link(EI, rhoA, self.L, self.m_tip, self.J_tip, self.r_hub)
+
+
+def drive_of(model: ModalModel, D_m: float, f_c: float) -> Drive:
+    """The Kalman drive model of a link's modes (masses on springs to the hub, the rest
+    of the link rigid on it) with the motor friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m)."""
+    J, k, B = model.star()
+    return Drive(J, k, B, float(D_m), float(f_c), star=True, J_hub=max(model.J_rest, 0.0))
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """A parameterization of the link: names, ``model(p)`` and the bounds."""
+
+    names: list[str]
+    model: Callable[[np.ndarray], ModalModel]
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+@single_threaded
+def fit_link(
+    record: EncoderRecord,
+    motor: MotorRecord,
+    geometry: Geometry,
+    modes: int | None = None,
+) -> ParameterFit:
+    """Fit EI, ρA, the modal damping and (when not given) the motor friction.
+
+    Parameters
+    ----------
+    record : EncoderRecord
+        The current in (N·m), the encoder out (rad), the motor's J_m and friction
+        (:func:`~arcosim.identification.records.encoder_record`).
+    motor : MotorRecord
+        The same log's τ̂_reac record (:func:`~arcosim.identification.records.motor_record`),
+        for the start's first clamped mode.
+    geometry : Geometry
+        L, m_tip, J_tip, r_hub.
+    modes : int, optional
+        Modes in the model (a count; default: those below the record's band, at least
+        one); the rest of the link is rigid on the hub.
+
+    Returns
+    -------
+    ParameterFit
+        ``EI`` (N·m²), ``rhoA`` (kg/m), ``zeta[i]``, then ``D_m``, ``f_c`` with
+        standard errors; ``extra`` holds the modal model (``modes_rad_s``,
+        ``participation``, ``tip_shape_m``, ``J_link``), the equivalent chain, the
+        start and the evidence.
+
+    Raises
+    ------
+    IdentificationError
+        When the record shows no clamped mode, or the fit diverges.
+    """
+    detected = detect_modes(motor, 8)
+    EI0, rhoA0, count, note = _start(record, detected, geometry, _first_mode(detected, motor))
+    count = count if modes is None else modes
+
+    def model(p: np.ndarray) -> ModalModel:
+        return modal_model(geometry.link(p[0], p[1]), count).with_damping(p[2 : 2 + count])
+
+    names = ["EI", "rhoA", *(f"zeta[{i}]" for i in range(1, count + 1))]
+    start = [EI0, rhoA0, *([START_ZETA] * count)]
+    lower = [1e-3 * EI0, 1e-3 * rhoA0, *([0.0] * count)]
+    upper = [np.inf, np.inf, *([MAX_ZETA] * count)]
+    problem = _Problem(names, model, np.array(lower), np.array(upper))
+    result = _fit(record, problem, np.array(start), note)
+    fitted = model(result.values)
+    result.extra.update(
+        modal_report(fitted),
+        detected_modes_rad_s=[float(w) for w in detected.frequency],
+        residue_t_values=[float(t) for t in detected.t_value],
+        J_link=fitted.J_link,
+    )
+    return result
+
+
+@single_threaded
+def fit_modes(record: EncoderRecord, motor: MotorRecord, modes: int | None = None) -> ParameterFit:
+    """A link's modal model when its geometry is unknown: each mode's frequency, damping
+    and hub participation, and the link's inertia outside the modes.
+
+    Parameters
+    ----------
+    record : EncoderRecord
+        The current in (N·m), the encoder out (rad).
+    motor : MotorRecord
+        The same log's τ̂_reac record, for the start (the modes it shows, their
+        residues r_i = b_i² ω_i⁴).
+    modes : int, optional
+        Modes fitted (a count; default: every mode the record shows that counts).
+
+    Returns
+    -------
+    ParameterFit
+        ``omega[i]`` (rad/s), ``zeta[i]``, ``b[i]`` (√kg·m), ``J_rest`` (kg·m²), then
+        ``D_m``, ``f_c``, with standard errors; ``extra`` as :func:`fit_link`'s.
+
+    Raises
+    ------
+    IdentificationError
+        When the record shows fewer modes than asked, or none.
+    """
+    detected = detect_modes(motor, 8)
+    _first_mode(detected, motor)
+    count = detected.n if modes is None else modes
+    if detected.n < count:
+        raise IdentificationError(missing_modes(detected, count, motor))
+    w0 = detected.frequency[:count]
+    b0 = np.sqrt(detected.residue[:count]) / w0**2
+    zeta0 = np.clip(detected.damping[:count], 1e-3, 0.2)
+    rest0 = 0.1 * float(np.sum(b0**2))
+    note = "the record's modes " + ", ".join(f"{w:.4g}" for w in w0) + " rad/s and residues"
+
+    def model(p: np.ndarray) -> ModalModel:
+        w, zeta, b = p[:count], p[count : 2 * count], p[2 * count : 3 * count]
+        J_link = float(np.sum(b**2)) + p[3 * count]
+        return ModalModel(w, b, np.zeros(count), zeta, J_link, 1.0)
+
+    names = [f"{p}[{i}]" for p in ("omega", "zeta", "b") for i in range(1, count + 1)]
+    names.append("J_rest")
+    start = np.concatenate([w0, zeta0, b0, [rest0]])
+    lower = np.concatenate([0.5 * w0, np.zeros(count), 1e-3 * b0, [0.0]])
+    upper = np.concatenate([2.0 * w0, np.full(count, MAX_ZETA), np.full(count + 1, np.inf)])
+    result = _fit(record, _Problem(names, model, lower, upper), start, note)
+    result.extra.update(modal_report(model(result.values)))
+    result.extra.pop("tip_shape_m")
+    b, std = result.values[2 * count : 3 * count], result.std[2 * count : 3 * count]
+    result.extra["warnings"] = [
+        f"the mode at {w:.1f} rad/s is weakly determined (hub participation {x:.3g} ± "
+        f"{e:.2g}): it may be no mode of the link; fit fewer (modes=…)"
+        for w, x, e in zip(result.values[:count], b, std)
+        if x < T_WEAK * e
+    ]
+    return result
+
+
+def _start(
+    record: EncoderRecord, detected: DetectedModes, geometry: Geometry, first: float
+) -> tuple[float, float, int, str]:
+    """The fit's start: EI (N·m²) and ρA (kg/m) with the record's first clamped mode
+    ``first`` (rad/s), the modes below the band (a count) and a note for the report.
+    With a tip, ρA from the record's ratio of the second mode to the first; without
+    one (the ratio is the bare beam's), from a scan of the innovations over ρA."""
+
+    def stiffness(rhoA: float) -> float:
+        """EI (N·m²) that puts the first clamped mode on the record's: the modes scale
+        as √EI at a fixed ρA."""
+        return (first / modal_model(geometry.link(1.0, rhoA), 1).frequency[0]) ** 2
+
+    def at(rhoA: float, count: int) -> ModalModel:
+        return modal_model(geometry.link(stiffness(rhoA), rhoA), count)
+
+    centre = record.J_m * 3.0 / ((geometry.r_hub + geometry.L) ** 3 - geometry.r_hub**3)
+    grid = centre * np.logspace(-SCAN_DECADES / 2, SCAN_DECADES / 2, SCAN_COUNT)
+    second = _second_mode(detected, first)
+    if second is not None and (geometry.m_tip > 0 or geometry.J_tip > 0):
+        # the tip's share of the link's mass sets ω₂/ω₁: ρA from the record's ratio
+        rhoA0 = _ratio_match(lambda x: at(x, 2).frequency, grid, second / first)
+        how = f"from the ratio of the second mode ({second:.4g} rad/s) to the first"
+    else:
+        short = encoder_opening(record, SCAN_SECONDS)
+        rhoA0 = _scanned(short, at, grid, detected.band)
+        how = f"by a scan of the innovations on the first {short.duration:g} s"
+    modes = max(1, int(np.sum(at(rhoA0, 8).frequency < detected.band)))
+    EI0 = stiffness(rhoA0)
+    note = (
+        f"first clamped mode {first:.4g} rad/s (subspace stabilization diagram), ρA {how}: "
+        f"EI = {EI0:.4g} N.m², ρA = {rhoA0:.4g} kg/m"
+    )
+    return EI0, rhoA0, modes, note
+
+
+def _scanned(
+    short: EncoderRecord,
+    at: Callable[[float, int], ModalModel],
+    grid: np.ndarray,
+    band: float,
+) -> float:
+    """The ρA (kg/m) whose link (``at(ρA, modes)``, every mode below ``band`` rad/s)
+    predicts the encoder of ``short`` best: the best of ``grid``, then refined between
+    its neighbours."""
+    in_band = [max(1, int(np.sum(at(float(x), 8).frequency < band))) for x in grid]
+    costs = [_cost(short, at(float(x), n).with_damping(START_ZETA)) for x, n in zip(grid, in_band)]
+    best = int(np.argmin(costs))
+    logs = np.log(grid)
+    found = optimize.minimize_scalar(
+        lambda x: _cost(short, at(float(np.exp(x)), in_band[best]).with_damping(START_ZETA)),
+        bounds=(logs[max(best - 1, 0)], logs[min(best + 1, len(grid) - 1)]),
+        method="bounded",
+        options={"xatol": 1e-3},
+    )
+    return float(np.exp(found.x))
+
+
+def _first_mode(detected: DetectedModes, motor: MotorRecord) -> float:
+    """The lowest mode that counts (rad/s), or the refusal naming what is missing."""
+    strong = detected.frequency[detected.t_value >= T_CONFIRM]
+    if not strong.size:
+        raise IdentificationError(missing_modes(detected, None, motor))
+    return float(strong[0])
+
+
+def _second_mode(detected: DetectedModes, first: float) -> float | None:
+    """The strongest detected mode above 2 × the first (rad/s), or None."""
+    above = (detected.frequency > 2.0 * first) & (detected.t_value >= T_CONFIRM)
+    if not np.any(above):
+        return None
+    return float(detected.frequency[above][np.argmax(detected.t_value[above])])
+
+
+def _ratio_match(
+    frequencies: Callable[[float], np.ndarray], grid: np.ndarray, ratio: float
+) -> float:
+    """The ρA (kg/m) on or between ``grid`` whose ω₂/ω₁ is nearest ``ratio``."""
+
+    def mismatch(log_rhoA: float) -> float:
+        w = frequencies(float(np.exp(log_rhoA)))
+        return abs(np.log(w[1] / w[0] / ratio))
+
+    logs = np.log(grid)
+    best = int(np.argmin([mismatch(x) for x in logs]))
+    low, high = logs[max(best - 1, 0)], logs[min(best + 1, len(logs) - 1)]
+    found = optimize.minimize_scalar(mismatch, bounds=(low, high), method="bounded")
+    return float(np.exp(found.x))
+
+
+def _cost(record: EncoderRecord, model: ModalModel) -> float:
+    with np.errstate(all="ignore"):
+        e = innovations(record, drive_of(model, record.D_m, record.f_c))
+    cost = float(np.sum(e**2))
+    return cost if np.isfinite(cost) else np.inf
+
+
+def _fit(record: EncoderRecord, problem: _Problem, start: np.ndarray, note: str) -> ParameterFit:
+    """The prediction-error fit of ``problem`` on openings of growing length (from
+    :data:`SCAN_SECONDS` to the whole record), then the friction sign from the
+    smoother's states and a last pass on the whole record."""
+    friction = not record.friction_given
+    names = list(problem.names) + (["D_m", "f_c"] if friction else [])
+    values = np.concatenate([start, [record.D_m, record.f_c]] if friction else [start])
+    lower = np.concatenate([problem.lower, [0.0, 0.0]] if friction else [problem.lower])
+    upper = np.concatenate([problem.upper, [np.inf, np.inf]] if friction else [problem.upper])
+    seconds, runs = SCAN_SECONDS, 0
+    while True:
+        part = encoder_opening(record, seconds)
+        values, residual, jac, more = _least_squares(part, problem, values, (lower, upper))
+        runs += more
+        if part.duration >= record.duration:
+            break
+        seconds *= 2.0
+    drive = _drive(problem, values, record)
+    with np.errstate(all="ignore"):
+        states = Kalman.of(record, drive).smoothed(record, drive)
+    if np.all(np.isfinite(states)):
+        m = len(drive.J) + 1
+        record = replace(
+            record, friction_sign=stuck_aware_sign(record, drive, states), velocity=states[:, m]
+        )
+        values, residual, jac, more = _least_squares(record, problem, values, (lower, upper))
+        runs += more
+    drive = _drive(problem, values, record)
+    lag = decorrelation_lag(residual, 1)
+    std = np.sqrt(np.clip(np.diag(newey_west_covariance(jac, residual, lag)), 0.0, None))
+    extra = {
+        "information_criterion": innovation_criterion(residual, len(values)),
+        "innovation_variance": float(np.mean(residual**2)),
+        "torque_std": record.torque_std,
+        "friction": "fitted" if friction else "given",
+        "D_m": drive.D_m,
+        "f_c": drive.f_c,
+    }
+    return ParameterFit(
+        names=names,
+        values=values,
+        std=std,
+        start=np.concatenate([start, [record.D_m, record.f_c]] if friction else [start]),
+        start_note=note + "; then the prediction-error fit from the current to the encoder",
+        rms_residual=float(np.sqrt(np.mean(residual**2))),
+        rms_data=1.0,
+        lag=lag,
+        evaluations=runs,
+        extra=extra,
+    )
+
+
+def _drive(problem: _Problem, p: np.ndarray, record: EncoderRecord) -> Drive:
+    """The drive of parameter vector ``p`` (the problem's, then D_m, f_c when fitted)."""
+    D_m, f_c = (p[-2], p[-1]) if not record.friction_given else (record.D_m, record.f_c)
+    return drive_of(problem.model(p), D_m, f_c)
+
+
+def _least_squares(
+    record: EncoderRecord,
+    problem: _Problem,
+    first: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Least squares on the innovations from ``first``: values, innovations, their
+    Jacobian by parameter (N − 1, P), model runs. Each parameter is scaled by its start."""
+    scale = np.maximum(np.abs(first), 1e-9)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            e = innovations(record, _drive(problem, x * scale, record))
+        if not np.all(np.isfinite(e)):
+            raise IdentificationError(
+                "the flexible link's prediction-error fit diverged (the record does not "
+                "determine the link): excite its modes better, or check L and m_tip"
+            )
+        return e
+
+    lower, upper = bounds[0] / scale, bounds[1] / scale
+    result = optimize.least_squares(
+        residual,
+        np.clip(first / scale, lower, upper),
+        bounds=(lower, upper),
+        x_scale="jac",
+        diff_step=1e-6,
+        max_nfev=MAX_ITERATIONS,
+    )
+    runs = int(result.nfev * (len(first) + 1))
+    return result.x * scale, result.fun, result.jac / scale, runs
+
+
+def modal_of(result: ParameterFit, geometry: Geometry, count: int | None = None) -> ModalModel:
+    """The fitted link's modal model (of :func:`fit_link`'s result), ``count`` modes
+    (default the fit's), the next :data:`STATIC_MODES` in its quasi-static tip
+    deflection; a mode beyond the fit's takes the last fitted damping."""
+    values = result.as_dict()
+    zeta = [values[n] for n in result.names if n.startswith("zeta[")]
+    count = len(zeta) if count is None else count
+    link = geometry.link(values["EI"], values["rhoA"])
+    zeta_all = np.concatenate([zeta, np.full(max(count - len(zeta), 0), zeta[-1])])[:count]
+    full = modal_model(link, count + STATIC_MODES).first(count)
+    return full.with_damping(zeta_all)
