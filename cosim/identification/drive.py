@@ -231,7 +231,8 @@ def identify_drive(
     )
     plausibility = decision.plausibility
     if decision.problems:
-        raise IdentificationError("; ".join(plausibility + decision.problems))
+        # the warnings first (the log's implausible units or length lead), as check says
+        raise IdentificationError("; ".join(decision.warnings + decision.problems))
     record, encoder = decision.record, decision.encoder
     try:
         choice = identify_whole_chain(record, masses, encoder)

@@ -47,6 +47,9 @@ BROADBAND_DROP = 0.1
 FIRST_HARMONIC = 3
 #: Periodic: at least this many lines (a count) on multiples of one fundamental.
 LEAST_HARMONICS = 3
+#: Periodic: the harmonics carry at least this share of the lines' power
+#: (dimensionless, 0 … 1).
+HARMONIC_POWER = 0.8
 #: Periodic: a line is a harmonic when within this many frequency bins (2π/T) of k·ω_0.
 HARMONIC_TOLERANCE = 0.5
 
@@ -217,10 +220,10 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     coarse = position[keep] * resolution
     # lines under two periods of the record are told from a trend's remnant poorly:
     # the harmonic test leaves them out, and a periodic excitation keeps its harmonics
-    w0 = harmonic_fundamental(coarse[coarse >= 2 * resolution], resolution)
+    low = coarse >= 2 * resolution
+    w0 = harmonic_fundamental(coarse[low], resolution, amplitude[keep][low])
     if w0:
-        on = np.abs(coarse - np.rint(coarse / w0) * w0) <= HARMONIC_TOLERANCE * resolution
-        on &= coarse >= 0.5 * w0
+        on = _on_harmonics(coarse, w0, resolution)
         return np.rint(coarse[on] / w0) * w0, amplitude[keep][on], share
     if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
         return coarse, amplitude[keep], share
@@ -367,14 +370,18 @@ def _fit(x: np.ndarray, t: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.nd
     return coef[: len(w)], coef[len(w) :]
 
 
-def harmonic_fundamental(lines: np.ndarray, resolution: float) -> float:
+def harmonic_fundamental(
+    lines: np.ndarray, resolution: float, amplitudes: np.ndarray | None = None
+) -> float:
     """The fundamental (rad/s) the lines are harmonics of, or 0 when they are not.
 
-    The lines count as harmonics of ω_0 when at least :data:`LEAST_HARMONICS` of them,
-    all of them, sit within :data:`HARMONIC_TOLERANCE` bins (``resolution``) of whole
-    multiples k·ω_0 and the lowest is at most the :data:`FIRST_HARMONIC`-th: a
-    square-wave or stepped reference, not a multi-sine whose lines merely lie on the
-    record's grid (its lowest line the 10th or the 100th multiple of 2π/T).
+    The lines count as harmonics of ω_0 when at least :data:`LEAST_HARMONICS` of them
+    sit within :data:`HARMONIC_TOLERANCE` bins (``resolution``) of whole multiples
+    k·ω_0, the lowest of those at most the :data:`FIRST_HARMONIC`-th, and they carry
+    :data:`HARMONIC_POWER` of the lines' power: a square-wave or stepped reference (in
+    a closed loop its current also shows the loop's resonances between the harmonics),
+    not a multi-sine whose lines merely lie on the record's grid (its lowest line the
+    10th or the 100th multiple of 2π/T).
 
     Parameters
     ----------
@@ -382,6 +389,8 @@ def harmonic_fundamental(lines: np.ndarray, resolution: float) -> float:
         Line frequencies (rad/s), ascending, shape ``(L,)``.
     resolution : float
         The record's frequency grid 2π/T (rad/s).
+    amplitudes : ndarray, optional
+        The lines' amplitudes (any unit), shape ``(L,)``; default all equal.
 
     Returns
     -------
@@ -398,19 +407,35 @@ def harmonic_fundamental(lines: np.ndarray, resolution: float) -> float:
     """
     if len(lines) < LEAST_HARMONICS:
         return 0.0
-    for first in range(1, FIRST_HARMONIC + 1):
-        w0 = lines[0] / first
-        if w0 < resolution:
-            break
-        for _ in range(2):  # assign the harmonic numbers, refit ω_0 on them
-            k = np.maximum(np.rint(lines / w0), 1)
-            w0 = float(np.sum(k * lines) / np.sum(k * k))
-        k = np.rint(lines / w0)
-        off = np.abs(lines - k * w0)
-        near = np.all(off <= HARMONIC_TOLERANCE * resolution + 1e-3 * lines)
-        if near and np.all(k >= 1) and len(np.unique(k)) == len(k):
-            return w0
+    power = np.ones(len(lines)) if amplitudes is None else np.asarray(amplitudes) ** 2
+    strongest = lines[int(np.argmax(power))]
+    for base in dict.fromkeys((lines[0], strongest)):
+        for first in range(1, FIRST_HARMONIC + 1):
+            w0 = _harmonic_fit(lines, base / first, resolution)
+            if w0 >= resolution:
+                on = _on_harmonics(lines, w0, resolution)
+                lowest = lines[on][0] / w0 if np.any(on) else np.inf
+                enough = np.sum(on) >= LEAST_HARMONICS and lowest < FIRST_HARMONIC + 0.5
+                if enough and power[on].sum() >= HARMONIC_POWER * power.sum():
+                    return w0
     return 0.0
+
+
+def _on_harmonics(lines: np.ndarray, w0: float, resolution: float) -> np.ndarray:
+    """Which ``lines`` (rad/s) lie within the tolerance of a multiple k ≥ 1 of ``w0``."""
+    k = np.rint(lines / w0)
+    return (k >= 1) & (np.abs(lines - k * w0) <= HARMONIC_TOLERANCE * resolution + 1e-3 * lines)
+
+
+def _harmonic_fit(lines: np.ndarray, w0: float, resolution: float) -> float:
+    """ω_0 (rad/s) refitted by least squares on the lines near its multiples."""
+    for _ in range(3):
+        on = _on_harmonics(lines, w0, resolution)
+        if not np.any(on):
+            return w0
+        k = np.rint(lines[on] / w0)
+        w0 = float(np.sum(k * lines[on]) / np.sum(k * k))
+    return w0
 
 
 def broadband_band(x: np.ndarray, h: float) -> tuple[float, float] | None:
