@@ -18,8 +18,9 @@ Per seed (the seed changes the noise, the phases, the sequence): n, J_i, k_i (er
 %), B_i, D_m, f_c within 2σ, and whether ``check`` agrees with ``identify``: ``check``
 ok exactly when ``identify`` fits, and every ``check`` warning among ``identify``'s.
 
-Run: ``python -m benchmarks.excitation_accuracy [--seeds 20] [--rows NAME ...]
-[--out FILE.json]`` (prints the markdown table); ``arcosim bench accuracy`` runs it too.
+Run: ``python -m benchmarks.excitation_accuracy [--seeds 20] [--first-seed 1] [--rows NAME
+...] [--out FILE.json]`` (prints the markdown table; ``--merge A.json B.json …`` tabulates
+runs made in parts); ``arcosim bench accuracy`` runs it too.
 """
 
 from __future__ import annotations
@@ -143,9 +144,13 @@ def markdown(summaries: dict[str, dict]) -> str:
 
 
 def score_rows(
-    names: Sequence[str], seeds: Sequence[int], progress: Callable[[str], None] = print
+    names: Sequence[str],
+    seeds: Sequence[int],
+    progress: Callable[[str], None] = print,
+    out: Path | None = None,
 ) -> tuple[dict[str, dict], dict[str, list[dict]]]:
-    """Every row of ``names`` over ``seeds``: the summaries, and every run's numbers."""
+    """Every row of ``names`` over ``seeds``: the summaries, and every run's numbers
+    (written to ``out`` as JSON after each seed, when given)."""
     summaries: dict[str, dict] = {}
     results: dict[str, list[dict]] = {}
     for name in names:
@@ -154,8 +159,20 @@ def score_rows(
             r = run_seed(ROWS[name], seed)
             results[name].append(r)
             progress(f"{name}, seed {seed}: n = {r.get('n')}, agree {r['agree']}")
-        summaries[name] = summary(results[name], ROWS[name])
+            summaries[name] = summary(results[name], ROWS[name])
+            if out:
+                out.write_text(json.dumps({"summary": summaries, "runs": results}, indent=1))
     return summaries, results
+
+
+def merged(paths: Sequence[Path]) -> dict[str, dict]:
+    """The summaries of several runs' JSON files (``--out`` of runs over other seeds or
+    rows), their runs pooled per row."""
+    runs: dict[str, list[dict]] = {}
+    for path in paths:
+        for name, rows in json.loads(path.read_text())["runs"].items():
+            runs.setdefault(name, []).extend(rows)
+    return {name: summary(rows, ROWS[name]) for name, rows in runs.items()}
 
 
 def table(
@@ -179,11 +196,13 @@ def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = pr
     parser.add_argument("--rows", nargs="*", default=list(ROWS))
     parser.add_argument("--first-seed", type=int, default=1)
     parser.add_argument("--out", type=Path)
+    parser.add_argument("--merge", type=Path, nargs="*", help="only tabulate these --out files")
     args = parser.parse_args(argv)
+    if args.merge:
+        print(markdown(merged(args.merge)))
+        return 0
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    summaries, results = score_rows(args.rows, seeds, progress)
-    if args.out:
-        args.out.write_text(json.dumps({"summary": summaries, "runs": results}, indent=1))
+    summaries, _ = score_rows(args.rows, seeds, progress, args.out)
     print(markdown(summaries))
     return 0
 

@@ -77,6 +77,7 @@ from arcosim.cli.identify_options import (
     masses_option,
 )
 from arcosim.cli.identify_output_error import run_output_error
+from arcosim.cli.identify_plot import check_plot
 from arcosim.cli.identify_whole_chain import run_whole_chain
 from arcosim.cli.options import add_command, add_fmus_option, force_option, log_options, number
 from arcosim.errors import UserError
@@ -165,6 +166,19 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
         "it must put the chain's first mode in the band the log shows",
     )
+    p.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="whole-chain: the measured response torque → motor speed with its coherence, "
+        "the model's over it, the residual against the noise floor; and FILE.csv",
+    )
+    p.add_argument(
+        "--reference",
+        metavar="COLUMN",
+        help="whole-chain with --plot: a logged reference or added excitation (a closed "
+        "loop's): the measured response estimated indirectly through it",
+    )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
@@ -173,6 +187,9 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
+    if args.plot is not None and args.method != "whole-chain":
+        raise UserError(f"--plot is for --method whole-chain (not {args.method})")
+    check_plot(args)
     if args.chain and args.method == "whole-chain":
         raise UserError(
             "--chain is for the methods that use a chain (observer, output-error, "

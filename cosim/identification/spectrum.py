@@ -37,7 +37,10 @@ LINE_PROMINENCE = 30.0
 LINE_SHARE = 0.8
 #: More lines than this (a count) are read as broadband (a line fit would be slow and
 #: no multi-sine plays that many).
-MAX_LINES = 400
+MAX_LINES = 2000
+#: Bins (a count) either side of a line its leakage is counted over: beyond, the Hann
+#: envelope is under 1e-15 of the line.
+LEAKAGE_REACH = 256
 #: Lines are refined by least squares (:func:`refine_lines`) up to this many (a count).
 REFINE_LIMIT = 120
 #: Broadband: the usable band is where the Welch spectrum stays above this fraction of
@@ -260,12 +263,14 @@ def _peaks(x: np.ndarray, floor: float | None = None) -> tuple[np.ndarray, np.nd
     candidates = np.flatnonzero(peak & (power > LINE_PROMINENCE * floor))
     accepted: list[int] = []
     leak = np.zeros(len(power))
-    index = np.arange(len(power))
+    reach = np.arange(-LEAKAGE_REACH, LEAKAGE_REACH + 1)
+    envelope = leakage_envelope(reach)
     for j in candidates[np.argsort(-power[candidates])]:
         if power[j] <= LINE_PROMINENCE * (floor + leak[j]):
             continue
         accepted.append(int(j))
-        leak += power[j] * leakage_envelope(index - j)
+        near = (j + reach >= 0) & (j + reach < len(power))
+        leak[j + reach[near]] += power[j] * envelope[near]
     return np.sort(np.array(accepted, dtype=int)), power
 
 
