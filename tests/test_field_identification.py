@@ -223,8 +223,15 @@ def test_check_tells_a_good_log_from_a_poor_one() -> None:
     text = report.text()
     assert "counts/s" in text and "multi-sine: 11 lines" in text, text
     try:  # check is ok exactly when identify fits
-        identify_drive(poor.time, poor.i_a, poor.omega_m, poor.theta_m, k_t=d.k_t, J_m=d.J_m,
-                       encoder_cpr=d.counts)
+        identify_drive(
+            poor.time,
+            poor.i_a,
+            poor.omega_m,
+            poor.theta_m,
+            k_t=d.k_t,
+            J_m=d.J_m,
+            encoder_cpr=d.counts,
+        )
         assert report.ok, text
     except IdentificationError:
         assert not report.ok, text

@@ -88,3 +88,33 @@ def test_a_closed_loop_warns_and_the_reference_removes_the_bias() -> None:
     assert indirect.estimator.startswith("indirect") and not indirect.warnings
     ratio = indirect.response / _model(indirect.omega)
     assert np.median(np.abs(ratio - 1)) < 0.05, ratio
+
+
+@pytest.mark.slow
+def test_identify_plot_writes_the_figure_and_its_csv(tmp_path, capsys) -> None:
+    """``arcosim identify … --plot FILE.png`` on the README's sample: the figure, FILE.csv
+    with ω, the measured and the model's magnitude and phase, the coherence, and its
+    units; the measured response within 5 % of the model's where the coherence is high."""
+    import csv
+    import json
+    from pathlib import Path
+
+    from arcosim.cli import main
+
+    sample = Path(__file__).parents[1] / "examples" / "data" / "belt_drive.csv"
+    count = "0.0031415926535897933"
+    scales = ["--scale", "i_a=0.001", "--scale", f"theta_m={count}", "--scale", f"omega_m={count}"]
+    motor = ["--set", "k_to=0.0406", "--set", "J_mo=2.09e-5", "--set", "encoder_cpr=2000"]
+    plot = tmp_path / "frf.png"
+    args = ["identify", str(sample), *scales, *motor, "--method", "whole-chain"]
+    assert main([*args, "--masses", "auto", "--plot", str(plot)]) == 0
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rows = list(csv.DictReader(plot.with_suffix(".csv").open()))
+    units = json.loads(plot.with_suffix(".units.json").read_text())
+    assert units["omega"] == "rad/s" and units["coherence"] == "1"
+    assert list(rows[0]) == list(units) and len(rows) >= 20
+    good = [r for r in rows if float(r["coherence"]) > 0.95]
+    ratio = [float(r["measured_magnitude"]) / float(r["model_magnitude"]) for r in good]
+    assert len(good) >= 10 and np.median(np.abs(np.array(ratio) - 1)) < 0.05, ratio
+    assert main([*args, "--plot", str(plot)]) == 2  # never over an existing file
+    assert "exists" in capsys.readouterr().err
