@@ -19,13 +19,10 @@ import numpy as np
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import STUCK_VELOCITY_COUNTS
+from arcosim.identification.excitation_design import LINE_T
 from arcosim.identification.log_decision import WEAK_T, LogDecision, decide_log
 from arcosim.identification.plausibility import plausibility_warnings
 from arcosim.identification.spectrum import excitation_spectrum
-
-#: Lines the encoder sees with a t value under this are named in the report (the
-#: excitation design's threshold, :data:`~arcosim.identification.excitation_design.LINE_T`).
-LINE_T = 5.0
 
 
 @dataclass

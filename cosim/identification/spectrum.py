@@ -13,7 +13,8 @@ step) and says what was played, for the log's check and the fits' decisions
   fit of a sine at off-grid frequencies (:func:`refine_lines`);
 - **periodic** (a square-wave or stepped reference, position-loop steps): lines that all
   sit on whole multiples of one fundamental whose first harmonics are present, counted
-  as the harmonics of that fundamental (:func:`harmonic_fundamental`);
+  as the harmonics of that fundamental
+  (:func:`~arcosim.identification.harmonics.harmonic_fundamental`);
 - **broadband** (PRBS, noise, steps): lines that carry less than
   :data:`LINE_SHARE` of the signal's power; the usable band is where the Welch spectrum
   stays within :data:`BROADBAND_DROP` of its peak (:func:`broadband_band`).
@@ -28,6 +29,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import signal as sp_signal
+
+from arcosim.identification.harmonics import (
+    harmonic_fundamental,
+    on_harmonics,
+)
 
 #: A line stands this many times above the periodogram's median (its noise or
 #: broadband level) and above the leakage envelope of the stronger lines.
@@ -46,15 +52,6 @@ REFINE_LIMIT = 120
 #: Broadband: the usable band is where the Welch spectrum stays above this fraction of
 #: its peak (dimensionless; 0.1: −10 dB).
 BROADBAND_DROP = 0.1
-#: Periodic: the lowest line must be at most this harmonic of the fundamental (a count).
-FIRST_HARMONIC = 3
-#: Periodic: at least this many lines (a count) on multiples of one fundamental.
-LEAST_HARMONICS = 3
-#: Periodic: the harmonics carry at least this share of the lines' power
-#: (dimensionless, 0 … 1).
-HARMONIC_POWER = 0.8
-#: Periodic: a line is a harmonic when within this many frequency bins (2π/T) of k·ω_0.
-HARMONIC_TOLERANCE = 0.5
 
 
 @dataclass(frozen=True)
@@ -226,7 +223,7 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     low = coarse >= 2 * resolution
     w0 = harmonic_fundamental(coarse[low], resolution, amplitude[keep][low])
     if w0:
-        on = _on_harmonics(coarse, w0, resolution)
+        on = on_harmonics(coarse, w0, resolution)
         return np.rint(coarse[on] / w0) * w0, amplitude[keep][on], share
     if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
         return coarse, amplitude[keep], share
@@ -373,74 +370,6 @@ def _fit(x: np.ndarray, t: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.nd
     X = np.hstack([np.cos(phase), np.sin(phase)])
     coef = np.linalg.lstsq(X, x, rcond=None)[0]
     return coef[: len(w)], coef[len(w) :]
-
-
-def harmonic_fundamental(
-    lines: np.ndarray, resolution: float, amplitudes: np.ndarray | None = None
-) -> float:
-    """The fundamental (rad/s) the lines are harmonics of, or 0 when they are not.
-
-    The lines count as harmonics of ω_0 when at least :data:`LEAST_HARMONICS` of them
-    sit within :data:`HARMONIC_TOLERANCE` bins (``resolution``) of whole multiples
-    k·ω_0, the lowest of those at most the :data:`FIRST_HARMONIC`-th, and they carry
-    :data:`HARMONIC_POWER` of the lines' power: a square-wave or stepped reference (in
-    a closed loop its current also shows the loop's resonances between the harmonics),
-    not a multi-sine whose lines merely lie on the record's grid (its lowest line the
-    10th or the 100th multiple of 2π/T).
-
-    Parameters
-    ----------
-    lines : ndarray
-        Line frequencies (rad/s), ascending, shape ``(L,)``.
-    resolution : float
-        The record's frequency grid 2π/T (rad/s).
-    amplitudes : ndarray, optional
-        The lines' amplitudes (any unit), shape ``(L,)``; default all equal.
-
-    Returns
-    -------
-    float
-        ω_0 (rad/s), fitted by least squares over the harmonics; 0 when the lines are
-        not harmonics of one fundamental.
-
-    Examples
-    --------
-    >>> round(harmonic_fundamental(np.array([2.0, 6.01, 10.0, 14.02]), 0.1), 3)
-    2.001
-    >>> harmonic_fundamental(np.geomspace(3.0, 150.0, 40), 0.1)
-    0.0
-    """
-    if len(lines) < LEAST_HARMONICS:
-        return 0.0
-    power = np.ones(len(lines)) if amplitudes is None else np.asarray(amplitudes) ** 2
-    strongest = lines[int(np.argmax(power))]
-    for base in dict.fromkeys((lines[0], strongest)):
-        for first in range(1, FIRST_HARMONIC + 1):
-            w0 = _harmonic_fit(lines, base / first, resolution)
-            if w0 >= resolution:
-                on = _on_harmonics(lines, w0, resolution)
-                lowest = lines[on][0] / w0 if np.any(on) else np.inf
-                enough = np.sum(on) >= LEAST_HARMONICS and lowest < FIRST_HARMONIC + 0.5
-                if enough and power[on].sum() >= HARMONIC_POWER * power.sum():
-                    return w0
-    return 0.0
-
-
-def _on_harmonics(lines: np.ndarray, w0: float, resolution: float) -> np.ndarray:
-    """Which ``lines`` (rad/s) lie within the tolerance of a multiple k ≥ 1 of ``w0``."""
-    k = np.rint(lines / w0)
-    return (k >= 1) & (np.abs(lines - k * w0) <= HARMONIC_TOLERANCE * resolution + 1e-3 * lines)
-
-
-def _harmonic_fit(lines: np.ndarray, w0: float, resolution: float) -> float:
-    """ω_0 (rad/s) refitted by least squares on the lines near its multiples."""
-    for _ in range(3):
-        on = _on_harmonics(lines, w0, resolution)
-        if not np.any(on):
-            return w0
-        k = np.rint(lines[on] / w0)
-        w0 = float(np.sum(k * lines[on]) / np.sum(k * k))
-    return w0
 
 
 def broadband_band(x: np.ndarray, h: float) -> tuple[float, float] | None:
