@@ -42,7 +42,10 @@ Contract (scripts rely on it)::
   estimates every load angle with them), their standard errors under ``std``, the evidence
   (modes seen and their residue t values, weak modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
-  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
+  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s); it refuses
+  exactly when ``arcosim check`` says not ok (one set of decisions).
+  ``--plot FILE.png [--reference COLUMN]``: the measured response torque → motor speed
+  under the model's, and ``FILE.csv`` (``arcosim.cli.identify_plot``).
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
   time, from the motor alone (``arcosim.identification.load_torque``: the observer FMU's estimator 1
   with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) and the
