@@ -14,6 +14,10 @@ import numpy as np
 FIRST_HARMONIC = 3
 #: Periodic: at least this many lines (a count) on multiples of one fundamental.
 LEAST_HARMONICS = 3
+#: Periodic: the harmonics present fill at least this share of the multiples up to the
+#: highest (dimensionless): a square wave's odd ones about half, a multi-sine whose few
+#: lines happen to sit on whole rad/s (10 of 120) far fewer.
+HARMONIC_FILL = 0.25
 #: Periodic: the harmonics carry at least this share of the lines' power
 #: (dimensionless, 0 … 1).
 HARMONIC_POWER = 0.8
@@ -28,7 +32,8 @@ def harmonic_fundamental(
 
     The lines count as harmonics of ω_0 when at least :data:`LEAST_HARMONICS` of them
     sit within :data:`HARMONIC_TOLERANCE` bins (``resolution``) of whole multiples
-    k·ω_0, the lowest of those at most the :data:`FIRST_HARMONIC`-th, and they carry
+    k·ω_0, the lowest of those at most the :data:`FIRST_HARMONIC`-th, they fill
+    :data:`HARMONIC_FILL` of the multiples up to the highest, and they carry
     :data:`HARMONIC_POWER` of the lines' power: a square-wave or stepped reference (in
     a closed loop its current also shows the loop's resonances between the harmonics),
     not a multi-sine whose lines merely lie on the record's grid (its lowest line the
@@ -66,7 +71,10 @@ def harmonic_fundamental(
             if w0 >= resolution:
                 on = on_harmonics(lines, w0, resolution)
                 lowest = lines[on][0] / w0 if np.any(on) else np.inf
-                enough = np.sum(on) >= LEAST_HARMONICS and lowest < FIRST_HARMONIC + 0.5
+                count = int(np.sum(on))
+                top = np.rint(lines[on][-1] / w0) if count else np.inf
+                enough = count >= LEAST_HARMONICS and lowest < FIRST_HARMONIC + 0.5
+                enough = enough and count >= HARMONIC_FILL * top
                 if enough and power[on].sum() >= HARMONIC_POWER * power.sum():
                     return w0
     return 0.0
