@@ -112,11 +112,12 @@ def measured_response(
 
     Examples
     --------
-    A rigid body of 1e-3 kg·m² (response 1/(jωJ)) under two lines:
+    A rigid body of 1e-3 kg·m² (response 1/(jωJ)) under two lines, with sensor noise:
 
     >>> t = np.arange(20001) * 1e-3
-    >>> torque = np.sin(5.0 * t) + np.sin(20.0 * t)
-    >>> theta = -(np.sin(5.0 * t) / 25 + np.sin(20.0 * t) / 400) / 1e-3
+    >>> noise = np.random.default_rng(1).normal(0.0, 1e-3, (2, len(t)))
+    >>> torque = np.sin(5.0 * t) + np.sin(20.0 * t) + noise[0]
+    >>> theta = -(np.sin(5.0 * t) / 25 + np.sin(20.0 * t) / 400) / 1e-3 + noise[1]
     >>> frf = measured_response(t, torque, theta, 1.0)
     >>> frf.estimator, np.round(np.abs(frf.response) * frf.omega * 1e-3, 3)
     ('H1 at the lines (windowed Fourier sums, open loop)', array([1., 1.]))

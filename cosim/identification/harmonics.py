@@ -57,7 +57,7 @@ def harmonic_fundamental(
     Examples
     --------
     >>> round(harmonic_fundamental(np.array([2.0, 6.01, 10.0, 14.02]), 0.1), 3)
-    2.001
+    2.002
     >>> harmonic_fundamental(np.geomspace(3.0, 150.0, 40), 0.1)
     0.0
     """
