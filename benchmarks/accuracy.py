@@ -23,6 +23,8 @@ The bench also gets the honesty check of B's standard error (over ``--b-seeds`` 
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
 within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accuracy.py``:
 three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
+Then the excitation rows (``benchmarks/excitation_accuracy.py``: an off-grid multi-sine,
+a square-wave reference in a position loop, a PRBS; check agreeing with identify).
 Last, the load torque rows (``benchmarks/load_accuracy.py``: the two- and five-mass chains,
 the load on the last and on a middle mass, a model with springs 5 % off, the same
 seeds; and the bandwidth's trade-off on the bench). Then the flexible-link rows
@@ -54,7 +56,13 @@ from arcosim.identification.offline_observer import estimate_states, replay
 from arcosim.identification.output_error import ParameterFit
 from arcosim.identification.records import MotorRecord, motor_record
 from arcosim.identification.uniform_fit import uniform_chain
-from benchmarks import beam_accuracy, chain_accuracy, field_accuracy, load_accuracy
+from benchmarks import (
+    beam_accuracy,
+    chain_accuracy,
+    excitation_accuracy,
+    field_accuracy,
+    load_accuracy,
+)
 from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
 #: Broadband lines (rad/s): the flexible scenario's plus 150 for the five-mass chain.
@@ -348,6 +356,9 @@ def run(
         f"{len(chain_seeds)} seeds; `auto`; only k_t, J_m and the counts known, the friction "
         "where the row says):\n\n" + field_accuracy.markdown(field_rows)
     )
+    excitation_text, excitation_summary = excitation_accuracy.table(chain_seeds, quick, progress)
+    text += excitation_text
+    summary.update(excitation_summary)
     load_text, load_summary = _load_torque_table(chain_seeds, quick, progress)
     text += load_text
     summary.update(load_summary)

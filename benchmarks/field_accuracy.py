@@ -162,7 +162,12 @@ ROWS: dict[str, Row] = {
 
 def run_row(row: Row, seed: int, duration: float = DURATION) -> dict:
     """Identify one record of ``row``: errors (%) and standard errors (%) per parameter."""
-    log = row.log(seed, duration)
+    return score_log(row, row.log(seed, duration), seed)
+
+
+def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
+    """Identify ``log`` (a record of ``row``): errors (%) and standard errors (%) per
+    parameter, the warnings, or the refusal (``error``)."""
     d = row.drive
     friction = {"D_m": d.D_m, "f_c": d.f_c} if row.friction_given else {}
     wall, cpu = time.perf_counter(), time.process_time()
@@ -189,6 +194,7 @@ def run_row(row: Row, seed: int, duration: float = DURATION) -> dict:
         return out
     choice = result.choice
     n = choice.n
+    out["warnings"] = list(result.warnings)
     out.update(n=n, modes=choice.fit.extra["modes_rad_s"], weak=choice.fit.extra["weak_modes"])
     if n != d.n:
         return out

@@ -13,7 +13,8 @@ other than friction exceeds f_c.
 
 Drive: a first-order current loop (bandwidth ``current_bandwidth``) follows the
 reference held over each sample step; the reference is either an open-loop current
-(A, a function of time) or the output of a PI speed loop on the encoder's speed. The
+(A, a function of time) or the output of a PI speed loop on the encoder's speed,
+optionally inside a P position loop on the encoder's angle. The
 log records, per sample k: the mean current over the step ending at sample k plus a
 sensor offset and Gaussian noise (A); the encoder angle (whole counts, rad); its
 backward difference (rad/s). An optional load torque (constant plus a slow sine) acts
@@ -81,14 +82,19 @@ class SpeedLoop:
     Attributes:
         kp: proportional gain (A·s/rad).
         ki: integral gain (A/rad).
-        reference: speed reference (rad/s) as a function of time (s).
+        reference: speed reference (rad/s) as a function of time (s); with
+            ``position_gain``, the position reference (rad) instead.
         limit: current limit (A).
+        position_gain: gain (1/s) of a P position loop around the speed loop, on the
+            encoder angle: speed reference = position_gain · (reference − angle); 0:
+            no position loop.
     """
 
     kp: float
     ki: float
     reference: Callable[[np.ndarray], np.ndarray]
     limit: float = np.inf
+    position_gain: float = 0.0
 
 
 @dataclass
@@ -219,7 +225,10 @@ def simulate(
             i_ref = float(refs[k - 1])
         else:
             w_meas = (enc[k - 1] - enc[k - 2]) / h if k >= 2 else 0.0
-            error = speed_ref[k - 1] - w_meas
+            target = speed_ref[k - 1]
+            if speed_loop.position_gain:
+                target = speed_loop.position_gain * (target - enc[k - 1])
+            error = target - w_meas
             unclamped = speed_loop.kp * error + integral + speed_loop.ki * h * error
             i_ref = float(np.clip(unclamped, -speed_loop.limit, speed_loop.limit))
             if i_ref == unclamped:

@@ -1,10 +1,11 @@
 """``arcosim check LOG.csv``: can this log support whole-chain identification?
 
-Before any fit: the step's regularity, the motion (the encoder's range, how often the
-motor stands still), the excitation's lines against the band the sample rate and the
-disturbance observer leave, and the modes the record shows (the weak ones named), each
-finding with what would fix it. Exit status 0 when the log can support identification,
-1 when it cannot (the reasons printed), 2 for a bad input.
+Before any fit, the decisions ``arcosim identify --method whole-chain`` acts on
+(:func:`arcosim.identification.log_decision.decide_log`): exit status 0 exactly when
+identify fits, 1 when it would refuse (the reasons printed), 2 for a bad input; every
+warning printed is one identify gives too. With the figures behind them: the step, the
+motion, the excitation (a multi-sine's lines, a periodic reference's harmonics or a
+broadband band) and the modes the fit reads.
 
 The drive's figures come as the observer's parameters, as for ``arcosim identify``:
 ``--set k_to=… --set J_mo=… --set encoder_cpr=… [--set g_dist=…]``; any not given
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from arcosim.cli.identify_options import masses_option
 from arcosim.cli.options import add_command, log_options
 from arcosim.cli.parameters import defaults_note, known_parameters, set_names
 from arcosim.identification.log_check import check_log
@@ -32,11 +34,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "check",
         summary="say whether a log can support identification, before any fit",
         description="""
-Before any fit, say whether a log can support whole-chain identification: the
-step, the motion the encoder sees, the excitation against the band the sample rate
-and the disturbance observer leave, and the modes the record shows, each problem
-with what would fix it. Exit status 0: it can; 1: it cannot (reasons printed);
-2: a bad input.
+Before any fit, say whether whole-chain identification (arcosim identify --method
+whole-chain) will fit this log: the same decisions, so exit status 0 exactly when
+identify fits, 1 when it would refuse (reasons printed), 2 for a bad input; every
+warning is one identify gives too. Shown: the step, the motion the encoder sees, the
+excitation (lines, harmonics of a periodic reference, or broadband) and the modes.
+Give --masses, --load and the friction (--set D_m=… --set f_c=…) as you will to
+identify.
 
 Give first what you know of the motor (anything not given takes the paper bench's
 value, and the output says so):
@@ -49,6 +53,17 @@ arcosim check log.csv --set k_to=0.0406 --set J_mo=2.09e-5 --set encoder_cpr=200
 arcosim check log.csv --scale i_a=0.001 --set k_to=0.0406 --json""",
     )
     log_options(p, "k_to (N.m/A), J_mo (kg.m2), encoder_cpr, g_dist (rad/s); repeatable")
+    p.add_argument(
+        "--masses",
+        default="auto",
+        help="the number of load masses identify will be asked for (default auto)",
+    )
+    p.add_argument(
+        "--load",
+        choices=("none", "constant", "slow"),
+        default="none",
+        help="the load torque model identify will use (default none)",
+    )
     p.add_argument("--json", action="store_true", help="print the report as one JSON object")
     p.set_defaults(execute=_execute)
 
@@ -67,6 +82,9 @@ def _execute(args: argparse.Namespace) -> int:
         J_m=values["J_mo"],
         encoder_cpr=int(values["encoder_cpr"]),
         g_dist=values["g_dist"],
+        masses=args.masses if args.masses == "auto" else masses_option(args.masses),
+        load=args.load,
+        **({"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}),
     )
     note = defaults_note(values, NEEDED, given)
     if args.json:

@@ -42,7 +42,10 @@ Contract (scripts rely on it)::
   estimates every load angle with them), their standard errors under ``std``, the evidence
   (modes seen and their residue t values, weak modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
-  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s).
+  simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s); it refuses
+  exactly when ``arcosim check`` says not ok (one set of decisions).
+  ``--plot FILE.png [--reference COLUMN]``: the measured response torque → motor speed
+  under the model's, and ``FILE.csv`` (``arcosim.cli.identify_plot``).
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
   time, from the motor alone (``arcosim.identification.load_torque``: the observer FMU's estimator 1
   with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) and the
@@ -87,6 +90,7 @@ from arcosim.cli.identify_options import (
     masses_option,
 )
 from arcosim.cli.identify_output_error import run_output_error
+from arcosim.cli.identify_plot import check_plot
 from arcosim.cli.identify_whole_chain import run_whole_chain
 from arcosim.cli.options import add_command, add_fmus_option, force_option, log_options, number
 from arcosim.errors import UserError
@@ -177,6 +181,19 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         help="output-error: start from this stiffness (N.m/rad) instead of the cost scan; "
         "it must put the chain's first mode in the band the log shows",
     )
+    p.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="whole-chain: the measured response torque → motor speed with its coherence, "
+        "the model's over it, the residual against the noise floor; and FILE.csv",
+    )
+    p.add_argument(
+        "--reference",
+        metavar="COLUMN",
+        help="whole-chain with --plot: a logged reference or added excitation (a closed "
+        "loop's): the measured response estimated indirectly through it",
+    )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)
 
@@ -185,6 +202,9 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
+    if args.plot is not None and args.method != "whole-chain":
+        raise UserError(f"--plot is for --method whole-chain (not {args.method})")
+    check_plot(args)
     if args.chain and args.method in ("whole-chain", "beam"):
         raise UserError(
             "--chain is for the methods that use a chain (observer, output-error, "

@@ -10,7 +10,9 @@ import json
 import sys
 
 from arcosim.cli.identify_options import write_report
+from arcosim.cli.identify_plot import write_plot
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
+from arcosim.identification.band import search_band
 from arcosim.identification.drive import DriveIdentification, identify_drive
 from arcosim.identification.whole_chain import MAX_AUTO_MASSES
 from arcosim.logs import DriveLog, tool_keys
@@ -62,7 +64,15 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     note = defaults_note(values, ("J_mo", "k_to", "encoder_cpr"), given)
     if note:
         result.assumptions["defaults"] = note
+    view = None
+    if getattr(args, "plot", None):
+        band = search_band(values["g_dist"], float(log.time[1] - log.time[0]))
+        k_t, J_m = actuator.k_to + actuator.dkt, actuator.J_mo + actuator.dJm
+        view = write_plot(args, log, result, k_t, J_m, int(values["encoder_cpr"]), band)
+        result.warnings.extend(w for w in view if w not in result.warnings)
     report = result.report()
+    if view is not None:
+        report["frf"] = {"plot": str(args.plot), "csv": str(args.plot.with_suffix(".csv"))}
     write_report(args, report)
     if args.json:
         print(json.dumps(tool_keys(report) if args.tool_names else report, indent=2))

@@ -12,6 +12,9 @@ records           -- the two records every fit reads: MotorRecord (θ_m, τ̂_re
 
 Modes
 -----
+spectrum          -- what the excitation is: lines (leakage-aware), harmonics of one
+                     period, or broadband with its band (excitation_spectrum)
+harmonics         -- lines that are harmonics of one fundamental (a periodic reference)
 band              -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band)
 subspace          -- PO-MOESP subspace identification, one input and one output
 modal_start       -- the record's modes (stabilization diagram, residues) and the
@@ -51,7 +54,14 @@ Checks
 ------
 plausibility      -- are the log's units and length plausible? (the step against the
                      motion, the torque balance, the record's length)
+log_decision      -- the one set of decisions check reports and identify refuses by
+                     (decide_log, LogDecision)
 log_check         -- can a log support identification? (check_log, CheckReport)
+
+View
+----
+frf               -- the measured response torque → motor speed (H1 at the lines, Welch,
+                     indirect), the model's, the residual against the noise floor
 
 Excitation
 ----------

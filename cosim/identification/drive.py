@@ -17,11 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
-from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.log_check import log_plausibility
+from arcosim.identification.log_decision import decide_log
 from arcosim.identification.noise_floor import floor_warning, noise_floor
-from arcosim.identification.records import LOADS, MotorRecord, encoder_record, motor_record
+from arcosim.identification.records import LOADS, MotorRecord
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
 
@@ -212,27 +211,29 @@ def identify_drive(
     if load not in LOADS:
         raise IdentificationError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
     friction_given = D_m is not None and f_c is not None
-    # fitted friction: the DOB's τ̂ (the modal start) is computed without it
-    actuator = (
-        Actuator(J_m, k_t, 0.0, 0.0, D_m or 0.0, f_c or 0.0)
-        if friction_given
-        else (Actuator(J_m, k_t))
-    )
     time, i_a, omega_m, theta_m = (
         np.asarray(x, dtype=float) for x in (time, i_a, omega_m, theta_m)
     )
-    record = motor_record(time, i_a, omega_m, theta_m, actuator, g_dist)
-    encoder = None
-    if encoder_cpr > 0:
-        encoder = encoder_record(
-            time, i_a, theta_m, actuator, encoder_cpr, friction_given, load, g_dist
-        )
-    elif not friction_given or load != "none":
-        raise IdentificationError(
-            "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
-            "(D_m and f_c) and no load torque model"
-        )
-    plausibility = log_plausibility(time, i_a, omega_m, theta_m, k_t, J_m)
+    # the one set of decisions `check` reports: its problems are the fit's refusals
+    decision = decide_log(
+        time,
+        i_a,
+        omega_m,
+        theta_m,
+        k_t=k_t,
+        J_m=J_m,
+        encoder_cpr=encoder_cpr,
+        g_dist=g_dist,
+        masses=masses,
+        D_m=D_m,
+        f_c=f_c,
+        load=load,
+    )
+    plausibility = decision.plausibility
+    if decision.problems:
+        # the warnings first (the log's implausible units or length lead), as check says
+        raise IdentificationError("; ".join(decision.warnings + decision.problems))
+    record, encoder = decision.record, decision.encoder
     try:
         choice = identify_whole_chain(record, masses, encoder)
     except IdentificationError as error:
@@ -251,7 +252,7 @@ def identify_drive(
         parameters=parameters,
         std=fit.std_dict(),
         assumptions=dict(fit.extra["assumptions"]),
-        warnings=plausibility + list(fit.extra["warnings"]) + ([above] if above else []),
+        warnings=decision.warnings + list(fit.extra["warnings"]) + ([above] if above else []),
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}

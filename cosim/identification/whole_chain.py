@@ -227,17 +227,10 @@ def identify_whole_chain(
     """
     auto = masses == "auto"
     n_asked = None if auto else _masses(masses)
-    check_excited(record)
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
-    detected = detect_modes(record, largest)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
-    if unknown and detected.n:
-        # τ̂ was computed without friction: estimate it from the first modes, take it
-        # out of τ̂, and read the modes again
-        modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
-        record, D_m, f_c, detected = friction_cleaned(raw, encoder, modes, largest)
-        encoder = with_friction(encoder, D_m, f_c)
+    record, encoder, detected = first_reading(record, masses, encoder)
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
         # the fit's friction is far better than the start's: read the modes once more
@@ -274,6 +267,41 @@ def identify_whole_chain(
         detected.n,
         detected.singular_values,
     )
+
+
+def first_reading(
+    record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
+) -> tuple[MotorRecord, EncoderRecord | None, DetectedModes]:
+    """The modes as the fit first reads them (a friction not given estimated from them
+    and taken out of τ̂ first), and the records then fitted: what
+    :func:`identify_whole_chain` starts from and ``check`` judges; raises
+    IdentificationError for a bad ``masses`` or a record with no motion or too short."""
+    auto = masses == "auto"
+    n_asked = None if auto else _masses(masses)
+    check_excited(record)
+    largest = max(MAX_AUTO_MASSES, n_asked or 0)
+    detected = detect_modes(record, largest)
+    if encoder is not None and not encoder.friction_given and detected.n:
+        # τ̂ was computed without friction: take it out, read the modes again
+        modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
+        record, D_m, f_c, detected = friction_cleaned(record, encoder, modes, largest)
+        encoder = with_friction(encoder, D_m, f_c)
+    return record, encoder, detected
+
+
+def refusal(detected: DetectedModes, masses: int | str, record: MotorRecord) -> str | None:
+    """Why the modes read cannot support ``masses`` (a count, or ``"auto"``), or None:
+    the one rule :func:`identify_whole_chain` refuses by and ``check`` judges by."""
+    n = detected.n if masses == "auto" else int(masses)
+    if n < 1 or detected.n < n:
+        return missing_modes(detected, n if n >= 1 else None, record)
+    if float(np.max(detected.t_value)) < T_CONFIRM:
+        t = ", ".join(f"{t:.0f}" for t in detected.t_value)
+        why = f"residue t values {t}, all under {T_CONFIRM:g}"
+        return f"every mode the record shows is weakly determined ({why}): " + missing_modes(
+            detected, None, record
+        )
+    return None
 
 
 def _prediction_error(
@@ -314,15 +342,9 @@ def _choose_and_fit(
 ) -> tuple[int, ParameterFit, dict[int, float]]:
     """n (read, or asked and checked), the fit, and the criterion per n tried."""
     n = detected.n if auto else n_asked
-    if n < 1 or detected.n < n:
-        raise IdentificationError(missing_modes(detected, n if n >= 1 else None, record))
-    if float(np.max(detected.t_value)) < T_CONFIRM:
-        raise IdentificationError(
-            "every mode the record shows is weakly determined (residue t values "
-            + ", ".join(f"{t:.0f}" for t in detected.t_value)
-            + f", all under {T_CONFIRM:g}): "
-            + missing_modes(detected, None, record)
-        )
+    why = refusal(detected, "auto" if auto else n_asked, record)
+    if why:
+        raise IdentificationError(why)
     criterion: dict[int, float] = {}
     if encoder is None:
         result = fit_chain(record, n, _strongest(detected, n))
