@@ -5,7 +5,9 @@
 - :mod:`benchmarks.speed`: µs per co-simulation step and seconds per fit
   (``arcosim bench speed``, or ``python -m benchmarks.speed``);
 - :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`, :mod:`benchmarks.noise_envelope`:
-  one-off measurements, run as scripts.
+  one-off measurements, run as scripts;
+- :mod:`benchmarks.link_frequencies`: the flexible-link FMU's frequencies against the
+  continuous beam's, for 2, 4 and 8 elements (``python -m benchmarks.link_frequencies``).
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """

@@ -17,10 +17,10 @@ def test_validate_passes_the_built_fmus(build_fmus, capsys) -> None:
         str(build_fmus(n) / f"{name}.fmu")
         for n in (1, 3)
         for name in ("MotorChainPlant", "ReactionTorqueObserver")
-    ]
+    ] + [str(build_fmus(3) / "FlexLinkPlant.fmu")]
     assert main(["validate", *fmus]) == 0
     out = capsys.readouterr().out
-    assert out.count(": OK") == 4 and "problem" not in out
+    assert out.count(": OK") == 5 and "problem" not in out
 
 
 def test_validate_names_what_is_wrong(build_fmus, tmp_path: Path, capsys) -> None:
@@ -47,4 +47,4 @@ def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> Non
     build_fmus(3)
     assert main(["validate"]) == 0
     out = capsys.readouterr().out
-    assert out.count(": OK") == 3 and str(build_fmus(3)) in out
+    assert out.count(": OK") == 4 and str(build_fmus(3)) in out  # the link included

@@ -30,8 +30,9 @@ from arcosim.build.cache import (
     source_digest,
 )
 from arcosim.build.portable import make_portable, slave_class
-from arcosim.build.recipes import RECIPES, SSP_NAME, FmuRecipe, check_masses
+from arcosim.build.recipes import LINK, RECIPES, SSP_NAME, FmuRecipe, check_elements, check_masses
 from arcosim.errors import BuildError
+from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 from arcosim.version import __version__
 
 
@@ -102,7 +103,7 @@ def _build_python_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
     return target
 
 
-def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
+def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS) -> list[Path]:
     """Build every FMU of the project for ``n`` load masses, and their SSP system.
 
     Parameters
@@ -112,11 +113,13 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
     out : Path, optional
         Folder to write into (created if needed); default: the per-user cache
         (:func:`arcosim.build.cache.default_folder`).
+    elements : int, optional
+        Hermite elements of the flexible-link plant (``FlexLinkPlant.fmu``), 1 to 16.
 
     Returns
     -------
     list of Path
-        The three FMUs and ``ActionReaction.ssp``.
+        The three FMUs, ``ActionReaction.ssp`` and ``FlexLinkPlant.fmu``.
 
     Examples
     --------
@@ -125,15 +128,16 @@ def build_all(n: int = 3, out: Path | None = None) -> list[Path]:
     >>> paths = arcosim.build_all(2, Path(tempfile.mkdtemp()) / "fmus")
     >>> [p.name for p in paths]  # doctest: +NORMALIZE_WHITESPACE
     ['MotorChainPlant.fmu', 'ReactionTorqueObserver.fmu', 'ExcitationSource.fmu',
-     'ActionReaction.ssp']
+     'ActionReaction.ssp', 'FlexLinkPlant.fmu']
     """
     check_masses(n)
-    target = Path(out) if out is not None else default_folder(n)
+    check_elements(elements)
+    target = Path(out) if out is not None else default_folder(n, elements)
     with lock_folder(target):
-        return build_locked(n, target)
+        return build_locked(n, target, elements)
 
 
-def build_locked(n: int, target: Path) -> list[Path]:
+def build_locked(n: int, target: Path, elements: int = LINK_ELEMENTS) -> list[Path]:
     """:func:`build_all` into ``target`` for a caller that holds its lock.
 
     The digest goes first (so a folder being rebuilt is never current) and comes back
@@ -144,6 +148,7 @@ def build_locked(n: int, target: Path) -> list[Path]:
     BuildError
         When a file cannot be written, or a built file is not a complete FMU.
     """
+    from arcosim.build.clink import build_link
     from arcosim.build.ssp import write_ssp
 
     stamp = target / DIGEST_FILE
@@ -151,11 +156,12 @@ def build_locked(n: int, target: Path) -> list[Path]:
         stamp.unlink(missing_ok=True)
         built = [build_fmu(recipe, n, target) for recipe in RECIPES]
         built.append(write_ssp(target / SSP_NAME, target))
+        built.append(build_link(elements, target / LINK.file_name))
         problems = [p for p in map(fmu_problem, built) if p is not None]
         if problems:
             raise BuildError(f"the build into {target} left a broken file: {problems[0]}")
         partial = target / f".{DIGEST_FILE}.{os.getpid()}.part"
-        partial.write_text(source_digest(n) + "\n", encoding="utf-8")
+        partial.write_text(source_digest(n, elements) + "\n", encoding="utf-8")
         partial.replace(stamp)
     except OSError as error:
         raise BuildError(

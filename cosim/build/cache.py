@@ -25,8 +25,9 @@ from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
-from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+from arcosim.build.recipes import LINK, RECIPES, SSP_NAME, check_elements, check_masses
 from arcosim.errors import BuildError
+from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 from arcosim.version import __version__
 
 #: Written beside the FMUs, last: the digest of the sources they were built from.
@@ -57,26 +58,28 @@ def cache_root() -> Path:
     return Path(base).expanduser() / "arcosim"
 
 
-def default_folder(n: int = 3) -> Path:
-    """The cache folder of the FMUs for ``n`` masses built from the current sources.
+def default_folder(n: int = 3, elements: int = LINK_ELEMENTS) -> Path:
+    """The cache folder of the FMUs for ``n`` masses (and a link of ``elements`` Hermite
+    elements) built from the current sources.
 
     Examples
     --------
     >>> default_folder(3).parent.name
     'fmus'
     """
-    return cache_root() / "fmus" / f"n{check_masses(n)}-{source_digest(n)[:16]}"
+    digest = source_digest(check_masses(n), check_elements(elements))
+    return cache_root() / "fmus" / f"n{n}-{digest[:16]}"
 
 
 @functools.cache
-def source_digest(n: int) -> str:
+def source_digest(n: int, elements: int = LINK_ELEMENTS) -> str:
     """SHA-256 (hex) of everything the FMUs for ``n`` masses are built from.
 
     The bundled code, the plant's Python and C sources, and the build code itself,
-    with the project version and ``n``. Computed once per process (a process runs one
-    version of the sources).
+    with the project version, ``n`` and the link's number of elements. Computed once per
+    process (a process runs one version of the sources).
     """
-    digest = hashlib.sha256(f"{__version__} n={n}".encode())
+    digest = hashlib.sha256(f"{__version__} n={n} elements={elements}".encode())
     roots = (fmu_package_dir(), plant_package_dir(), Path(__file__).parent)
     files = sorted(
         (f for root in roots for f in root.rglob("*") if f.suffix in {".py", ".c", ".h"}),
@@ -142,13 +145,14 @@ def fmu_problem(path: Path) -> str | None:
     return None
 
 
-def is_current(folder: Path, n: int) -> bool:
-    """True if ``folder`` holds complete FMUs for ``n`` masses built from these sources."""
+def is_current(folder: Path, n: int, elements: int = LINK_ELEMENTS) -> bool:
+    """True if ``folder`` holds complete FMUs for ``n`` masses (and the link of
+    ``elements`` elements) built from these sources."""
     stamp = folder / DIGEST_FILE
     try:
-        if stamp.read_text(encoding="utf-8").strip() != source_digest(n):
+        if stamp.read_text(encoding="utf-8").strip() != source_digest(n, elements):
             return False
     except OSError:
         return False
-    wanted = [folder / r.file_name for r in RECIPES] + [folder / SSP_NAME]
+    wanted = [folder / r.file_name for r in (*RECIPES, LINK)] + [folder / SSP_NAME]
     return all(fmu_problem(path) is None for path in wanted)

@@ -8,6 +8,8 @@ from arcosim.errors import UserError
 
 #: Numbers of load masses an FMU can be built for.
 MIN_MASSES, MAX_MASSES = 1, 20
+#: Numbers of Hermite elements the flexible-link FMU can be built for.
+MIN_ELEMENTS, MAX_ELEMENTS = 1, 16
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,32 @@ SOURCE = FmuRecipe(
     "ExcitationSource", "arsource.fmu:ExcitationSource", ("fmukit", "flexchain", "arsource")
 )
 RECIPES = (PLANT, OBSERVER, SOURCE)
+
+
+@dataclass(frozen=True)
+class LinkRecipe:
+    """The flexible-link plant FMU (C, :mod:`arcosim.build.clink`): its identifier carries
+    the number of Hermite elements, not of masses.
+
+    Examples
+    --------
+    >>> LINK.identifier(8)
+    'FlexLinkPlant_e8'
+    """
+
+    name: str
+
+    def identifier(self, elements: int) -> str:
+        """Model identifier for a link of ``elements`` elements, e.g. ``FlexLinkPlant_e8``."""
+        return f"{self.name}_e{elements}"
+
+    @property
+    def file_name(self) -> str:
+        """The FMU's file name, ``"FlexLinkPlant.fmu"``."""
+        return f"{self.name}.fmu"
+
+
+LINK = LinkRecipe("FlexLinkPlant")
 #: The SSP system of the three FMUs, written beside them.
 SSP_NAME = "ActionReaction.ssp"
 
@@ -79,3 +107,28 @@ def check_masses(n: int) -> int:
             f"--masses {n}: the number of load masses must be {MIN_MASSES} to {MAX_MASSES}"
         )
     return n
+
+
+def check_elements(elements: int) -> int:
+    """Return ``elements`` if the link FMU can be built with that many elements.
+
+    Raises
+    ------
+    UserError
+        When ``elements`` is not an integer from :data:`MIN_ELEMENTS` to :data:`MAX_ELEMENTS`.
+
+    Examples
+    --------
+    >>> check_elements(8)
+    8
+    """
+    if (
+        isinstance(elements, bool)
+        or not isinstance(elements, int)
+        or not MIN_ELEMENTS <= elements <= MAX_ELEMENTS
+    ):
+        raise UserError(
+            f"--elements {elements}: the number of the link's Hermite elements must be "
+            f"{MIN_ELEMENTS} to {MAX_ELEMENTS}"
+        )
+    return elements

@@ -1,9 +1,11 @@
-"""``arcosim build [--masses N] [--out DIR]``: build the project's FMUs and their SSP.
+"""``arcosim build [--masses N] [--elements E] [--out DIR]``: build the project's FMUs and
+their SSP.
 
 Writes ``MotorChainPlant.fmu``, ``ReactionTorqueObserver.fmu``,
-``ExcitationSource.fmu`` and ``ActionReaction.ssp`` into ``--out`` (default: the
-per-user cache, :mod:`arcosim.build.cache`), for n load masses (model identifiers
-``MotorChainPlant_n3`` …).
+``ExcitationSource.fmu``, ``ActionReaction.ssp`` and the flexible-link plant
+``FlexLinkPlant.fmu`` into ``--out`` (default: the per-user cache,
+:mod:`arcosim.build.cache`), for n load masses (model identifiers ``MotorChainPlant_n3``
+…) and a link of E Hermite elements (``FlexLinkPlant_e6`` …).
 """
 
 from __future__ import annotations
@@ -12,8 +14,16 @@ import argparse
 from pathlib import Path
 
 from arcosim.build.builder import build_all
-from arcosim.build.recipes import MAX_MASSES, MIN_MASSES, check_masses
+from arcosim.build.recipes import (
+    MAX_ELEMENTS,
+    MAX_MASSES,
+    MIN_ELEMENTS,
+    MIN_MASSES,
+    check_elements,
+    check_masses,
+)
 from arcosim.cli.options import add_command
+from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -24,12 +34,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         summary="build the FMUs",
         description="""
 Build the plant, observer and excitation FMUs and their SSP system for n load
-masses into a folder (default: the per-user cache, where every other command looks
-for them; they are built there on first use anyway, so this is only needed to get
-the files themselves).""",
+masses, and the flexible-link plant for E Hermite elements, into a folder (default:
+the per-user cache, where every other command looks for them; they are built there on
+first use anyway, so this is only needed to get the files themselves).""",
         examples="""
 arcosim build --out fmus
-arcosim build --masses 2 --out fmus2""",
+arcosim build --masses 2 --out fmus2
+arcosim build --elements 8 --out fmus""",
     )
     p.add_argument(
         "--masses",
@@ -37,6 +48,14 @@ arcosim build --masses 2 --out fmus2""",
         default=3,
         metavar="N",
         help=f"number of load masses n, {MIN_MASSES} to {MAX_MASSES} (default 3)",
+    )
+    p.add_argument(
+        "--elements",
+        type=int,
+        default=LINK_ELEMENTS,
+        metavar="E",
+        help=f"Hermite elements of the flexible link, {MIN_ELEMENTS} to {MAX_ELEMENTS} "
+        f"(default {LINK_ELEMENTS})",
     )
     p.add_argument(
         "--out",
@@ -49,6 +68,7 @@ arcosim build --masses 2 --out fmus2""",
 
 
 def _execute(args: argparse.Namespace) -> int:
-    for path in build_all(check_masses(args.masses), args.out):
+    elements = check_elements(args.elements)
+    for path in build_all(check_masses(args.masses), args.out, elements):
         print(f"built {path}")
     return 0

@@ -60,3 +60,22 @@ STEP = 1e-3  #: communication step (s)
 def inertias(n: int) -> list[float]:
     """Load inertias (kg·m²) for n masses: the bench's for n = 3, else J_1 for each."""
     return list(J) if n == 3 else [J[0]] * n
+
+
+# -- the flexible link (the FlexLinkPlant FMU, plant_models/flexlink_c; issue 28) ---------
+#: A 0.4 m aluminium strip (about 20 mm × 2.4 mm) with a 20 g tip mass on the bench's
+#: motor: first clamped mode 39.8 rad/s with the tip mass (69.5 rad/s without).
+#: Hermite cubic elements of the built FMU (``arcosim build --elements``): the first three
+#: clamped modes within 0.2 %. The fastest element mode grows as the count squared and its
+#: decay β ω² as the count to the fourth: past 8 elements take a lower ``LINK_BETA`` (the
+#: FMU refuses decays over 1e6 1/s).
+LINK_ELEMENTS = 6
+LINK_EI = 1.0  #: bending stiffness EI (N·m²)
+LINK_RHOA = 0.1  #: mass per length ρA (kg/m)
+LINK_L = 0.4  #: length from the clamp to the tip (m)
+LINK_M_TIP = 0.02  #: tip mass (kg)
+LINK_J_TIP = 0.0  #: tip mass's inertia about its own centre (kg·m²)
+LINK_R_HUB = 0.01  #: radius of the clamp from the motor's axis (m)
+#: Stiffness-proportional damping β (s): mode j damped ζ_j = β ω_j / 2 (0.1 % for the
+#: first clamped mode, 0.8 % for the second).
+LINK_BETA = 5e-5

@@ -6,6 +6,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "friction_events.h"
+#include "matrix_exp.h"
+
 #define N N_MASSES
 #define SIZE PH_SIZE
 #define M PH_INPUTS
@@ -13,101 +16,13 @@
 #define CUR (2 * N + 2) /* index of the current in x */
 #define MAX_EVENTS_PER_STEP 16
 
-/* ---- small dense linear algebra (row-major, fixed leading dimension BIG) ---- */
+/* ---- the matrix exponential (matrix_exp.h, shared with flexlink_c) ---- */
 
 typedef double Square[BIG][BIG];
 
-/* c = a b (n × n); c may be a or b. t: scratch. */
-static void matmul(Square c, Square a, Square b, int n, Square t) {
-    for (int r = 0; r < n; r++)
-        for (int col = 0; col < n; col++) {
-            double s = 0.0;
-            for (int k = 0; k < n; k++) s += a[r][k] * b[k][col];
-            t[r][col] = s;
-        }
-    for (int r = 0; r < n; r++) memcpy(c[r], t[r], sizeof(double) * n);
-}
-
-/* Solve a x = b in place (b becomes x); Gaussian elimination, partial pivoting. */
-static int solve(Square a, Square b, int n) {
-    for (int col = 0; col < n; col++) {
-        int pivot = col;
-        for (int r = col + 1; r < n; r++)
-            if (fabs(a[r][col]) > fabs(a[pivot][col])) pivot = r;
-        if (a[pivot][col] == 0.0 || !isfinite(a[pivot][col])) return -1;
-        if (pivot != col) {
-            double tmp[BIG];
-            memcpy(tmp, a[col], sizeof tmp);
-            memcpy(a[col], a[pivot], sizeof tmp);
-            memcpy(a[pivot], tmp, sizeof tmp);
-            memcpy(tmp, b[col], sizeof tmp);
-            memcpy(b[col], b[pivot], sizeof tmp);
-            memcpy(b[pivot], tmp, sizeof tmp);
-        }
-        double inv = 1.0 / a[col][col];
-        for (int r = col + 1; r < n; r++) {
-            double f = a[r][col] * inv;
-            if (f != 0.0) {
-                for (int c = col; c < n; c++) a[r][c] -= f * a[col][c];
-                for (int c = 0; c < n; c++) b[r][c] -= f * b[col][c];
-            }
-        }
-    }
-    for (int col = n - 1; col >= 0; col--) {
-        double inv = 1.0 / a[col][col];
-        for (int c = 0; c < n; c++) b[col][c] *= inv;
-        for (int r = 0; r < col; r++) {
-            double f = a[r][col];
-            if (f != 0.0)
-                for (int c = 0; c < n; c++) b[r][c] -= f * b[col][c];
-        }
-    }
-    return 0;
-}
-
-/* e = expm(a), scaling and squaring with a (6, 6) Padé approximant (as linalg.expm). */
+/* e = expm(a), with work[0 … 4] as scratch. */
 static int expm(Square e, Square a_in, int n, Square *work) {
-    double(*a)[BIG] = work[0], (*x)[BIG] = work[1], (*num)[BIG] = work[2];
-    double(*den)[BIG] = work[3], (*t)[BIG] = work[4];
-    double norm = 0.0;
-    for (int r = 0; r < n; r++) {
-        double s = 0.0;
-        for (int c = 0; c < n; c++) s += fabs(a_in[r][c]);
-        if (s > norm || isnan(s)) norm = s;
-    }
-    if (!isfinite(norm)) return -1;
-    int s = norm > 0.5 ? (int)ceil(log2(norm / 0.5)) : 0;
-    if (s < 0) s = 0;
-    double scale = pow(0.5, s);
-    for (int r = 0; r < n; r++)
-        for (int c = 0; c < n; c++) {
-            a[r][c] = scale * a_in[r][c];
-            x[r][c] = a[r][c];
-        }
-    const int q = 6;
-    double coef = 0.5;
-    for (int r = 0; r < n; r++)
-        for (int c = 0; c < n; c++) {
-            double id = r == c ? 1.0 : 0.0;
-            num[r][c] = id + coef * a[r][c];
-            den[r][c] = id + -coef * a[r][c];
-        }
-    int positive = 1;
-    for (int k = 2; k <= q; k++) {
-        coef = coef * (q - k + 1) / (k * (2 * q - k + 1));
-        matmul(x, a, x, n, t);
-        double sign = positive ? coef : -coef;
-        for (int r = 0; r < n; r++)
-            for (int c = 0; c < n; c++) {
-                num[r][c] = num[r][c] + coef * x[r][c];
-                den[r][c] = den[r][c] + sign * x[r][c];
-            }
-        positive = !positive;
-    }
-    if (solve(den, num, n) != 0) return -1;
-    for (int r = 0; r < n; r++) memcpy(e[r], num[r], sizeof(double) * n);
-    for (int i = 0; i < s; i++) matmul(e, e, e, n, t);
-    return 0;
+    return mx_expm(&e[0][0], &a_in[0][0], n, BIG, &work[0][0][0]);
 }
 
 /* ---- the chain's matrices ---- */
@@ -370,47 +285,7 @@ static double drive_torque(const Physics *p, const double *x) {
     return p->k_t * x[CUR] - (p->k1 * (x[0] - x[1]) + p->B1 * (x[N + 1] - x[N + 2]));
 }
 
-static double hermite(double y0, double d0, double y1, double d1, double tau, double s) {
-    double r = s / tau;
-    double h00 = (1 + 2 * r) * ((1 - r) * (1 - r));
-    double h10 = r * ((1 - r) * (1 - r));
-    double h01 = r * r * (3 - 2 * r);
-    double h11 = r * r * (r - 1);
-    return h00 * y0 + h10 * tau * d0 + h01 * y1 + h11 * tau * d1;
-}
-
-/* An event on the Hermite interpolant: reversal (sign·y < 0) or breakaway (|y| > f_c). */
-typedef struct {
-    int breakaway;
-    double y0, d0, y1, d1, tau, sign, f_c;
-} Event;
-
-static int event_at(const Event *e, double s) {
-    double y = hermite(e->y0, e->d0, e->y1, e->d1, e->tau, s);
-    return e->breakaway ? fabs(y) > e->f_c : e->sign * y < 0.0;
-}
-
-/* Smallest s in (0, tau] where the event becomes true, or -1 (bisection on a grid). */
-static double first_root(const Event *e, double tau) {
-    const int samples = 32;
-    double lo = 0.0;
-    for (int j = 1; j <= samples; j++) {
-        double hi = tau * j / samples;
-        if (event_at(e, hi)) {
-            for (int it = 0; it < 60; it++) {
-                double mid = 0.5 * (lo + hi);
-                if (event_at(e, mid))
-                    hi = mid;
-                else
-                    lo = mid;
-                if (hi - lo <= 1e-15 * tau) break;
-            }
-            return hi;
-        }
-        lo = hi;
-    }
-    return -1.0;
-}
+/* hermite, Event and first_root: friction_events.h (shared with flexlink_c) */
 
 static double first_reversal(const Physics *p, const double *x0, const double *x1,
                              const double *u, double tau) {
@@ -504,27 +379,3 @@ double physics_reaction_torque(const Physics *p) {
 double physics_average_current(const Physics *p, double h) { return p->x[CUR + 1] / h; }
 
 double physics_average_reaction(const Physics *p, double h) { return p->x[CUR + 2] / h; }
-
-/* ---- noise and encoder (flexchain/noise.py) ---- */
-
-static uint64_t splitmix64(uint64_t z) {
-    z += 0x9E3779B97F4A7C15ULL;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-}
-
-double noise_gaussian(uint64_t seed, uint64_t k) {
-    uint64_t base = splitmix64(seed ^ 0x5DEECE66DULL);
-    uint64_t a = splitmix64(base + 2 * k);
-    uint64_t b = splitmix64(base + 2 * k + 1);
-    double u1 = (double)((a >> 11) + 1) * 0x1p-53;
-    double u2 = (double)(b >> 11) * 0x1p-53;
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * PH_PI * u2);
-}
-
-double noise_quantize(double theta, int64_t counts_per_rev) {
-    if (counts_per_rev <= 0) return theta;
-    double step = 2.0 * PH_PI / (double)counts_per_rev;
-    return floor(theta / step) * step;
-}

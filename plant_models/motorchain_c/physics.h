@@ -10,9 +10,7 @@
 #include <stdint.h>
 
 #include "chain_size.h" /* generated at build: #define N_MASSES n */
-
-/* π as the double nearest to it, the value of Python's math.pi (C99 has no M_PI) */
-#define PH_PI 3.14159265358979323846
+#include "sensor_noise.h" /* noise_gaussian, noise_quantize, PH_PI (shared) */
 
 #define PH_SIZE (2 * N_MASSES + 5) /* state length */
 #define PH_INPUTS (N_MASSES + 2)   /* i_ref, τ_fric, τ_ext,1 … τ_ext,n */
@@ -66,10 +64,5 @@ int physics_advance(Physics *p, PhysicsCache *cache, double h, double i_ref,
 double physics_reaction_torque(const Physics *p);     /* τ_1 (N·m) */
 double physics_average_current(const Physics *p, double h);  /* A */
 double physics_average_reaction(const Physics *p, double h); /* N·m */
-
-/* flexchain/noise.py: sample k of stream seed, bit-identical to the Python. */
-double noise_gaussian(uint64_t seed, uint64_t k);
-/* Encoder: whole counts, floored; counts_per_rev <= 0 = ideal. */
-double noise_quantize(double theta, int64_t counts_per_rev);
 
 #endif
