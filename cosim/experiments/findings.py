@@ -413,8 +413,9 @@ def _link_section(results: Results) -> str:
 Hermite elements, written apart from the identification's modal model): a {p["L"]:g} m
 strip, EI = {p["EI"]:g} N·m², ρA = {p["rhoA"]:g} kg/m, a {1e3 * p["m_tip"]:g} g tip mass,
 clamped at r = {1e2 * p["r_hub"]:g} cm, damping β = {p["beta"]:g} s, on the bench's motor
-and sensors, driven by a {rig.amplitude:g} A multi-sine of {len(lines)} lines
-{lines[0]:g}–{lines[-1]:g} rad/s for {LINK_DURATION:g} s (`flexible_link.csv`, seed
+and realistic sensors (also under `--ideal`: the fit needs the encoder's counts), driven
+by a {rig.amplitude:g} A multi-sine of {len(lines)} lines {lines[0]:g}–{lines[-1]:g}
+rad/s for {LINK_DURATION:g} s (`flexible_link.csv`, seed
 {rig.seed}; the hub up to {results.link["peak_speed_rad_s"]:.3g} rad/s, below 0.3 × the
 first clamped mode). Given: k_t, J_m, the friction, the encoder's counts, L, m_tip and r.
 The fit (`arcosim identify flexible_link.csv --method beam --set L=… --set m_tip=…
