@@ -81,11 +81,12 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         "fig6_state_estimates.png",
         "fig7_whole_chain.png",
         "fig8_load_torque.png",
+        "fig9_flexible_link.png",
     ):
         assert (out / name).stat().st_size > 20_000, name
     # by default one log per maneuver (issue 27: ~7 MB, not 99 MB; --all-csv: every run)
     runs = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
-    for name in (*runs, "load_true_chain.csv"):
+    for name in (*runs, "load_true_chain.csv", "flexible_link.csv"):
         assert (out / name).stat().st_size > 100_000, name
         header = (out / name).open(encoding="utf-8").readline().strip()
         assert header == "time,i_a,omega_m,theta_m", (name, header)
@@ -121,6 +122,9 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         cells = rows[label]  # chain, settling, mean %, max %, ...
         assert cells[4] == "%" and cells[6] == "%", cells
         assert float(cells[5]) < limit, cells
+    # experiment 6: the flexible link (its numbers: tests/test_flexible_link_experiment.py)
+    assert "6. Flexible link from the hub alone" in result.stdout
+    assert "clamped mode 2 (rad/s)" in report and "fig9_flexible_link.png" in report
 
 
 @pytest.mark.slow

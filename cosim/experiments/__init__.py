@@ -8,9 +8,10 @@ scenarios        -- a current command, a duration and FMU settings, run as one c
 paper            -- the paper's own Table II, in SI units
 metrics          -- how estimates are scored against the plant's truth
 load_scores      -- how a load torque estimate is scored (settling, settled error, lag)
-reproduce        -- the five experiments, one function each (``reproduce``)
+flexible_link    -- a flexible link on the link plant FMU: its run, the fit from the hub, scores
+reproduce        -- the six experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
-reproduce_figures -- Figs. 4–8 from the runs and what they found
+reproduce_figures -- Figs. 4–9 from the runs and what they found
 report           -- the figures drawn, and tables as Markdown or text
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.

@@ -1,4 +1,4 @@
-"""The paper's three experiments on the bench, and two beyond it (``arcosim reproduce``).
+"""The paper's three experiments on the bench, and three beyond it (``arcosim reproduce``).
 
 1. actuator self-identification with the load detached (mode 0);
 2. five rigid maneuvers with different noise seeds (mode 1), with the actuator terms
@@ -14,7 +14,10 @@
    torque, then a 2 rad/s sine) during the broadband maneuver, estimated from the motor
    alone (model-based observer with ``load_mass = 3``), with the true chain and with
    experiment 4's chain: settling time, settled error, lag of the sine (scenario
-   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
+   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8;
+6. beyond the paper: a flexible link (the link plant FMU) identified from the hub's
+   current and encoder alone — EI, ρA, the clamped modes, eq. 7's reaction torque and
+   the tip angle against the plant's (:mod:`arcosim.experiments.flexible_link`) → Fig. 9.
 
 :func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
 ``arcosim reproduce`` is the command line.
@@ -37,9 +40,19 @@ from arcosim.experiments.findings import (
     Results,
     report_markdown,
 )
+from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
+from arcosim.experiments.flexible_link import (
+    EXPERIMENT_RIG,
+    LINK_FMU,
+    LINK_UNITS,
+    LinkRun,
+    identify_link,
+    simulate_link,
+)
 from arcosim.experiments.load_scores import score_profile
 from arcosim.experiments.metrics import flexible_score
 from arcosim.experiments.reproduce_figures import (
+    link_figure,
     load_torque_figure,
     paper_figures,
     whole_chain_figure,
@@ -64,7 +77,7 @@ from arcosim.outputs import check_output_folder, refuse_existing, write_text
 
 #: The runs written by default, each its log only (``all_csv``: every run, every signal).
 DEFAULT_CSV = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
-DEFAULT_CSV += ("load_true_chain.csv",)
+DEFAULT_CSV += ("load_true_chain.csv", "flexible_link.csv")
 
 #: The files :func:`reproduce` writes into its folder.
 OUTPUTS = (
@@ -75,11 +88,13 @@ OUTPUTS = (
     "whole_chain.csv",
     "load_true_chain.csv",
     "load_identified_chain.csv",
+    "flexible_link.csv",
     "fig4_reaction_torque.png",
     "fig5_flexible_response.png",
     "fig6_state_estimates.png",
     "fig7_whole_chain.png",
     "fig8_load_torque.png",
+    "fig9_flexible_link.png",
     "report.md",
 )
 
@@ -93,7 +108,7 @@ def reproduce(
     all_csv: bool = False,
     tool_names: bool = False,
 ) -> Results:
-    """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
+    """Run the six experiments, write CSVs, figures and ``report.md`` into ``out``.
 
     Parameters
     ----------
@@ -148,25 +163,28 @@ def reproduce(
         flexible = _flexible_maneuver(bench, actuator, k_mean, b_mean)
         identification, estimated = _whole_chain(bench, actuator, flexible)
         loaded = _load_torque(bench, actuator) if estimated is not None else None
+        link = _flexible_link(bench)
         bar.set_postfix_str(f"writing the figures and report.md into {out}")
         if loaded is not None:
             results.files.append(load_torque_figure(out, loaded))
         results.files += paper_figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
         if estimated is not None:
             results.files.append(whole_chain_figure(out, identification, results))
+        results.files.append(link_figure(out, *link))
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
     return results
 
 
 def _total_steps() -> int:
-    """The co-simulation steps of the five experiments, for the progress bar (a count)."""
+    """The co-simulation steps of the six experiments, for the progress bar (a count)."""
     return (
         round(SCENARIOS["selfid"].duration / STEP)
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
         + 2 * round(SCENARIOS["flexible"].duration / STEP)
         + round(SCENARIOS["identification"].duration / STEP)
         + 2 * round(LOAD_PROFILE.duration / STEP)
+        + round(LINK_DURATION / STEP)
     )
 
 
@@ -332,6 +350,34 @@ def _load_torque(bench: _Bench, actuator: dict[str, float]) -> dict[str, Recordi
         loaded["true chain"], results.actuator, bench.encoder_cpr
     )
     return loaded
+
+
+def _flexible_link(bench: _Bench) -> tuple[LinkRun, dict[str, np.ndarray]]:
+    """Experiment 6: the link plant FMU driven by a multi-sine, identified from its hub's
+    current and encoder alone (EI, ρA, the damping), then eq. 7's reaction torque and the
+    tip angle over the record by the fitted model's smoother.
+
+    Fills ``results.link``; returns the run and the estimates (Fig. 9).
+    """
+    bench.status("flexible link")
+    run = simulate_link(bench.folder / LINK_FMU, EXPERIMENT_RIG)
+    bench.progress(len(run.time) - 1)
+    bench.status("flexible-link fit")
+    findings = identify_link(run, EXPERIMENT_RIG)
+    bench.results.link = findings.as_dict()
+    columns = run.log()  # the log; with all_csv the plant's truth and the estimates too
+    if bench.all_csv:
+        columns.update(run.signals)
+        columns.update({f"{name}_hat": x for name, x in findings.estimates.items()})
+    path = write_csv(
+        bench.out / "flexible_link.csv",
+        columns,
+        units={name: LINK_UNITS[name.removesuffix("_hat")] for name in columns},
+        tool_names=bench.tool_names,
+        force=True,
+    )
+    bench.results.files.append(path)
+    return run, findings.estimates
 
 
 def _angle_scores(run: Recording, motor: np.ndarray) -> list[float]:

@@ -1,8 +1,9 @@
-"""The figures of ``arcosim reproduce`` (Figs. 4–8) from its runs and results.
+"""The figures of ``arcosim reproduce`` (Figs. 4–9) from its runs and results.
 
 :func:`paper_figures` draws the paper's Figs. 4–6, :func:`whole_chain_figure` Fig. 7
 (experiment 4's chain against the truth), :func:`load_torque_figure` Fig. 8 (experiment
-5's load torque); the drawing itself is in :mod:`arcosim.experiments.report`.
+5's load torque), :func:`link_figure` Fig. 9 (experiment 6's flexible link); the drawing
+itself is in :mod:`arcosim.experiments.report`.
 """
 
 from __future__ import annotations
@@ -12,8 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.experiments.findings import N_MASSES, TRUE_CHAIN, Results
+from arcosim.experiments.flexible_link import LinkRun
 from arcosim.experiments.load_scores import step_truth
 from arcosim.experiments.report import (
+    figure_flexible_link,
     figure_flexible_response,
     figure_load_torque,
     figure_reaction_torque,
@@ -138,3 +141,24 @@ def load_torque_figure(out: Path, runs: dict[str, Recording]) -> Path:
     rec = runs["true chain"]
     truth = step_truth(rec.time, LOAD_PROFILE.torque(rec.time))
     return figure_load_torque(rec.time, truth, estimates, out / "fig8_load_torque.png")
+
+
+def link_figure(out: Path, run: LinkRun, estimates: dict[str, np.ndarray]) -> Path:
+    """Fig. 9: experiment 6's reaction torque and tip angle from the hub over the plant's.
+
+    Parameters
+    ----------
+    out : Path
+        Folder the PNG file goes into.
+    run : LinkRun
+        Experiment 6's run of the link plant (its ``tau_reac``, N·m, and ``alpha_tip``,
+        rad).
+    estimates : dict of str to ndarray
+        ``tau_reac`` (N·m) and ``alpha_tip`` (rad) from the hub, each shape ``(N,)``.
+
+    Returns
+    -------
+    Path
+        The figure written.
+    """
+    return figure_flexible_link(run.time, run.signals, estimates, out / "fig9_flexible_link.png")
