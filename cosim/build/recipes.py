@@ -56,7 +56,12 @@ OBSERVER = FmuRecipe(
 SOURCE = FmuRecipe(
     "ExcitationSource", "arsource.fmu:ExcitationSource", ("fmukit", "flexchain", "arsource")
 )
-RECIPES = (PLANT, OBSERVER, SOURCE)
+CONTROLLER = FmuRecipe(
+    "ActionReactionController",
+    "arcontroller.fmu:ActionReactionController",
+    ("fmukit", "flexchain", "arcontroller"),
+)
+RECIPES = (PLANT, OBSERVER, SOURCE, CONTROLLER)
 #: The SSP system of the three FMUs, written beside them.
 SSP_NAME = "ActionReaction.ssp"
 
