@@ -3,6 +3,7 @@ library's algorithm, and closes the loop around the plant FMU in both master ord
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -80,3 +81,45 @@ def test_the_fmu_runs_the_library_controller_and_settles(fmus, ordering: str) ->
     tail = run.time >= 3.0
     assert np.ptp(run["plant.theta_m"][tail]) <= 2 * COUNT + 1e-12
     assert np.abs(run["controller.i_ref"]).max() <= defaults.I_MAX
+
+
+@pytest.mark.slow
+def test_simulate_move_prints_how_the_move_went(fmus, capsys) -> None:
+    from arcosim.cli import main
+
+    assert (
+        main(["simulate", "--scenario", "move", "--duration", "3", "--json", "--fmus", str(fmus)])
+        == 0
+    )
+    summary = json.loads(capsys.readouterr().out)
+    assert 1.0 < summary["settling_1pct"] <= 2.5
+    assert abs(summary["final_error"]) < 0.01
+    assert (
+        main(
+            [
+                "simulate",
+                "--scenario",
+                "move",
+                "--set",
+                "controller.bandwidth=5",
+                "--fmus",
+                str(fmus),
+            ]
+        )
+        == 2
+    )
+    assert "move_time = 1.0 s and bandwidth = 5.0 rad/s" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("parameter_set", ["move", "move-load"])
+def test_the_closed_loop_ssp_moves_the_last_mass(fmus, parameter_set: str) -> None:
+    """MotionControl.ssp in the SSP runner (Jacobi: the command one step late), with a
+    constant load of −5 mN·m on the last mass in ``move-load``."""
+    from arcosim.host.ssp import run_ssp
+
+    run = run_ssp(fmus / "MotionControl.ssp", parameter_set, stop=4.0)
+    last = run["plant.theta[3]"]
+    outside = np.flatnonzero(np.abs(last - 1.0) > 0.01)
+    assert run.time[outside[-1]] <= 2.5
+    assert abs(last[-1] - 1.0) < 0.005
