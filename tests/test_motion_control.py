@@ -119,7 +119,7 @@ def test_a_bench_move_settles_sensorless(delay: int) -> None:
 def test_a_five_mass_move_settles_sensorless() -> None:
     run = closed_loop(FIVE)
     _check_move(run)
-    assert run.residual_rms(1.0) <= 2e-3
+    assert run.residual_rms(1.0) <= 2.5e-3
 
 
 @pytest.mark.slow
@@ -127,3 +127,18 @@ def test_the_full_state_upper_bound_settles_faster() -> None:
     run = closed_loop(BENCH_2, full_state=True)
     assert run.settling_time(1.0, 0.005) <= 1.5
     assert run.residual_rms(1.0) <= 2e-4
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("fj", "fk"), [(1.1, 0.9), (0.9, 1.1)], ids=["model J +10 %, k -10 %", "J -10 %, k +10 %"]
+)
+def test_a_bench_move_settles_with_the_model_ten_percent_off(fj: float, fk: float) -> None:
+    """The controller designed from a chain whose every J_i is off by one factor and every
+    k_i by another (the corners of the identification's ±10 %), run on the true chain."""
+    model = dict(
+        BENCH_2, J=tuple(fj * x for x in BENCH_2["J"]), k=tuple(fk * x for x in BENCH_2["k"])
+    )
+    run = closed_loop(BENCH_2, model)
+    _check_move(run)
+    assert run.residual_rms(1.0) <= 2.5e-3

@@ -5,10 +5,11 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
 
 * **estimates**: the observer's model-based estimator with its load-torque state on mass
   L (:class:`~arcosim.fmu.flexchain.observer.Observer`, mode 2, estimator 1, the same
-  code as the observer FMU) gives every load angle and velocity and the torque d̂ on
-  mass L; a motor observer (:class:`MotorObserver`) gives the motor's angle, velocity
-  and the friction d̂_m on it, from the current and the encoder, with the first spring
-  pulling towards the estimated mass 1;
+  code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``)
+  gives every load angle and velocity and the torque d̂ on mass L; the motor's angle
+  and velocity enter as measured; a motor observer (:class:`MotorObserver`) gives the
+  friction d̂_m the friction model misses, from the current and the encoder, with the
+  first spring pulling towards the estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
   (:func:`shaped_step`, zero velocity, acceleration and jerk at both ends, lasting
   ``move_time``) whose sum is the target path s(t); a reference model, the design model
@@ -209,6 +210,7 @@ class MotionController:
             estimator=Estimator.MODEL_BASED,
             encoder_cpr=d.encoder_cpr,
             load_mass=d.control_mass,
+            torque_noise_std=defaults.CONTROL_TORQUE_NOISE_STD,
         )
         self.observer = Observer(settings, theta_m0, 0.0)
         self.offset = settings.angle_offset()
@@ -246,13 +248,16 @@ class MotionController:
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
         dob.step(h, i_a, omega_m, theta_m)
-        self.motor.step(h, i_a, theta_m + self.offset - t0, theta_1, omega_1, self.friction)
-        d_m, w_m, th_m = self.motor.s
+        th_m = theta_m + self.offset - t0
+        self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
+        d_m = self.motor.s[0]
         drive = theta_m + obs.offset
         if dob.sticking:
             settle_sticking(dob, est, h, drive)
         est.step(h, dob.tau_reac_hat, drive)
-        x = [th_m, *(a - t0 for a in est.theta), w_m, *est.omega]
+        # the motor's own states as measured: its observer's (model-based) estimates of
+        # them cost the loop its stability under a 10 % model error (docs/control.md)
+        x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]
         L = self.design.control_mass
         self.theta_hat_ctrl = est.theta[L - 1]
         return self._command(h, theta_ref, x, est.tau_load, d_m)
