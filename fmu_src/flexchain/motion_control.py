@@ -185,7 +185,7 @@ class MotionController:
     >>> controller = arcosim.MotionController(arcosim.design_controller(chain, h=1e-3))
     >>> i_ref = controller.step(1e-3, 1.0, 0.0, 0.0, 0.0)  # a 1 rad move starts, at rest
     >>> round(i_ref, 3), round(controller.i_ff, 6)  # A: the friction cancelled; no feedforward yet
-    (0.045, 2e-06)
+    (0.049, 2e-06)
     """
 
     _transient = ("_designs",)
@@ -215,11 +215,13 @@ class MotionController:
         self.observer = Observer(settings, theta_m0, 0.0)
         self.offset = settings.angle_offset()
         self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
-        self.theta0 = theta_m0
+        # the origin of the relative states: where the estimates start (the encoder's
+        # angle at the middle of its count), so the reference starts on them
+        self.theta0 = theta_m0 + self.offset
         self.t = 0.0
-        self.path = TargetPath(theta_m0, d.move_time)
+        self.path = TargetPath(self.theta0, d.move_time)
         self.reference = [0.0] * (2 * n + 2)
-        self.theta_hat_ctrl = theta_m0
+        self.theta_hat_ctrl = self.theta0
         self.i_ff = self.i_fb = self.i_ref = 0.0
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
 
