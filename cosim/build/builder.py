@@ -30,7 +30,15 @@ from arcosim.build.cache import (
     source_digest,
 )
 from arcosim.build.portable import make_portable, slave_class
-from arcosim.build.recipes import LINK, RECIPES, SSP_NAME, FmuRecipe, check_elements, check_masses
+from arcosim.build.recipes import (
+    CONTROL_SSP_NAME,
+    LINK,
+    RECIPES,
+    SSP_NAME,
+    FmuRecipe,
+    check_elements,
+    check_masses,
+)
 from arcosim.errors import BuildError
 from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 from arcosim.version import __version__
@@ -149,13 +157,22 @@ def build_locked(n: int, target: Path, elements: int = LINK_ELEMENTS) -> list[Pa
         When a file cannot be written, or a built file is not a complete FMU.
     """
     from arcosim.build.clink import build_link
-    from arcosim.build.ssp import write_ssp
+    from arcosim.build.ssp import MOTION_CONTROL, motion_control_sets, write_ssp
 
     stamp = target / DIGEST_FILE
     try:
         stamp.unlink(missing_ok=True)
         built = [build_fmu(recipe, n, target) for recipe in RECIPES]
         built.append(write_ssp(target / SSP_NAME, target))
+        built.append(
+            write_ssp(
+                target / CONTROL_SSP_NAME,
+                target,
+                motion_control_sets(n),
+                stop=6.0,
+                layout=MOTION_CONTROL,
+            )
+        )
         built.append(build_link(elements, target / LINK.file_name))
         problems = [p for p in map(fmu_problem, built) if p is not None]
         if problems:

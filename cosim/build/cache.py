@@ -25,7 +25,14 @@ from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
-from arcosim.build.recipes import LINK, RECIPES, SSP_NAME, check_elements, check_masses
+from arcosim.build.recipes import (
+    CONTROL_SSP_NAME,
+    LINK,
+    RECIPES,
+    SSP_NAME,
+    check_elements,
+    check_masses,
+)
 from arcosim.errors import BuildError
 from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 from arcosim.version import __version__
@@ -155,4 +162,5 @@ def is_current(folder: Path, n: int, elements: int = LINK_ELEMENTS) -> bool:
     except OSError:
         return False
     wanted = [folder / r.file_name for r in (*RECIPES, LINK)] + [folder / SSP_NAME]
+    wanted.append(folder / CONTROL_SSP_NAME)
     return all(fmu_problem(path) is None for path in wanted)
