@@ -80,9 +80,10 @@ def chain_modes(params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         ]
     )
     poles = np.linalg.eigvals(A)
-    poles = poles[poles.imag > 1e-9]  # one of each oscillating pair; the rigid ones drop
-    order = np.argsort(np.abs(poles))
-    poles = poles[order]
+    size = np.abs(poles)
+    # one of each oscillating pair; the rigid body's two poles at (or rounded near) 0 drop
+    poles = poles[(poles.imag > 1e-9) & (size > 1e-6 * np.max(size))]
+    poles = poles[np.argsort(np.abs(poles))]
     return np.abs(poles), -poles.real / np.abs(poles)
 
 
