@@ -6,12 +6,14 @@ over [t_k, t_k + h], sets it (and any external torque) and steps the plant: zero
 The controller is any object with ``step(h, theta_ref, i_a, omega_m, theta_m) -> i_ref``
 (:class:`arcosim.experiments.motion_baselines.CascadeController`, the sensorless
 ``MotionController``); with ``full_state=True`` the master calls its
-``step_full_state(h, theta_ref, angles, velocities)`` with the plant's true angles and
-velocities of the motor and every mass instead (the upper bound).
+``step_full_state(h, theta_ref, angles, velocities[, i_a])`` with the plant's true angles
+and velocities of the motor and every mass instead (the upper bound), and the measured
+current when the method takes it.
 """
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Mapping, Sequence
 from ctypes import c_double
 from dataclasses import dataclass, field
@@ -134,6 +136,7 @@ def run_closed_loop(
     names = [*MEASURED, "theta_m_true", *(f"theta[{i}]" for i in range(1, n + 1))]
     names += ["omega_m_true", *(f"omega[{i}]" for i in range(1, n + 1))]
     inspected = [a for a in INSPECTED if hasattr(controller, a)]
+    takes_current = full_state and _takes_current(controller.step_full_state)
     log = np.empty((steps + 1, len(names)))
     commands, seen = np.empty(steps), np.empty((steps, len(inspected)))
     with FmuInstance(folder / f"{PLANT.name}.fmu", "plant") as fmu:
@@ -145,11 +148,12 @@ def run_closed_loop(
         _checked(outputs.get(), fmu, 0.0)
         for k in range(steps):
             t = k * h
-            row = log[k] = outputs.array
+            log[k] = outputs.array
+            row = log[k].tolist()  # Python floats, as an FMU would be given them
             if full_state:
-                command = controller.step_full_state(
-                    h, ref(t), row[3 : 4 + n].tolist(), row[4 + n :].tolist()
-                )
+                angles, velocities = row[3 : 4 + n], row[4 + n :]
+                measured = (row[0],) if takes_current else ()  # i_a, when it asks for it
+                command = controller.step_full_state(h, ref(t), angles, velocities, *measured)
             else:
                 command = controller.step(h, ref(t), row[0], row[1], row[2])
             commands[k] = inputs.array[0] = command
@@ -170,6 +174,11 @@ def run_closed_loop(
         i_ref=commands,
         inspected={a: seen[:, j].copy() for j, a in enumerate(inspected)},
     )
+
+
+def _takes_current(method: Callable) -> bool:
+    """Whether ``step_full_state`` takes the measured current after the velocities."""
+    return len(inspect.signature(method).parameters) >= 5
 
 
 def _checked(status: int, fmu: FmuInstance, t: float) -> None:

@@ -65,7 +65,7 @@ def chain_modes(params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
     Examples
     --------
     >>> f, z = chain_modes({"J_mo": 1.0, "J[1]": 1.0, "k[1]": 2.0, "B[1]": 0.0})
-    >>> round(float(f[0]), 6), float(z[0])  # sqrt(k (1/J_m + 1/J_1))
+    >>> round(float(f[0]), 6), round(float(z[0]), 12)  # sqrt(k (1/J_m + 1/J_1)), undamped
     (2.0, 0.0)
     """
     J, k, B = chain_vectors(params)
@@ -199,7 +199,7 @@ def smooth_profile(t: np.ndarray | float, distance: float, move_time: float):
     --------
     >>> p, v, a = smooth_profile(np.array([0.0, 0.5, 2.0]), 1.0, 1.0)
     >>> p.tolist(), v.tolist()
-    [[0.0, 0.5, 1.0], [0.0, 1.875, 0.0]]
+    ([0.0, 0.5, 1.0], [0.0, 1.875, 0.0])
     """
     tau = np.clip(np.asarray(t, dtype=float) / move_time, 0.0, 1.0)
     p = distance * tau**3 * (10 - 15 * tau + 6 * tau**2)
@@ -326,10 +326,19 @@ def cascade_shaper(params: Mapping[str, float], gains: CascadeGains, kind: str =
     if kind not in ("zv", "zvd"):
         raise ValueError(f"kind must be 'zv' or 'zvd', got {kind!r}")
     shaper = Shaper((0.0,), (1.0,))
-    for omega, zeta in zip(*cascade_modes(params, gains)):
-        if omega < gains.velocity_filter and zeta < 1.0:
-            shaper = shaper.then(getattr(Shaper, kind)(float(omega), float(zeta)))
+    for omega, zeta in shaped_modes(params, gains):
+        shaper = shaper.then(getattr(Shaper, kind)(omega, zeta))
     return shaper
+
+
+def shaped_modes(params: Mapping[str, float], gains: CascadeGains) -> list[tuple[float, float]]:
+    """The modes :func:`cascade_shaper` shapes: (ω rad/s, ζ) of every mode under the
+    cascade below its velocity filter."""
+    return [
+        (float(omega), float(zeta))
+        for omega, zeta in zip(*cascade_modes(params, gains))
+        if omega < gains.velocity_filter
+    ]
 
 
 class CascadeController:

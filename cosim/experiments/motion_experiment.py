@@ -32,6 +32,7 @@ from arcosim.experiments.motion_baselines import (
     cascade_gains,
     cascade_shaper,
     chain_modes,
+    shaped_modes,
 )
 from arcosim.experiments.motion_findings import (
     CONTROLLERS,
@@ -146,14 +147,14 @@ def model_errors(n: int, seeds: tuple[int, ...]) -> dict[str, tuple[np.ndarray, 
     --------
     >>> errors = model_errors(2, (1,))
     >>> list(errors)
-    ['seed 1', 'J +10 %, k −10 %', 'J −10 %, k +10 %']
-    >>> bool(np.all(np.abs(errors["seed 1"][0] - 1.0) <= 0.1))
+    ['random, seed 1', 'J +10 %, k −10 %', 'J −10 %, k +10 %']
+    >>> bool(np.all(np.abs(errors["random, seed 1"][0] - 1.0) <= 0.1))
     True
     """
     out = {}
     for seed in seeds:
         rng = np.random.default_rng(seed)
-        out[f"seed {seed}"] = (rng.uniform(0.9, 1.1, n), rng.uniform(0.9, 1.1, n))
+        out[f"random, seed {seed}"] = (rng.uniform(0.9, 1.1, n), rng.uniform(0.9, 1.1, n))
     ones = np.ones(n)
     out["J +10 %, k −10 %"] = (1.1 * ones, 0.9 * ones)
     out["J −10 %, k +10 %"] = (0.9 * ones, 1.1 * ones)
@@ -243,7 +244,9 @@ def run_chain(
         modes=[float(w) for w in chain_modes(params)[0]],
         identification_error=_identification_error(chain, result),
         gains=gains.text(),
-        shaper=", ".join(f"{a:.3f} at {t:.3f} s" for t, a in zip(shaper.times, shaper.amplitudes)),
+        shaper=f"{len(shaper.times)} impulses over {shaper.duration:.3f} s, on "
+        + ", ".join(f"{w:.1f}" for w, _ in shaped_modes(params, gains))
+        + " rad/s",
     )
     status(f"motion control, {chain.name}: the four controllers")
     nominal = runs.four(params)
