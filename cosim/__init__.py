@@ -30,6 +30,12 @@ uniform_chain       -- the paper's uniform chain: k and B by output error
 estimate_load_torque -- the torque on a load mass over a log (the observer's estimator)
 ObserverSettings    -- the observer FMU's parameters as one value (estimate_load_torque's)
 
+Motion and vibration control (the controller FMU's algorithms, standard library)
+-------------------------------------------------------------------------------
+design_controller   -- state feedback and reference shaping for a chain and a move time
+ControllerDesign    -- its result: the discrete model, the gain, the goals
+MotionController    -- moves a load mass and damps the chain from current and encoder
+
 Scenarios and co-simulation
 ---------------------------
 SCENARIOS           -- the named scenarios (selfid, rigid, flexible, identification, …)
@@ -117,6 +123,9 @@ _API = {
     "encoder_record": "arcosim.identification.records",
     "identify_whole_chain": "arcosim.identification.whole_chain",
     "uniform_chain": "arcosim.identification.uniform_fit",
+    "design_controller": "arcosim.fmu.flexchain.control_design",
+    "ControllerDesign": "arcosim.fmu.flexchain.control_design",
+    "MotionController": "arcosim.fmu.flexchain.motion_control",
     "SCENARIOS": "arcosim.experiments.scenarios",
     "Scenario": "arcosim.experiments.scenarios",
     "run_scenario": "arcosim.experiments.scenarios",

@@ -39,4 +39,14 @@ The observer
 * :mod:`~arcosim.fmu.flexchain.load_observer` — the same with the torque on one load mass.
 * :mod:`~arcosim.fmu.flexchain.observer` — the settings, their rules
   (``ObserverSettings.problems``) and the observer that runs the configured mode.
+
+The controller
+
+* :mod:`~arcosim.fmu.flexchain.riccati` — the discrete Riccati equation (the Kalman gains'
+  and the state feedback's one solver).
+* :mod:`~arcosim.fmu.flexchain.control_design` — the discrete motor and chain, the state
+  feedback from the chain and a move time or bandwidth.
+* :mod:`~arcosim.fmu.flexchain.motor_observer` — the motor's angle, velocity and friction.
+* :mod:`~arcosim.fmu.flexchain.motion_control` — the controller: estimates, reference
+  shaping, feedback, limit.
 """

@@ -60,3 +60,16 @@ STEP = 1e-3  #: communication step (s)
 def inertias(n: int) -> list[float]:
     """Load inertias (kg·m²) for n masses: the bench's for n = 3, else J_1 for each."""
     return list(J) if n == 3 else [J[0]] * n
+
+
+# -- the motion and vibration controller (ActionReactionController) ----------------------
+MOVE_TIME = 1.0  #: duration of a shaped point-to-point move (s); 0 = set by the bandwidth
+BANDWIDTH = 0.0  #: feedback bandwidth ω_c (rad/s); 0 = set by the move time
+I_MAX = 10.0  #: current limit of the controller's command (A)
+#: Bandwidth of the controller's motor observer (angle, velocity and friction of the
+#: motor, from its current and encoder; rad/s): its three poles sit there.
+MOTOR_OBSERVER_BANDWIDTH = 150.0
+#: Bandwidth of its friction estimate (rad/s): the pole of its friction state. What the
+#: friction model (f_c times the sign of the motor's heading) misses is cancelled this
+#: fast; at 150 rad/s the bench's two-mass chain held a 26 mrad limit cycle at its mode.
+MOTOR_FRICTION_BANDWIDTH = 20.0

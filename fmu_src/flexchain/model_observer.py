@@ -29,6 +29,7 @@ from . import linalg
 from .driven_chain import discretize
 from .filters import lowpass_pole
 from .linalg import Matrix
+from .riccati import solve_doubling
 
 #: Discretizations kept for distinct step sizes (a variable-step master may use a few).
 CACHE_SIZE = 8
@@ -85,8 +86,8 @@ def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Mat
     """Prior covariance P of the steady-state Kalman filter with a scalar measurement
     of the last state: ``P = F (P − P hᵀ h P / (h P hᵀ + r)) Fᵀ + Q``, h = [0 … 0 1].
 
-    Structure-preserving doubling (Chu, Fan & Lin 2005): quadratic convergence, so a
-    few tens of iterations even for modes that ring for minutes.
+    Structure-preserving doubling (:func:`~arcosim.fmu.flexchain.riccati.solve_doubling`):
+    quadratic convergence, so a few tens of iterations even for modes that ring for minutes.
 
     Parameters
     ----------
@@ -110,25 +111,12 @@ def filter_riccati(F: Matrix, Q: Matrix, r: float, iterations: int = 100) -> Mat
         If the iteration does not converge (or meets a singular matrix).
     """
     m = len(F)
-    A = linalg.transpose(F)
     G = linalg.zeros(m, m)
     G[m - 1][m - 1] = 1.0 / r
-    H = [row[:] for row in Q]
-    eye = linalg.identity(m)
-    for _ in range(iterations):
-        W = linalg.add(eye, linalg.matmul(G, H))
-        both = linalg.solve(W, [ra + rg for ra, rg in zip(A, G)])
-        WA = [row[:m] for row in both]
-        WG = [row[m:] for row in both]
-        At = linalg.transpose(A)
-        H_next = linalg.add(H, linalg.matmul(At, linalg.matmul(H, WA)))
-        G = linalg.add(G, linalg.matmul(linalg.matmul(A, WG), At))
-        A = linalg.matmul(A, WA)
-        change = linalg.norm_inf(linalg.add(H_next, H, -1.0))
-        H = H_next
-        if change <= 1e-13 * max(linalg.norm_inf(H), 1e-300):
-            return [[0.5 * (H[i][j] + H[j][i]) for j in range(m)] for i in range(m)]
-    raise ValueError("the Kalman gain's Riccati iteration did not converge")
+    try:
+        return solve_doubling(linalg.transpose(F), G, Q, iterations)
+    except ValueError:
+        raise ValueError("the Kalman gain's Riccati iteration did not converge") from None
 
 
 def theta_noise_covariance(Gamma: Matrix, theta_noise_std: float, h: float) -> Matrix:

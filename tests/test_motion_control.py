@@ -1,0 +1,129 @@
+"""The motion and vibration controller's design and its closed loop on the reference plant.
+
+The design (pure Python) is checked against scipy; the closed loops run the Python
+reference plant (exact over each step, Coulomb friction with sticking) read by the plant
+FMU's sensors (``tests/control_runs.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from arcosim.fmu.flexchain.control_design import (
+    DECAY_RATIO,
+    design_controller,
+    goals,
+    hold_discretize,
+    plant_matrices,
+    regulator_gain,
+)
+from arcosim.fmu.flexchain.motion_control import shaped_step
+from arcosim.fmu.flexchain.riccati import solve_doubling
+from tests.control_runs import ACTUATOR, BENCH_2, FIVE, closed_loop, observer_params
+
+H = 1e-3
+COUNT = 2 * math.pi / 2000  # one encoder count (rad)
+
+
+def _true_loop(design, chain: dict) -> np.ndarray:
+    """``F − g K`` of the plant ``chain`` under the design's gain (full state)."""
+    A, b = plant_matrices(
+        ACTUATOR["J_m"], ACTUATOR["k_t"], ACTUATOR["D_m"], chain["J"], chain["k"], chain["B"]
+    )
+    F, g = hold_discretize(A, b, H)
+    return np.array(F) - np.outer(g, design.K)
+
+
+def test_doubling_solves_the_regulators_riccati_equation_as_scipy_does() -> None:
+    design = design_controller(observer_params(**FIVE), h=H)
+    rng = np.random.default_rng(3)
+    M = rng.standard_normal((6, 6))
+    Q = M @ M.T
+    F = np.array(design.F)[:6, :6]
+    g = np.array(design.g)[:6]
+    K = regulator_gain(F.tolist(), g.tolist(), Q.tolist(), 2.0)
+    X = scipy.linalg.solve_discrete_are(F, g[:, None], Q, np.array([[2.0]]))
+    K_ref = (g @ X @ F) / (2.0 + g @ X @ g)
+    assert np.allclose(K, K_ref, rtol=1e-8, atol=1e-12)
+    assert solve_doubling([[1.0]], [[1.0]], [[1.0]])[0][0] == pytest.approx((1 + 5**0.5) / 2)
+
+
+@pytest.mark.parametrize("chain", [BENCH_2, FIVE], ids=["bench two-mass", "five-mass"])
+def test_every_pole_decays_at_the_prescribed_rate(chain: dict) -> None:
+    """The shifted regulator: every closed-loop pole, each flexible mode's included,
+    inside the circle of radius e^(−α h), α = DECAY_RATIO · ω_c."""
+    design = design_controller(observer_params(**chain), h=H)
+    poles = np.linalg.eigvals(_true_loop(design, chain))
+    alpha = DECAY_RATIO * design.bandwidth
+    assert np.abs(poles).max() <= math.exp(-alpha * H) * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("chain", [BENCH_2, FIVE], ids=["bench two-mass", "five-mass"])
+def test_the_gain_stabilizes_every_chain_within_ten_percent(chain: dict) -> None:
+    """Every J_i, k_i scaled by independent factors in [0.9, 1.1] (20 seeds) and the two
+    corners: the full-state loop with the nominal gain stays stable, and no flexible mode
+    loses more than half its designed decay rate."""
+    design = design_controller(observer_params(**chain), h=H)
+    n = len(chain["J"])
+    rng = np.random.default_rng(29)
+    factors = [rng.uniform(0.9, 1.1, (2, n)) for _ in range(20)]
+    factors += [np.array([[1.1] * n, [0.9] * n]), np.array([[0.9] * n, [1.1] * n])]
+    worst = 0.0
+    for fj, fk in factors:
+        plant = dict(chain, J=tuple(np.array(chain["J"]) * fj), k=tuple(np.array(chain["k"]) * fk))
+        worst = max(worst, np.abs(np.linalg.eigvals(_true_loop(design, plant))).max())
+    assert worst < math.exp(-0.5 * DECAY_RATIO * design.bandwidth * H)
+
+
+def test_move_time_and_bandwidth_exactly_one() -> None:
+    assert goals(1.0, 0.0) == (1.0, 8.0)
+    assert goals(0.0, 4.0) == (2.0, 4.0)
+    for bad in ((1.0, 4.0), (0.0, 0.0), (-1.0, 0.0), (math.inf, 0.0)):
+        with pytest.raises(ValueError, match=r"move_time .* and bandwidth"):
+            goals(*bad)
+    with pytest.raises(ValueError, match="control_mass = 3"):
+        design_controller(observer_params(**BENCH_2), h=H, control_mass=3)
+
+
+def test_the_shaped_step_is_smooth_and_ends_at_rest() -> None:
+    tau = np.linspace(0.0, 1.0, 2001)
+    values = np.array([shaped_step(t) for t in tau])
+    assert values[0].tolist() == [0.0, 0.0, 0.0] and values[-1].tolist() == [1.0, 0.0, 0.0]
+    assert np.all(np.diff(values[:, 0]) >= 0)
+    # the derivatives are the value's (central differences)
+    d = np.gradient(values[:, 0], tau)
+    assert np.allclose(d[1:-1], values[1:-1, 1], atol=1e-4)
+
+
+def _check_move(run, target: float = 1.0) -> None:
+    """A 1 rad move of the last mass: inside ±1 % by 2.5 s and staying there, the motor
+    still within two counts over the last 2 s."""
+    assert run.settling_time(target, 0.01 * target) <= 2.5
+    tail = run.time >= run.time[-1] - 2.0
+    assert np.ptp(run.theta_m[tail]) <= 2 * COUNT + 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("delay", [0, 1], ids=["sequential", "parallel master"])
+def test_a_bench_move_settles_sensorless(delay: int) -> None:
+    run = closed_loop(BENCH_2, delay=delay)
+    _check_move(run)
+    assert run.residual_rms(1.0) <= 2e-3
+
+
+@pytest.mark.slow
+def test_a_five_mass_move_settles_sensorless() -> None:
+    run = closed_loop(FIVE)
+    _check_move(run)
+    assert run.residual_rms(1.0) <= 2e-3
+
+
+@pytest.mark.slow
+def test_the_full_state_upper_bound_settles_faster() -> None:
+    run = closed_loop(BENCH_2, full_state=True)
+    assert run.settling_time(1.0, 0.005) <= 1.5
+    assert run.residual_rms(1.0) <= 2e-4
