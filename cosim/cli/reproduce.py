@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from arcosim.cli.options import add_command, add_fmus_option, tool_names_option
+from arcosim.experiments import motion_findings as motion
 from arcosim.experiments.findings import (
     LOAD_HEADER,
     TABLE_II_HEADER,
@@ -39,11 +40,12 @@ def add_parser(
     p = add_command(
         subparsers,
         "reproduce",
-        summary="run the paper's three experiments and two beyond them, write the report",
+        summary="run the paper's three experiments and three beyond them, write the report",
         description="""
 Run the paper's three experiments (the actuator's self-identification, Table II's
-rigid maneuvers, the state estimation by the recursion) and two beyond them (the
-whole chain from the motor alone, the load torque), print their tables and write
+rigid maneuvers, the state estimation by the recursion) and three beyond them (the
+whole chain from the motor alone, the load torque, motion control from the motor
+alone), print their tables and write
 report.md, the figures (PNG) and the runs as CSV into --out. By default one run per
 maneuver (selfid, rigid_seed1, flexible, identification, load_true_chain), each its
 log only (time, i_a, omega_m, theta_m: what arcosim identify reads; about 7 MB in
@@ -99,6 +101,12 @@ def _execute(args: argparse.Namespace) -> int:
     print("\n5. Load torque on mass 3 from the motor alone, % of the step")
     print(text_table(LOAD_HEADER, load_rows(results)))
     print(text_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results)))
+    print(f"\n{motion.NUMBER}. A 1 rad move of the last mass by four controllers")
+    print(text_table(motion.MOVE_HEADER, motion.move_rows(results.motion)))
+    print("the same with a load-torque step on the last mass during the hold")
+    print(text_table(motion.LOAD_HEADER, motion.load_rows(results.motion)))
+    print("the sensorless controller with model errors, against issue 29's Done-when criteria")
+    print(text_table(motion.ERROR_HEADER, motion.error_rows(results.motion)))
     print(
         f"\nwrote {args.out / 'report.md'} and {len(results.files) - 1} more files "
         f"in {time.perf_counter() - start:.0f} s"

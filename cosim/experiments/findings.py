@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.experiments.metrics import percent_error
+from arcosim.experiments.motion_findings import MotionResults, motion_markdown
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import LOAD_PROFILE
@@ -60,6 +61,8 @@ class Results:
         the step), ``sine_amplitude_ratio`` (dimensionless), ``sine_lag_s`` (s)).
     load_angles : dict of str to list of float
         Experiment 5: the angle score per mass per observer (dimensionless).
+    motion : dict of str to ChainFindings
+        Experiment 6: the moves by chain (:mod:`arcosim.experiments.motion_findings`).
     files : list of Path
         Every file written, ``report.md`` last.
     """
@@ -73,6 +76,7 @@ class Results:
     whole_scores: list[float] = field(default_factory=list)
     load: dict[str, dict[str, float]] = field(default_factory=dict)
     load_angles: dict[str, list[float]] = field(default_factory=dict)
+    motion: MotionResults = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
 
 
@@ -353,4 +357,4 @@ torque state, whose static deflections the unmodelled torque leaves wrong):
 {markdown_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results))}
 
 ![Fig. 8](fig8_load_torque.png)
-"""
+""" + motion_markdown(results.motion)

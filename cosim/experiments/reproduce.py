@@ -14,7 +14,11 @@
    torque, then a 2 rad/s sine) during the broadband maneuver, estimated from the motor
    alone (model-based observer with ``load_mass = 3``), with the true chain and with
    experiment 4's chain: settling time, settled error, lag of the sine (scenario
-   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8.
+   ``load-torque``, :mod:`arcosim.identification.load_torque`) → Fig. 8;
+6. beyond the paper: a 1 rad move of the last mass on the bench and a five-mass chain,
+   each identified by ``identify_drive``, by a drive's cascade, the cascade with input
+   shaping, the sensorless controller and its full-state upper bound, a load-torque
+   step and model errors (:mod:`arcosim.experiments.motion_experiment`) → Fig. 9.
 
 :func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
 ``arcosim reproduce`` is the command line.
@@ -39,6 +43,8 @@ from arcosim.experiments.findings import (
 )
 from arcosim.experiments.load_scores import score_profile
 from arcosim.experiments.metrics import flexible_score
+from arcosim.experiments.motion_experiment import motion_control, motion_steps
+from arcosim.experiments.motion_findings import FIGURE as MOTION_FIGURE
 from arcosim.experiments.reproduce_figures import (
     load_torque_figure,
     paper_figures,
@@ -80,6 +86,7 @@ OUTPUTS = (
     "fig6_state_estimates.png",
     "fig7_whole_chain.png",
     "fig8_load_torque.png",
+    MOTION_FIGURE,
     "report.md",
 )
 
@@ -93,7 +100,7 @@ def reproduce(
     all_csv: bool = False,
     tool_names: bool = False,
 ) -> Results:
-    """Run the five experiments, write CSVs, figures and ``report.md`` into ``out``.
+    """Run the six experiments, write CSVs, figures and ``report.md`` into ``out``.
 
     Parameters
     ----------
@@ -154,19 +161,22 @@ def reproduce(
         results.files += paper_figures(out, rigid, flexible, results, k_mean, b_mean, estimated)
         if estimated is not None:
             results.files.append(whole_chain_figure(out, identification, results))
+        results.motion, figure = motion_control(out, folder, ideal, bar.set_postfix_str, bar.update)
+        results.files.append(figure)
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
     return results
 
 
 def _total_steps() -> int:
-    """The co-simulation steps of the five experiments, for the progress bar (a count)."""
+    """The co-simulation steps of the six experiments, for the progress bar (a count)."""
     return (
         round(SCENARIOS["selfid"].duration / STEP)
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
         + 2 * round(SCENARIOS["flexible"].duration / STEP)
         + round(SCENARIOS["identification"].duration / STEP)
         + 2 * round(LOAD_PROFILE.duration / STEP)
+        + motion_steps()
     )
 
 
