@@ -12,6 +12,11 @@ reproduce        -- the five experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
 reproduce_figures -- Figs. 4–8 from the runs and what they found
 report           -- the figures drawn, and tables as Markdown or text
+closed_loop      -- the plant FMU with a Python controller in the loop (sequential, zero delay)
+motion_baselines -- a drive's cascade tuned out of the box, and input shapers (ZV, ZVD)
+motion_metrics   -- how a move is scored (settling, residual, peak current, limit cycle)
+motion_experiment -- experiment 6: a move of the last mass by four controllers, Fig. 9
+motion_findings  -- its setup, scores, the issue's Done-when check, tables and report text
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """
