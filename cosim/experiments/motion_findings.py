@@ -241,7 +241,7 @@ def move_rows(results: MotionResults) -> list[list[str]]:
                     _seconds(s.settle_05),
                     f"{1e3 * s.residual:.2f}",
                     f"{s.peak_current:.3f}",
-                    f"{s.limit_cycle:g}",
+                    f"{s.limit_cycle:.3g}",
                 ]
             )
     return rows
@@ -269,7 +269,7 @@ def load_rows(results: MotionResults) -> list[list[str]]:
                     f"{1e3 * s.peak:.2f}",
                     f"{1e3 * s.held:+.2f}",
                     _seconds(s.recovery),
-                    f"{s.limit_cycle:g}",
+                    f"{s.limit_cycle:.3g}",
                 ]
             )
     return rows
@@ -302,7 +302,7 @@ def error_rows(results: MotionResults) -> list[list[str]]:
                     _seconds(sensorless.settle_1),
                     _seconds(upper.settle_1),
                     f"{1e3 * sensorless.residual:.2f}",
-                    f"{sensorless.limit_cycle:g}",
+                    f"{sensorless.limit_cycle:.3g}",
                     f"{sum(met.values())}/4"
                     + (
                         ""
