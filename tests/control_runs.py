@@ -140,3 +140,7 @@ def closed_loop(
     return Run(
         a[:, 0], a[:, 1 : n + 2], a[:, n + 2], a[:, n + 3], a[:, n + 4], a[:, n + 5], a[:, n + 6]
     )
+
+
+#: The paper's bench (n = 3, the FMUs' defaults): clamped modes 7.5, 21.5, 31.8 rad/s.
+BENCH_3 = dict(J=tuple(defaults.J), k=(defaults.K,) * 3, B=(defaults.B,) * 3)

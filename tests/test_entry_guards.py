@@ -110,7 +110,10 @@ def _call(lib: ctypes.CDLL, name: str, component, calls: dict) -> int:
     return function(component, *args)
 
 
-@pytest.mark.parametrize("name", ["MotorChainPlant", "ReactionTorqueObserver", "ExcitationSource"])
+@pytest.mark.parametrize(
+    "name",
+    ["MotorChainPlant", "ReactionTorqueObserver", "ExcitationSource", "ActionReactionController"],
+)
 def test_a_null_instance_is_refused_by_every_entry(fmus, tmp_path, name) -> None:
     lib, _, variables = _binary(fmus / f"{name}.fmu", tmp_path)
     calls = _calls(variables)

@@ -42,6 +42,7 @@ CASES = [
     ("ReactionTorqueObserver", {"mode": 2, "estimator": 1, "load_mass": 3}),
     ("ExcitationSource", {"signal": 3}),
     ("ExcitationSource", {"signal": 1}),
+    ("ActionReactionController", {}),
 ]
 
 

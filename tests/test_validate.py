@@ -47,4 +47,4 @@ def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> Non
     build_fmus(3)
     assert main(["validate"]) == 0
     out = capsys.readouterr().out
-    assert out.count(": OK") == 3 and str(build_fmus(3)) in out
+    assert out.count(": OK") == 4 and str(build_fmus(3)) in out

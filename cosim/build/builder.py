@@ -30,7 +30,7 @@ from arcosim.build.cache import (
     source_digest,
 )
 from arcosim.build.portable import make_portable, slave_class
-from arcosim.build.recipes import RECIPES, SSP_NAME, FmuRecipe, check_masses
+from arcosim.build.recipes import CONTROL_SSP_NAME, RECIPES, SSP_NAME, FmuRecipe, check_masses
 from arcosim.errors import BuildError
 from arcosim.version import __version__
 
@@ -144,13 +144,22 @@ def build_locked(n: int, target: Path) -> list[Path]:
     BuildError
         When a file cannot be written, or a built file is not a complete FMU.
     """
-    from arcosim.build.ssp import write_ssp
+    from arcosim.build.ssp import MOTION_CONTROL, motion_control_sets, write_ssp
 
     stamp = target / DIGEST_FILE
     try:
         stamp.unlink(missing_ok=True)
         built = [build_fmu(recipe, n, target) for recipe in RECIPES]
         built.append(write_ssp(target / SSP_NAME, target))
+        built.append(
+            write_ssp(
+                target / CONTROL_SSP_NAME,
+                target,
+                motion_control_sets(n),
+                stop=6.0,
+                layout=MOTION_CONTROL,
+            )
+        )
         problems = [p for p in map(fmu_problem, built) if p is not None]
         if problems:
             raise BuildError(f"the build into {target} left a broken file: {problems[0]}")

@@ -25,7 +25,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from xml.etree import ElementTree
 
-from arcosim.build.recipes import RECIPES, SSP_NAME, check_masses
+from arcosim.build.recipes import CONTROL_SSP_NAME, RECIPES, SSP_NAME, check_masses
 from arcosim.errors import BuildError
 from arcosim.version import __version__
 
@@ -151,4 +151,5 @@ def is_current(folder: Path, n: int) -> bool:
     except OSError:
         return False
     wanted = [folder / r.file_name for r in RECIPES] + [folder / SSP_NAME]
+    wanted.append(folder / CONTROL_SSP_NAME)
     return all(fmu_problem(path) is None for path in wanted)

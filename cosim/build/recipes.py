@@ -56,9 +56,16 @@ OBSERVER = FmuRecipe(
 SOURCE = FmuRecipe(
     "ExcitationSource", "arsource.fmu:ExcitationSource", ("fmukit", "flexchain", "arsource")
 )
-RECIPES = (PLANT, OBSERVER, SOURCE)
+CONTROLLER = FmuRecipe(
+    "ActionReactionController",
+    "arcontroller.fmu:ActionReactionController",
+    ("fmukit", "flexchain", "arcontroller"),
+)
+RECIPES = (PLANT, OBSERVER, SOURCE, CONTROLLER)
 #: The SSP system of the three FMUs, written beside them.
 SSP_NAME = "ActionReaction.ssp"
+#: The closed loop of the controller and the plant, written beside them.
+CONTROL_SSP_NAME = "MotionControl.ssp"
 
 
 def check_masses(n: int) -> int:

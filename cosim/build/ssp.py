@@ -1,6 +1,7 @@
-"""Write the SSP 1.0 system source → plant → observer (``ActionReaction.ssp``).
+"""Write the SSP 1.0 systems: source → plant → observer (``ActionReaction.ssp``) and the
+closed loop controller → plant → controller (``MotionControl.ssp``).
 
-:func:`write_ssp` packs the three FMUs with ``SystemStructure.ssd`` (components,
+:func:`write_ssp` packs a system's FMUs with ``SystemStructure.ssd`` (components,
 connectors, connections, a DefaultExperiment, parameter sets bound inline per
 component, as ecos reads them, and OMSimulator's annotation of the system: its type,
 a fixed-step master, without which OMSimulator cannot open a valid SSP 1.0 file).
@@ -12,6 +13,7 @@ from __future__ import annotations
 import os
 import zipfile
 from collections.abc import Mapping
+from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 from xml.etree import ElementTree
@@ -60,6 +62,71 @@ BENCH = {
 }
 
 
+@dataclass(frozen=True)
+class SspLayout:
+    """One system: its name, a line saying what it does, components and connections.
+
+    Parameters
+    ----------
+    name : str
+        The system's name (``ssd:System``'s and the file's).
+    description : str
+        One line.
+    components : tuple of (str, str)
+        ``(component, FMU file stem)``.
+    connections : tuple of (str, str, str, str)
+        ``(start component, connector, end component, connector)``.
+    sets : dict
+        The parameter sets written when the caller gives none: set → component →
+        variable → start value (in the variable's unit).
+    """
+
+    name: str
+    description: str
+    components: tuple[tuple[str, str], ...]
+    connections: tuple[tuple[str, str, str, str], ...]
+    sets: Mapping[str, Mapping[str, Mapping[str, float | int | bool | str]]]
+
+
+ACTION_REACTION = SspLayout(
+    "ActionReaction",
+    "current source -> motor-chain plant -> action-reaction observer",
+    COMPONENTS,
+    CONNECTIONS,
+    {"bench": BENCH},
+)
+#: The closed loop: the plant's sensors feed the controller, its i_ref the plant; the
+#: target is the controller's input theta_ref, bound by the parameter set (a step at t0).
+MOTION_CONTROL = SspLayout(
+    "MotionControl",
+    "target -> sensorless motion controller -> motor-chain plant -> controller",
+    (("controller", "ActionReactionController"), ("plant", "MotorChainPlant")),
+    (
+        ("controller", "i_ref", "plant", "i_ref"),
+        ("plant", "i_a", "controller", "i_a"),
+        ("plant", "omega_m", "controller", "omega_m"),
+        ("plant", "theta_m", "controller", "theta_m"),
+    ),
+    {},
+)
+#: The load torque of the move-load set (N·m on the last mass, pulling back).
+LOAD_TORQUE = -5e-3
+
+
+def motion_control_sets(n: int) -> dict[str, dict[str, dict[str, float | int]]]:
+    """The closed loop's parameter sets for ``n`` load masses: ``move`` (a 1 rad step of
+    the last mass's target at t0, the bench's sensors) and ``move-load`` (the same
+    against a constant :data:`LOAD_TORQUE` on the last mass)."""
+    plant = {"encoder_cpr": ENCODER_CPR, "i_noise_std": I_NOISE_STD, "seed": 1}
+    return {
+        "move": {"controller": {"theta_ref": 1.0}, "plant": plant},
+        "move-load": {
+            "controller": {"theta_ref": 1.0},
+            "plant": {**plant, f"tau_ext[{n}]": LOAD_TORQUE},
+        },
+    }
+
+
 def write_ssp(
     path: Path,
     fmu_dir: Path,
@@ -67,28 +134,23 @@ def write_ssp(
     | None = None,
     stop: float = 10.0,
     step: float = 1e-3,
+    layout: SspLayout = ACTION_REACTION,
 ) -> Path:
-    """Pack the three FMUs of ``fmu_dir`` into an SSP at ``path``; return it.
+    """Pack the FMUs of ``layout`` from ``fmu_dir`` into an SSP at ``path``; return it.
 
     ``stop`` (s) goes into the DefaultExperiment, ``step`` (s) into OMSimulator's
-    fixed-step master (SSP 1.0 has no place for a step).
+    fixed-step master (SSP 1.0 has no place for a step); ``parameter_sets`` replace the
+    layout's own.
     """
-    sets = {"bench": BENCH} if parameter_sets is None else parameter_sets
+    sets = layout.sets if parameter_sets is None else parameter_sets
     for prefix, uri in NS.items():
         ElementTree.register_namespace(prefix, uri)
-    root = Element(
-        f"{{{SSD}}}SystemStructureDescription", {"version": "1.0", "name": "ActionReaction"}
-    )
+    root = Element(f"{{{SSD}}}SystemStructureDescription", {"version": "1.0", "name": layout.name})
     system = SubElement(
-        root,
-        f"{{{SSD}}}System",
-        {
-            "name": "ActionReaction",
-            "description": "current source -> motor-chain plant -> action-reaction observer",
-        },
+        root, f"{{{SSD}}}System", {"name": layout.name, "description": layout.description}
     )
     elements = SubElement(system, f"{{{SSD}}}Elements")
-    for name, stem in COMPONENTS:
+    for name, stem in layout.components:
         component = SubElement(
             elements,
             f"{{{SSD}}}Component",
@@ -99,7 +161,7 @@ def write_ssp(
             },
         )
         connectors = SubElement(component, f"{{{SSD}}}Connectors")
-        for a, ca, b, cb in CONNECTIONS:
+        for a, ca, b, cb in layout.connections:
             for element, connector, kind in ((a, ca, "output"), (b, cb, "input")):
                 if element == name:
                     c = SubElement(
@@ -119,7 +181,7 @@ def write_ssp(
                 p = SubElement(parameters, f"{{{SSV}}}Parameter", {"name": pname})
                 SubElement(p, f"{{{SSV}}}{type_of(value)}", {"value": _text(value)})
     connections = SubElement(system, f"{{{SSD}}}Connections")
-    for a, ca, b, cb in CONNECTIONS:
+    for a, ca, b, cb in layout.connections:
         SubElement(
             connections,
             f"{{{SSD}}}Connection",
@@ -136,7 +198,7 @@ def write_ssp(
             "SystemStructure.ssd",
             ElementTree.tostring(root, xml_declaration=True, encoding="UTF-8"),
         )
-        for _, stem in COMPONENTS:
+        for _, stem in layout.components:
             z.write(fmu_dir / f"{stem}.fmu", f"resources/{stem}.fmu")
     partial.replace(path)
     return path

@@ -6,7 +6,10 @@
 
 The CSV holds ``time``, the measured ``i_a``, ``omega_m``, ``theta_m`` (so it is a
 log that ``arcosim identify`` accepts) and every recorded signal as
-``plant.<name>`` / ``observer.<name>``. An existing ``--out`` file is replaced only
+``plant.<name>`` / ``observer.<name>``. The closed-loop scenarios ``move`` and
+``move-load`` run the controller FMU with the plant instead (``--set controller.NAME=…``;
+``--ordering gauss-seidel`` is the sequential master, ``jacobi`` the parallel one, a
+step late) and print how the move went. An existing ``--out`` file is replaced only
 with ``--force``, and never with one of the FMUs the run reads.
 
 The run is refused (exit 2) when its step and duration give no step or more than
@@ -42,6 +45,11 @@ from arcosim.cli.options import (
     whole_number,
 )
 from arcosim.errors import UserError
+from arcosim.experiments.control_scenarios import (
+    CONTROL_SCENARIOS,
+    move_summary,
+    run_control_scenario,
+)
 from arcosim.experiments.scenarios import (
     IDEAL_SENSORS,
     SCENARIOS,
@@ -70,7 +78,9 @@ omega_m, theta_m, then every recorded signal).""",
 arcosim simulate --scenario identification --out identification.csv
 arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --json""",
     )
-    names = ", ".join(f"{s.name} ({s.description})" for s in SCENARIOS.values())
+    names = ", ".join(
+        f"{s.name} ({s.description})" for s in (*SCENARIOS.values(), *CONTROL_SCENARIOS.values())
+    )
     p.add_argument("--scenario", default="flexible", help=f"one of: {names}")
     p.add_argument(
         "--masses",
@@ -84,7 +94,7 @@ arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --jso
         action="append",
         default=[],
         metavar="FMU.NAME=VALUE",
-        help="parameter of plant or observer, repeatable",
+        help="parameter of plant or observer (controller in move, move-load), repeatable",
     )
     p.add_argument(
         "--ideal", action="store_true", help="ideal sensors: exact angle, true velocity, no noise"
@@ -107,8 +117,11 @@ arcosim simulate --masses 2 --set plant.k[1]=0.5 --set observer.g_dist=200 --jso
 
 
 def _execute(args: argparse.Namespace) -> int:
+    if args.scenario in CONTROL_SCENARIOS:
+        return _execute_control(args)
     if args.scenario not in SCENARIOS:
-        raise UserError(f"--scenario {args.scenario!r}: use one of {', '.join(SCENARIOS)}")
+        known = ", ".join([*SCENARIOS, *CONTROL_SCENARIOS])
+        raise UserError(f"--scenario {args.scenario!r}: use one of {known}")
     scenario = SCENARIOS[args.scenario]
     if args.duration is not None:
         scenario = dataclasses.replace(scenario, duration=args.duration)
@@ -156,6 +169,52 @@ def _execute(args: argparse.Namespace) -> int:
         for key, value in final.items():
             if value:
                 print(f"  observer.{key:22s} {value:.6g}")
+        if args.out:
+            print(f"wrote {args.out}")
+    return 0
+
+
+def _execute_control(args: argparse.Namespace) -> int:
+    """``simulate`` for a closed-loop scenario: controller and plant FMUs."""
+    from fmpy import read_model_description  # deferred, as fmu_variables does
+
+    scenario = CONTROL_SCENARIOS[args.scenario]
+    if args.duration is not None:
+        scenario = dataclasses.replace(scenario, duration=args.duration)
+    check_steps("--step", scenario.duration, args.step)
+    n = args.masses
+    if args.out:
+        check_output(args.out, force=args.force, inputs=fmu_inputs(args.fmus) if args.fmus else ())
+    folder = fmu_folder(args, n)
+    if args.out:
+        check_output(args.out, force=args.force, inputs=fmu_inputs(folder))
+    variables = {
+        prefix: {v.name: v for v in read_model_description(str(folder / stem)).modelVariables}
+        for prefix, stem in (
+            ("plant", "MotorChainPlant.fmu"),
+            ("controller", "ActionReactionController.fmu"),
+        )
+    }
+    overrides = split_overrides(args.set, variables)
+    plant = {**(IDEAL_SENSORS if args.ideal else {}), **overrides["plant"]}
+    controller = {**({"encoder_cpr": 0} if args.ideal else {}), **overrides["controller"]}
+    ordering = "sequential" if args.ordering == "gauss-seidel" else "parallel"
+    recording = run_control_scenario(scenario, n, folder, plant, controller, args.step, ordering)
+    if args.out:
+        write_csv(
+            args.out,
+            recording_columns(recording),
+            units=recording.units,
+            tool_names=args.tool_names,
+            force=args.force,
+        )
+    summary = move_summary(recording, n, scenario.target)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"{scenario.name}: {len(recording.time) - 1} steps of {args.step:g} s ({ordering})")
+        for key, value in summary.items():
+            print(f"  {key:16s} {value:.6g}")
         if args.out:
             print(f"wrote {args.out}")
     return 0

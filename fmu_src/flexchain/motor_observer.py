@@ -74,6 +74,8 @@ class MotorObserver:
         ω_o (rad/s).
     """
 
+    _transient = ("_models",)  # derived from the settings; rebuilt after an FMU state restore
+
     def __init__(self, design: ControllerDesign, bandwidth: float) -> None:
         self.design = design
         self.bandwidth = bandwidth
