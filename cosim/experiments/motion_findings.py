@@ -223,6 +223,11 @@ MOVE_HEADER = [
 ]
 
 
+def _counts(value: float) -> str:
+    """Encoder counts for a table: whole as they are, fractions (ideal sensors) to 0.01."""
+    return f"{value:.0f}" if value == round(value) else f"{value:.2f}"
+
+
 def _seconds(value: float) -> str:
     return "never" if math.isinf(value) else f"{value:.2f}"
 
@@ -241,7 +246,7 @@ def move_rows(results: MotionResults) -> list[list[str]]:
                     _seconds(s.settle_05),
                     f"{1e3 * s.residual:.2f}",
                     f"{s.peak_current:.3f}",
-                    f"{s.limit_cycle:.3g}",
+                    _counts(s.limit_cycle),
                 ]
             )
     return rows
@@ -269,7 +274,7 @@ def load_rows(results: MotionResults) -> list[list[str]]:
                     f"{1e3 * s.peak:.2f}",
                     f"{1e3 * s.held:+.2f}",
                     _seconds(s.recovery),
-                    f"{s.limit_cycle:.3g}",
+                    _counts(s.limit_cycle),
                 ]
             )
     return rows
@@ -302,7 +307,7 @@ def error_rows(results: MotionResults) -> list[list[str]]:
                     _seconds(sensorless.settle_1),
                     _seconds(upper.settle_1),
                     f"{1e3 * sensorless.residual:.2f}",
-                    f"{sensorless.limit_cycle:.3g}",
+                    _counts(sensorless.limit_cycle),
                     f"{sum(met.values())}/4"
                     + (
                         ""
