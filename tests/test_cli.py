@@ -121,6 +121,11 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         cells = rows[label]  # chain, settling, mean %, max %, ...
         assert cells[4] == "%" and cells[6] == "%", cells
         assert float(cells[5]) < limit, cells
+    # experiment 6: the four controllers on both chains, twice (the move, the load step)
+    assert (out / "fig9_motion_control.png").stat().st_size > 20_000
+    assert "## 6. Beyond the paper: moving the last mass" in report
+    for name in ("cascade + ZV shaping", "full state (upper bound)"):
+        assert sum(name in line for line in result.stdout.splitlines()) == 4, name
 
 
 @pytest.mark.slow
