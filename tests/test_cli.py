@@ -125,6 +125,11 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     # experiment 6: the flexible link (its numbers: tests/test_flexible_link_experiment.py)
     assert "6. Flexible link from the hub alone" in result.stdout
     assert "clamped mode 2 (rad/s)" in report and "fig9_flexible_link.png" in report
+    # experiment 7: the four controllers on both chains, twice (the move, the load step)
+    assert (out / "fig10_motion_control.png").stat().st_size > 20_000
+    assert "## 7. Beyond the paper: moving the last mass" in report
+    for name in ("cascade + ZV shaping", "full state (upper bound)"):
+        assert sum(name in line for line in result.stdout.splitlines()) == 4, name
 
 
 @pytest.mark.slow

@@ -47,4 +47,6 @@ def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> Non
     build_fmus(3)
     assert main(["validate"]) == 0
     out = capsys.readouterr().out
-    assert out.count(": OK") == 5 and str(build_fmus(3)) in out  # the link and the controller included
+    assert (
+        out.count(": OK") == 5 and str(build_fmus(3)) in out
+    )  # the link and the controller included

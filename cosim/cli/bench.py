@@ -1,4 +1,4 @@
-"""``arcosim bench accuracy|speed [ARGS...]``: run a benchmark of a source checkout.
+"""``arcosim bench accuracy|speed|control [ARGS...]``: run a benchmark of a source checkout.
 
 The benchmarks live in the repository's ``benchmarks/`` folder (they are not part of
 the installed package); this command finds that folder from the current directory
@@ -16,7 +16,7 @@ from arcosim.cli.options import add_command
 from arcosim.errors import UserError
 
 #: Benchmark name → module of the ``benchmarks`` package.
-BENCHMARKS = {"accuracy": "accuracy", "speed": "speed"}
+BENCHMARKS = {"accuracy": "accuracy", "speed": "speed", "control": "control_accuracy"}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -24,7 +24,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p = add_command(
         subparsers,
         "bench",
-        summary="run a benchmark of the source checkout (accuracy, speed)",
+        summary="run a benchmark of the source checkout (accuracy, speed, control)",
         description="""
 Run one of the benchmarks in a source checkout's benchmarks/ folder (they are not
 part of the installed package): the folder is found from the current directory

@@ -1,5 +1,5 @@
 """``arcosim reproduce [--out DIR] [--ideal] [--all-csv] [--fmus DIR] [--force]``: the paper's
-experiments and three beyond them (:mod:`arcosim.experiments.reproduce`).
+experiments and four beyond them (:mod:`arcosim.experiments.reproduce`).
 
 Writes ``report.md``, the runs as CSV (one per maneuver, its log; ``--all-csv``: every
 run, every signal) and the PNG figures into ``--out`` (default ``reports/``), and prints
@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from arcosim.cli.options import add_command, add_fmus_option, tool_names_option
+from arcosim.experiments import motion_findings as motion
 from arcosim.experiments.findings import (
     LINK_HEADER,
     LOAD_HEADER,
@@ -41,14 +42,14 @@ def add_parser(
     p = add_command(
         subparsers,
         "reproduce",
-        summary="run the paper's three experiments and three beyond them, write the report",
+        summary="run the paper's three experiments and four beyond them, write the report",
         description="""
 Run the paper's three experiments (the actuator's self-identification, Table II's
-rigid maneuvers, the state estimation by the recursion) and three beyond them (the
-whole chain from the motor alone, the load torque, a flexible link from the hub alone),
-print their tables and write report.md, the figures (PNG) and the runs as CSV into
---out. By default one run per maneuver (selfid, rigid_seed1, flexible, identification,
-load_true_chain, flexible_link), each its
+rigid maneuvers, the state estimation by the recursion) and four beyond them (the
+whole chain from the motor alone, the load torque, a flexible link from the hub alone,
+motion control from the motor alone), print their tables and write report.md, the
+figures (PNG) and the runs as CSV into --out. By default one run per maneuver (selfid,
+rigid_seed1, flexible, identification, load_true_chain, flexible_link), each its
 log only (time, i_a, omega_m, theta_m: what arcosim identify reads; about 7 MB in
 all); --all-csv writes every run with every recorded signal (about 100 MB). Refuses a
 folder that already holds the report's files unless --force. Realistic sensors
@@ -104,6 +105,12 @@ def _execute(args: argparse.Namespace) -> int:
     print(text_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results)))
     print("\n6. Flexible link from the hub alone (FlexLinkPlant.fmu)")
     print(text_table(LINK_HEADER, link_rows(results)))
+    print(f"\n{motion.NUMBER}. A 1 rad move of the last mass by four controllers")
+    print(text_table(motion.MOVE_HEADER, motion.move_rows(results.motion)))
+    print("the same with a load-torque step on the last mass during the hold")
+    print(text_table(motion.LOAD_HEADER, motion.load_rows(results.motion)))
+    print("the sensorless controller with model errors, against issue 29's Done-when criteria")
+    print(text_table(motion.ERROR_HEADER, motion.error_rows(results.motion)))
     print(
         f"\nwrote {args.out / 'report.md'} and {len(results.files) - 1} more files "
         f"in {time.perf_counter() - start:.0f} s"

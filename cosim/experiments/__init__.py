@@ -9,10 +9,15 @@ paper            -- the paper's own Table II, in SI units
 metrics          -- how estimates are scored against the plant's truth
 load_scores      -- how a load torque estimate is scored (settling, settled error, lag)
 flexible_link    -- a flexible link on the link plant FMU: its run, the fit from the hub, scores
-reproduce        -- the six experiments, one function each (``reproduce``)
+reproduce        -- the seven experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
 reproduce_figures -- Figs. 4–9 from the runs and what they found
 report           -- the figures drawn, and tables as Markdown or text
+closed_loop      -- the plant FMU with a Python controller in the loop (sequential, zero delay)
+motion_baselines -- a drive's cascade tuned out of the box, and input shapers (ZV, ZVD)
+motion_metrics   -- how a move is scored (settling, residual, peak current, limit cycle)
+motion_experiment -- experiment 7: a move of the last mass by four controllers, Fig. 10
+motion_findings  -- its setup, scores, the issue's Done-when check, tables and report text
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """

@@ -1,4 +1,4 @@
-"""What the six experiments of :func:`arcosim.experiments.reproduce.reproduce` found, as
+"""What the seven experiments of :func:`arcosim.experiments.reproduce.reproduce` found, as
 tables (one header and a function of rows per table, shared by ``report.md`` and the
 text ``arcosim reproduce`` prints) and as ``report.md``'s text.
 """
@@ -14,6 +14,7 @@ import numpy as np
 from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
 from arcosim.experiments.flexible_link import EXPERIMENT_RIG, SETTLE
 from arcosim.experiments.metrics import percent_error
+from arcosim.experiments.motion_findings import MotionResults, motion_markdown
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import LOAD_PROFILE
@@ -36,7 +37,7 @@ TRUE_CHAIN = {
 
 @dataclass
 class Results:
-    """What the six experiments found (SI units).
+    """What the seven experiments found (SI units).
 
     Attributes
     ----------
@@ -65,6 +66,8 @@ class Results:
     link : dict of str to object
         Experiment 6: the flexible link from the hub alone
         (:meth:`arcosim.experiments.flexible_link.LinkFindings.as_dict`).
+    motion : dict of str to ChainFindings
+        Experiment 7: the moves by chain (:mod:`arcosim.experiments.motion_findings`).
     files : list of Path
         Every file written, ``report.md`` last.
     """
@@ -79,6 +82,7 @@ class Results:
     load: dict[str, dict[str, float]] = field(default_factory=dict)
     load_angles: dict[str, list[float]] = field(default_factory=dict)
     link: dict[str, object] = field(default_factory=dict)
+    motion: MotionResults = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
 
 
@@ -291,7 +295,7 @@ def _pct(value: float, truth: float) -> str:
 
 
 def report_markdown(results: Results, ideal: bool, k_mean: float, b_mean: float) -> str:
-    """``report.md``: the six experiments' setup, tables and figures.
+    """``report.md``: the seven experiments' setup, tables and figures.
 
     Parameters
     ----------
@@ -399,7 +403,8 @@ torque state, whose static deflections the unmodelled torque leaves wrong):
 
 ![Fig. 8](fig8_load_torque.png)
 
-{_link_section(results)}"""
+{_link_section(results)}
+""" + motion_markdown(results.motion)
 
 
 def _link_section(results: Results) -> str:

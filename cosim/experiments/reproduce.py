@@ -1,4 +1,4 @@
-"""The paper's three experiments on the bench, and three beyond it (``arcosim reproduce``).
+"""The paper's three experiments on the bench, and four beyond it (``arcosim reproduce``).
 
 1. actuator self-identification with the load detached (mode 0);
 2. five rigid maneuvers with different noise seeds (mode 1), with the actuator terms
@@ -18,6 +18,10 @@
 6. beyond the paper: a flexible link (the link plant FMU) identified from the hub's
    current and encoder alone — EI, ρA, the clamped modes, eq. 7's reaction torque and
    the tip angle against the plant's (:mod:`arcosim.experiments.flexible_link`) → Fig. 9.
+7. beyond the paper: a 1 rad move of the last mass on the bench and a five-mass chain,
+   each identified by ``identify_drive``, by a drive's cascade, the cascade with input
+   shaping, the sensorless controller and its full-state upper bound, a load-torque
+   step and model errors (:mod:`arcosim.experiments.motion_experiment`) → Fig. 10.
 
 :func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
 ``arcosim reproduce`` is the command line.
@@ -51,6 +55,8 @@ from arcosim.experiments.flexible_link import (
 )
 from arcosim.experiments.load_scores import score_profile
 from arcosim.experiments.metrics import flexible_score
+from arcosim.experiments.motion_experiment import motion_control, motion_steps
+from arcosim.experiments.motion_findings import FIGURE as MOTION_FIGURE
 from arcosim.experiments.reproduce_figures import (
     link_figure,
     load_torque_figure,
@@ -95,6 +101,7 @@ OUTPUTS = (
     "fig7_whole_chain.png",
     "fig8_load_torque.png",
     "fig9_flexible_link.png",
+    MOTION_FIGURE,
     "report.md",
 )
 
@@ -108,7 +115,7 @@ def reproduce(
     all_csv: bool = False,
     tool_names: bool = False,
 ) -> Results:
-    """Run the six experiments, write CSVs, figures and ``report.md`` into ``out``.
+    """Run the seven experiments, write CSVs, figures and ``report.md`` into ``out``.
 
     Parameters
     ----------
@@ -171,13 +178,15 @@ def reproduce(
         if estimated is not None:
             results.files.append(whole_chain_figure(out, identification, results))
         results.files.append(link_figure(out, *link))
+        results.motion, figure = motion_control(out, folder, ideal, bar.set_postfix_str, bar.update)
+        results.files.append(figure)
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
     return results
 
 
 def _total_steps() -> int:
-    """The co-simulation steps of the six experiments, for the progress bar (a count)."""
+    """The co-simulation steps of the seven experiments, for the progress bar (a count)."""
     return (
         round(SCENARIOS["selfid"].duration / STEP)
         + len(SEEDS) * round(SCENARIOS["rigid"].duration / STEP)
@@ -185,6 +194,7 @@ def _total_steps() -> int:
         + round(SCENARIOS["identification"].duration / STEP)
         + 2 * round(LOAD_PROFILE.duration / STEP)
         + round(LINK_DURATION / STEP)
+        + motion_steps()
     )
 
 

@@ -1,0 +1,196 @@
+"""Sensorless motion control against issue 29's Done-when criteria (``arcosim bench control``).
+
+Three chains of our own whose lowest mode is at least 10 rad/s (none of them the bench
+or the five-mass chain of ``arcosim reproduce``), realistic sensors (2000-count encoder,
+5 mA current noise), one plant noise seed per run. Per seed: the chain identified by
+``identify_drive`` from a 20 s log of the plant (the ``identification`` multi-sine), then
+a 1 rad move of the last mass in 6 s by the drive's cascade (the residual's reference)
+and by the sensorless controller and its full-state upper bound, each designed on
+
+- the identified chain,
+- the identified chain with every J_i and k_i scaled by independent uniform factors in
+  [0.9, 1.1] (numpy's generator seeded with the seed),
+- on the first seed only (they are deterministic, and the identified chains of the seeds
+  differ by about 0.1 %), the two corners: all J +10 % with all k −10 %, and the reverse.
+
+A seed passes a criterion when the sensorless move settles the last mass within ±1 % in
+≤ 2.5 s, leaves a residual ≤ max(0.1 × the cascade's, 1 mrad rms), settles within 1.3 ×
+the upper bound's time (same design) and holds no motor limit cycle over one count
+(:func:`arcosim.experiments.motion_findings.done_when`). Prints the pass counts per chain
+and model; writes ``control.md`` and ``control.json`` into ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from arcosim.build.builder import ensure_built
+from arcosim.errors import UserError
+from arcosim.experiments.motion_baselines import CascadeController, cascade_gains, chain_modes
+from arcosim.experiments.motion_experiment import (
+    MotionChain,
+    Runs,
+    design_parameters,
+    identify_chain,
+    model_errors,
+    scaled,
+    sensorless,
+)
+from arcosim.experiments.motion_findings import (
+    DISTANCE,
+    I_MAX,
+    MOVE_TIME,
+    MoveScore,
+    done_when,
+    score_move,
+)
+from arcosim.experiments.report import markdown_table
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.defaults import ENCODER_CPR
+
+#: The chains: lowest modes 19.7, 17.1 and 13.4 rad/s (motor free), damped at 0.05–0.2 %.
+CHAINS = (
+    MotionChain("two-mass, heavy tip", (5e-4, 1.5e-3), (0.3, 0.15), (1e-5, 1e-5)),
+    MotionChain("three-mass, soft middle", (4e-4, 3e-4, 8e-4), (0.3, 0.12, 0.25), (1e-5,) * 3),
+    MotionChain("four-mass, soft", (3e-4, 4e-4, 3e-4, 5e-4), (0.15, 0.12, 0.15, 0.1), (1e-5,) * 4),
+)
+#: The models per seed, in the table's order.
+MODELS = ("identified", "random errors", "J +10 %, k −10 %", "J −10 %, k +10 %")
+CRITERIA = ("settles", "residual", "near_bound", "no_limit_cycle")
+
+
+def score_seed(chain: MotionChain, folder: Path, seed: int, corners: bool) -> dict[str, dict]:
+    """One seed on one chain: every model's sensorless and upper-bound moves, and the
+    criteria; the corners only when ``corners``."""
+    params = design_parameters(identify_chain(folder, chain, False, seed), False)
+    runs = Runs(folder, chain, False, seed=seed)
+    cascade = _score(runs.run(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX)))
+    errors = model_errors(chain.n, (seed,))
+    models = {"identified": (np.ones(chain.n), np.ones(chain.n))}
+    models.update(list(zip(MODELS[1:], errors.values()))[: 3 if corners else 1])
+    out = {}
+    for label, (fJ, fk) in models.items():
+        wrong = scaled(params, fJ, fk)
+        moving = _score(runs.run(sensorless(wrong)))
+        upper = _score(runs.run(sensorless(wrong), full_state=True))
+        out[label] = {
+            "sensorless": moving.as_dict(),
+            "upper_bound": upper.as_dict(),
+            "cascade": cascade.as_dict(),
+            "criteria": done_when(moving, cascade, upper),
+        }
+    return out
+
+
+def _score(run) -> MoveScore:
+    return score_move(run, DISTANCE, DISTANCE, ENCODER_CPR)
+
+
+def run(
+    out: Path, seeds: Sequence[int], chains: Sequence[MotionChain], progress: Callable[[str], None]
+) -> dict[str, object]:
+    """Every chain over ``seeds``; the table, the per-seed results, the time (s)."""
+    started = time.perf_counter()
+    results: dict[str, dict] = {}
+    for chain in chains:
+        folder = ensure_built(chain.n)
+        modes = chain_modes({"J_mo": defaults.J_M, **chain.plant_values()})[0]
+        per_seed = {}
+        for seed in seeds:
+            progress(f"{chain.name}: seed {seed}")
+            per_seed[str(seed)] = score_seed(chain, folder, seed, corners=seed == seeds[0])
+        results[chain.name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
+    text = markdown(results)
+    summary = {"results": results, "seconds": time.perf_counter() - started}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "control.md").write_text(text, encoding="utf-8")
+    (out / "control.json").write_text(json.dumps(summary, indent=1, default=str), "utf-8")
+    return {"table": text, **summary}
+
+
+HEADER = [
+    "chain (lowest mode)",
+    "model",
+    "settles ≤ 2.5 s",
+    "residual",
+    "≤ 1.3 × bound",
+    "limit cycle ≤ 1",
+    "all four",
+    "±1 % settling: median, worst (s)",
+    "bound's median (s)",
+    "worst residual (mrad)",
+]
+
+
+def markdown(results: dict[str, dict]) -> str:
+    """Pass counts (of the seeds run) per chain and model, and the spread of settling."""
+    rows = []
+    for chain, found in results.items():
+        for model in MODELS:
+            seeds = [s[model] for s in found["seeds"].values() if model in s]
+            count = len(seeds)
+            passed = [sum(bool(s["criteria"][c]) for s in seeds) for c in CRITERIA]
+            every = sum(all(s["criteria"].values()) for s in seeds)
+            settle = [s["sensorless"]["settle_1"] for s in seeds]
+            bound = [s["upper_bound"]["settle_1"] for s in seeds]
+            residual = max(s["sensorless"]["residual"] for s in seeds)
+            rows.append(
+                [
+                    f"{chain} ({found['lowest_mode']:.1f} rad/s)",
+                    model,
+                    *(f"{p}/{count}" for p in passed),
+                    f"{every}/{count}",
+                    f"{_s(float(np.median(settle)))}, {_s(max(settle))}",
+                    _s(float(np.median(bound))),
+                    f"{1e3 * residual:.2f}",
+                ]
+            )
+    return markdown_table(HEADER, rows) + "\n"
+
+
+def _s(value: float) -> str:
+    return "never" if math.isinf(value) else f"{value:.2f}"
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``arcosim bench control``."""
+    p = subparsers.add_parser(
+        "control",
+        help="sensorless motion control: Done-when pass counts over seeds",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--seeds", type=int, default=20, help="plant seeds per chain (default 20)")
+    p.add_argument("--quick", action="store_true", help="the first chain only")
+    p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
+    p.set_defaults(execute=_execute)
+
+
+def _execute(args: argparse.Namespace) -> int:
+    if args.seeds < 1:
+        raise UserError(f"--seeds must be >= 1, got {args.seeds}")
+    chains = CHAINS[:1] if args.quick else CHAINS
+    result = run(args.out, range(1, args.seeds + 1), chains, _progress)
+    print(result["table"])
+    print(f"wrote {args.out / 'control.md'} and {args.out / 'control.json'} "
+          f"({result['seconds']:.0f} s)")  # fmt: skip
+    return 0
+
+
+def _progress(text: str) -> None:
+    print(f"  … {text}", flush=True)
+
+
+if __name__ == "__main__":
+    import sys
+
+    from benchmarks import main
+
+    sys.exit(main("control", add_parser, sys.argv[1:]))
