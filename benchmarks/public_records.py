@@ -39,6 +39,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from arcosim.experiments.report import markdown_table
 from arcosim.logs import write_csv
 from benchmarks import public_loaders as loaders
@@ -131,11 +133,13 @@ def _whole_rigid(result: dict, values: dict[str, float]) -> dict[str, float]:
 
 
 def _whole_chain(result: dict, values: dict[str, float]) -> dict[str, float]:
-    """Whole chain: n, J[1], k[1], B[1] and the clamped modes' first (rad/s)."""
+    """Whole chain: n, J[1], k[1], B[1] and its strongest clamped mode (rad/s; the one
+    whose residue stands most standard errors above zero)."""
     out = {"masses": float(result["masses"])}
     out.update({name: result[name] for name in ("J[1]", "k[1]", "B[1]") if name in result})
-    if result.get("modes_rad_s"):
-        out["clamped_mode"] = float(result["modes_rad_s"][0])
+    modes, t = result.get("modes_rad_s") or [], result.get("residue_t_values") or []
+    if modes:
+        out["clamped_mode"] = float(modes[int(np.argmax(t[: len(modes)]))] if t else modes[0])
     return out
 
 
