@@ -122,14 +122,17 @@ def _observer_mode0(result: dict, values: dict[str, float]) -> dict[str, float]:
 
 
 def _whole_rigid(result: dict, values: dict[str, float]) -> dict[str, float]:
-    """Whole chain read as a rigid drive: J_mo + every J_i, D_m, f_c (and n)."""
+    """Whole chain read as a rigid drive: J_mo + the load (``J_load`` of n = 0, or every
+    J_i), D_m, f_c and n; a term reported only as a bound under ``NAME (bound)``."""
     n = int(result["masses"])
-    return {
-        "masses": float(n),
-        "J_total": values["J_mo"] + sum(result[f"J[{i}]"] for i in range(1, n + 1)),
-        "D_m": result["D_m"],
-        "f_c": result["f_c"],
-    }
+    load = result.get("J_load", 0.0) + sum(result[f"J[{i}]"] for i in range(1, n + 1))
+    out = {"masses": float(n), "J_total": values["J_mo"] + load}
+    for name in ("D_m", "f_c"):
+        if name in result:
+            out[name] = result[name]
+        elif name in result.get("bounds", {}):
+            out[f"{name} (bound)"] = result["bounds"][name]
+    return out
 
 
 def _whole_chain(result: dict, values: dict[str, float]) -> dict[str, float]:
@@ -289,9 +292,14 @@ def comparison(name: str, result: dict) -> list[list[str]]:
             rows.append([name, run["label"], "refused", "", run["refusal"][:90], ""])
             continue
         for quantity, value in run["quantities"].items():
-            known = truth.get(quantity)
-            error = f"{100 * (value / known - 1):+.1f} %" if known else ""
+            bound = quantity.endswith(" (bound)")
+            known = truth.get(quantity.removesuffix(" (bound)"))
             shown = f"{known:.6g}" if known else ""
+            if bound:
+                verdict = ("covers it" if known <= value else "excludes it") if known else ""
+                rows.append([name, run["label"], quantity, shown, f"≤ {value:.6g}", verdict])
+                continue
+            error = f"{100 * (value / known - 1):+.1f} %" if known else ""
             rows.append([name, run["label"], quantity, shown, f"{value:.6g}", error])
     return rows
 

@@ -133,10 +133,12 @@ def test_refusal_and_comparison():
         "published": {"J_total": 100.0},
         "runs": [
             {"label": "mode 0", "quantities": {"J_total": 101.0, "f_c": 2.0}, "refusal": ""},
+            {"label": "n = 0", "quantities": {"J_total (bound)": 99.0}, "refusal": ""},
             {"label": "n = 0", "quantities": {}, "refusal": "--masses 0: must be 1 to 20"},
         ],
     }
     rows = public_records.comparison("emps", result)
     assert rows[0] == ["emps", "mode 0", "J_total", "100", "101", "+1.0 %"]
     assert rows[1][2:] == ["f_c", "", "2", ""]
-    assert rows[2][2:5] == ["refused", "", "--masses 0: must be 1 to 20"]
+    assert rows[2][2:] == ["J_total (bound)", "100", "≤ 99", "excludes it"]
+    assert rows[3][2:5] == ["refused", "", "--masses 0: must be 1 to 20"]
