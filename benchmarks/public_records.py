@@ -127,11 +127,20 @@ def _whole_rigid(result: dict, values: dict[str, float]) -> dict[str, float]:
     n = int(result["masses"])
     load = result.get("J_load", 0.0) + sum(result[f"J[{i}]"] for i in range(1, n + 1))
     out = {"masses": float(n), "J_total": values["J_mo"] + load}
-    for name in ("D_m", "f_c"):
-        if name in result:
+    out.update(_values_or_bounds(result, ("D_m", "f_c")))
+    return out
+
+
+def _values_or_bounds(result: dict, names: tuple[str, ...]) -> dict[str, float]:
+    """``names`` from a whole-chain result; one reported as a bound (``bounds``, whatever
+    value stands beside it) under ``NAME (bound)``."""
+    bounds = result.get("bounds", {})
+    out = {}
+    for name in names:
+        if name in bounds:
+            out[f"{name} (bound)"] = bounds[name]
+        elif name in result:
             out[name] = result[name]
-        elif name in result.get("bounds", {}):
-            out[f"{name} (bound)"] = result["bounds"][name]
     return out
 
 
@@ -139,7 +148,7 @@ def _whole_chain(result: dict, values: dict[str, float]) -> dict[str, float]:
     """Whole chain: n, J[1], k[1], B[1] and its strongest clamped mode (rad/s; the one
     whose residue stands most standard errors above zero)."""
     out = {"masses": float(result["masses"])}
-    out.update({name: result[name] for name in ("J[1]", "k[1]", "B[1]") if name in result})
+    out.update(_values_or_bounds(result, ("J[1]", "k[1]", "B[1]")))
     modes, t = result.get("modes_rad_s") or [], result.get("residue_t_values") or []
     if modes:
         out["clamped_mode"] = float(modes[int(np.argmax(t[: len(modes)]))] if t else modes[0])
