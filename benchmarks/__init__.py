@@ -4,6 +4,8 @@
   (``arcosim bench accuracy``, or ``python -m benchmarks.accuracy``);
 - :mod:`benchmarks.speed`: µs per co-simulation step and seconds per fit
   (``arcosim bench speed``, or ``python -m benchmarks.speed``);
+- :mod:`benchmarks.public_records`: ``check`` and ``identify`` on public measured records
+  of real drives against their published values (``arcosim bench public --data DIR``);
 - :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`, :mod:`benchmarks.noise_envelope`:
   one-off measurements, run as scripts;
 - :mod:`benchmarks.link_frequencies`: the flexible-link FMU's frequencies against the

@@ -1,4 +1,4 @@
-"""``arcosim bench accuracy|speed|control [ARGS...]``: run a benchmark of a source checkout.
+"""``arcosim bench accuracy|speed|control|public [ARGS...]``: run a benchmark of a source checkout.
 
 The benchmarks live in the repository's ``benchmarks/`` folder (they are not part of
 the installed package); this command finds that folder from the current directory
@@ -16,7 +16,12 @@ from arcosim.cli.options import add_command
 from arcosim.errors import UserError
 
 #: Benchmark name → module of the ``benchmarks`` package.
-BENCHMARKS = {"accuracy": "accuracy", "speed": "speed", "control": "control_accuracy"}
+BENCHMARKS = {
+    "accuracy": "accuracy",
+    "speed": "speed",
+    "control": "control_accuracy",
+    "public": "public_records",
+}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -24,14 +29,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p = add_command(
         subparsers,
         "bench",
-        summary="run a benchmark of the source checkout (accuracy, speed, control)",
+        summary="run a benchmark of the source checkout (accuracy, speed, control, public)",
         description="""
 Run one of the benchmarks in a source checkout's benchmarks/ folder (they are not
 part of the installed package): the folder is found from the current directory
 upwards, and ARGS go to the benchmark (arcosim bench NAME --help lists them).""",
         examples="""
 arcosim bench accuracy
-arcosim bench speed --help""",
+arcosim bench speed --help
+arcosim bench public --data DIR     # public measured records, see its --help""",
     )
     p.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
     p.add_argument("args", nargs=argparse.REMAINDER, help="the benchmark's own arguments")
