@@ -40,6 +40,9 @@ class Drive:
         Motor Coulomb friction (N·m).
     tau_load : float
         Constant load torque on the last mass (N·m).
+    J_rigid : float
+        Inertia rigidly coupled to the motor (kg·m²): the load of a rigid drive
+        (n = 0, ``J_total − J_m``); 0 for a chain.
     """
 
     J: np.ndarray
@@ -48,6 +51,7 @@ class Drive:
     D_m: float
     f_c: float
     tau_load: float = 0.0
+    J_rigid: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -173,10 +177,11 @@ def innovations(record: EncoderRecord, drive: Drive) -> np.ndarray:
 def discrete_drive(record: EncoderRecord, drive: Drive) -> tuple[np.ndarray, np.ndarray]:
     """Motor + chain over one step of ``record`` (its step, motor inertia and load
     model) for ``drive``: state ``[θ_m, θ_1…θ_n, ω_m, ω_1…ω_n]`` (rad, rad/s; then the
-    slow load's random walk, N·m), inputs (motor torque, load torque on the last mass;
+    slow load's random walk, N·m; n = 0: the rigid drive, its load inertia on the
+    motor), inputs (motor torque, load torque on the last mass;
     N·m) held over the step. Returns ``(A, Bd)``, shapes ``(S, S)`` and ``(S, 2)``."""
     m = len(drive.J) + 1
-    inverse = 1.0 / np.array([record.J_m, *drive.J])
+    inverse = 1.0 / np.array([record.J_m + drive.J_rigid, *drive.J])
     K = np.array(spring_matrix([float(x) for x in drive.k]))
     C = np.array(spring_matrix([float(x) for x in drive.B]))
     C[0, 0] += drive.D_m

@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from arcosim.identification.blas import single_threaded
-from arcosim.identification.encoder_fit import refine
+from arcosim.identification.encoder_fit import chain_size, refine
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import (
     DetectedModes,
@@ -47,11 +47,15 @@ from arcosim.identification.output_error import (
     continued_fit,
 )
 from arcosim.identification.records import (
+    FRICTION_FORMS,
+    LOAD_DRIFT,
     EncoderRecord,
     MotorRecord,
     encoder_opening,
     with_friction,
 )
+from arcosim.identification.rigid_drive import rigid_fit
+from arcosim.identification.structure_choice import RULE, Candidate, choose, scores
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
@@ -197,7 +201,8 @@ def identify_whole_chain(
     record : MotorRecord
         The log's reaction-torque record (:func:`~arcosim.motor_record`).
     masses : int or "auto"
-        Number of load masses (a count), or ``"auto"``.
+        Number of load masses (a count; 0: a rigid drive, fitted as ``J_load`` =
+        J_total − J_m with the friction), or ``"auto"`` (0 included).
     encoder : EncoderRecord, optional
         The same log's current → encoder record (:func:`~arcosim.encoder_record`).
 
@@ -210,8 +215,9 @@ def identify_whole_chain(
     Raises
     ------
     IdentificationError
-        When ``masses`` is neither a positive integer nor ``"auto"``, or the record
-        cannot support the chain asked for.
+        When ``masses`` is neither a whole number ≥ 0 nor ``"auto"``, or the record
+        cannot support the chain asked for (it shows fewer modes than asked; n = 0, the
+        rigid drive, needs the encoder record).
 
     Examples
     --------
@@ -232,7 +238,7 @@ def identify_whole_chain(
     detected = detect_modes(record, largest)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
-    if unknown and detected.n:
+    if unknown and detected.n and n_asked != 0:
         # τ̂ was computed without friction: estimate it from the first modes, take it
         # out of τ̂, and read the modes again
         modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
@@ -250,6 +256,13 @@ def identify_whole_chain(
             encoder = with_friction(encoder, D_m, f_c)
             detected = again
             n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    selection: dict = {"rule": RULE, "masses": {str(m): v for m, v in criterion.items()}}
+    if encoder is not None:
+        result, selection["friction"] = _friction_form(record, encoder, n, result)
+        selection["load"], load_warning = _load_check(encoder, n, result)
+        if load_warning:
+            result.extra.setdefault("structure_warnings", []).append(load_warning)
+    result.extra["selection"] = selection
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
@@ -260,7 +273,8 @@ def identify_whole_chain(
             f"{T_CONFIRM:g}); the information criterion chose {n} masses"
             for w, t in zip(detected.frequency, detected.t_value)
             if t < T_CONFIRM
-        ],
+        ]
+        + result.extra.get("structure_warnings", []),
     )
     refused = {}
     if detected.weak:
@@ -273,6 +287,125 @@ def identify_whole_chain(
         refused,
         detected.n,
         detected.singular_values,
+    )
+
+
+def _candidate(name: str, fit: ParameterFit) -> Candidate:
+    return Candidate(
+        name,
+        len(fit.values),
+        fit.extra["innovation_variance"],
+        fit.extra["innovation_count"],
+        fit.lag,
+    )
+
+
+def _restart(result: ParameterFit, n: int) -> ParameterFit:
+    """A start for :func:`refine` from ``result``'s chain (its evidence kept)."""
+    chain = np.array(result.values[: chain_size(n)], dtype=float)
+    start = ParameterFit(
+        result.names[: chain_size(n)],
+        chain,
+        np.zeros_like(chain),
+        chain,
+        result.start_note.split("; then")[0],
+        0.0,
+        result.rms_data,
+        1,
+        result.evaluations,
+    )
+    start.extra.update({k: v for k, v in result.extra.items() if k in _EVIDENCE})
+    return start
+
+
+_EVIDENCE = ("modes_rad_s", "damping_ratios", "singular_values")
+
+
+def _with_form(encoder: EncoderRecord, form: str, D_m: float, f_c: float) -> EncoderRecord:
+    """``encoder`` fitting the friction ``form`` from ``D_m``, ``f_c`` (the terms it
+    leaves out at 0); the noise model unchanged, so candidates compare."""
+    return replace(
+        encoder,
+        friction_form=form,
+        D_m=D_m if form in ("viscous", "both") else 0.0,
+        f_c=f_c if form in ("coulomb", "both") else 0.0,
+    )
+
+
+def _friction_form(
+    record: MotorRecord, encoder: EncoderRecord, n: int, result: ParameterFit
+) -> tuple[ParameterFit, dict]:
+    """The friction form chosen by the rule (:mod:`structure_choice`) among none,
+    viscous, Coulomb and both, each fitted on the record's first
+    :data:`CONFIRM_SECONDS` from ``result``'s chain; the whole record refitted with the
+    form chosen when it is not ``result``'s. Given friction: ``result`` as it is."""
+    if encoder.friction_given:
+        return result, {"given": True}
+    short = encoder_opening(encoder, CONFIRM_SECONDS)
+    start = _restart(result, n)
+    D_m = max(result.extra["D_m"], encoder.D_m, 1e-9)
+    f_c = max(result.extra["f_c"], encoder.f_c, 1e-9)
+    candidates, fits = [], {}
+    for form in FRICTION_FORMS:
+        try:
+            fits[form] = refine(_with_form(short, form, D_m, f_c), None, start, n)
+        except (IdentificationError, ValueError, np.linalg.LinAlgError):
+            continue
+        candidates.append(_candidate(form, fits[form]))
+    if len(candidates) < 2:
+        return result, {"candidates": scores(candidates) if candidates else {}}
+    chosen = choose(candidates).name
+    table = {"candidates": scores(candidates), "chosen": chosen}
+    if chosen == "both":
+        return result, table
+    found = fits[chosen].extra
+    final = refine(
+        _with_form(encoder, chosen, max(found["D_m"], 1e-9), max(found["f_c"], 1e-9)),
+        None if n == 0 else record,
+        start,
+        n,
+    )
+    if n == 0:
+        final.rms_residual, final.rms_data = result.rms_residual, result.rms_data
+    if "both" in fits:  # a term the rule left out: at most what the full form allows
+        both = fits["both"].as_dict(), fits["both"].std_dict()
+        final.extra["bounds"] = final.extra.get("bounds", {}) | {
+            name: max(both[0][name], 0.0) + 2.0 * both[1][name]
+            for name in ("D_m", "f_c")
+            if name not in final.names
+        }
+    return final, table
+
+
+def _load_check(encoder: EncoderRecord, n: int, result: ParameterFit) -> tuple[dict, str | None]:
+    """With no load torque modelled: the rule between none and a slow load torque on the
+    record's first :data:`CONFIRM_SECONDS`; a warning naming the load when it takes the
+    slow one."""
+    if encoder.load != "none":
+        return {"modelled": encoder.load}, None
+    short = encoder_opening(encoder, CONFIRM_SECONDS)
+    start = _restart(result, n)
+    D_m, f_c = max(result.extra["D_m"], 1e-9), max(result.extra["f_c"], 1e-9)
+    form = result.extra.get("friction_form", "both")
+    if not encoder.friction_given:
+        short = _with_form(short, form, D_m, f_c)
+    drift = LOAD_DRIFT * float(np.sqrt(np.mean(short.drive**2))) * np.sqrt(short.h)
+    candidates = []
+    for load, record in (("none", short), ("slow", replace(short, load="slow", load_std=drift))):
+        try:
+            candidates.append(_candidate(load, refine(record, None, start, n)))
+        except (IdentificationError, ValueError, np.linalg.LinAlgError):
+            continue
+    if len(candidates) < 2:
+        return {}, None
+    chosen = choose(candidates).name
+    table = {"candidates": scores(candidates), "chosen": chosen}
+    if chosen == "none":
+        return table, None
+    return table, (
+        "the residual holds a slowly varying torque the model leaves out (the selection "
+        "prefers a slow load torque): an unmodelled load torque; fit it with --load slow "
+        "(or constant)"
     )
 
 
@@ -312,42 +445,73 @@ def _choose_and_fit(
     auto: bool,
     n_asked: int | None,
 ) -> tuple[int, ParameterFit, dict[int, float]]:
-    """n (read, or asked and checked), the fit, and the criterion per n tried."""
+    """n (read, or asked and checked), the fit, and the criterion per n tried.
+
+    ``auto`` starts from the modes the record shows (all of them, weak ones too) and
+    drops the weakest one at a time while the information criterion falls, down to the
+    rigid drive (n = 0). An n asked for is fitted when the record shows that many
+    modes (weak ones with a warning, the caller's) and refused when it does not."""
     n = detected.n if auto else n_asked
-    if n < 1 or detected.n < n:
-        raise IdentificationError(missing_modes(detected, n if n >= 1 else None, record))
-    if float(np.max(detected.t_value)) < T_CONFIRM:
-        raise IdentificationError(
-            "every mode the record shows is weakly determined (residue t values "
-            + ", ".join(f"{t:.0f}" for t in detected.t_value)
-            + f", all under {T_CONFIRM:g}): "
-            + missing_modes(detected, None, record)
-        )
+    if n > detected.n:
+        raise IdentificationError(missing_modes(detected, n, record))
     criterion: dict[int, float] = {}
+    if n == 0:
+        if encoder is None:
+            raise IdentificationError(missing_modes(detected, None, record) + RIGID_NEEDS)
+        return 0, rigid_fit(encoder, record), criterion
     if encoder is None:
+        if float(np.max(detected.t_value)) < T_CONFIRM and auto:
+            raise IdentificationError(
+                "every mode the record shows is weakly determined (residue t values "
+                + ", ".join(f"{t:.0f}" for t in detected.t_value)
+                + f", all under {T_CONFIRM:g}): "
+                + missing_modes(detected, None, record)
+            )
         result = fit_chain(record, n, _strongest(detected, n))
         criterion[n] = information_criterion(result, record)
         return n, result, criterion
-    if auto and n >= 2:
-        # the data decide: BIC of the fits without the weakest modes, on the record's
-        # first CONFIRM_SECONDS, as long as dropping one more lowers it (a pole of the
-        # noise or of an excitation line adds nothing to the prediction of the encoder)
-        short = encoder_opening(encoder, CONFIRM_SECONDS)
-
-        def bic(m: int) -> float:
-            try:
-                trial = _prediction_error(None, short, _strongest(detected, m))
-                return trial.extra["information_criterion"]
-            except (IdentificationError, ValueError, np.linalg.LinAlgError):
-                return float("inf")  # no chain of m masses fits the opening
-
-        criterion[n] = bic(n)
-        while n >= 2:
-            criterion[n - 1] = bic(n - 1)
-            if not criterion[n - 1] < criterion[n]:
-                break
-            n -= 1
+    if auto:
+        n, criterion = _auto_masses(encoder, detected)
+        if n == 0:
+            return 0, rigid_fit(encoder, record), criterion
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
+
+
+def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, dict]:
+    """n by the rule (:mod:`~arcosim.identification.structure_choice`) on the record's
+    first :data:`CONFIRM_SECONDS`: from the modes seen, the weakest dropped one at a
+    time as long as the rule prefers the chain without it, down to the rigid drive (a
+    pole of the noise or of an excitation line adds nothing to the prediction of the
+    encoder). Returns n and, per n tried, its scores."""
+    short = encoder_opening(encoder, CONFIRM_SECONDS)
+
+    def candidate(m: int) -> Candidate | None:
+        try:
+            if m == 0:
+                trial = rigid_fit(short, None)
+            else:
+                trial = _prediction_error(None, short, _strongest(detected, m))
+        except (IdentificationError, ValueError, np.linalg.LinAlgError):
+            return None  # no chain of m masses fits the opening
+        return _candidate(f"n={m}", trial)
+
+    n = detected.n
+    tried = {n: candidate(n)}
+    while n >= 1:
+        tried[n - 1] = candidate(n - 1)
+        pair = [c for c in (tried[n - 1], tried[n]) if c is not None]
+        if not pair or choose(pair).name != f"n={n - 1}":
+            break
+        n -= 1
+    table = scores([c for c in tried.values() if c is not None])
+    return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
+
+
+#: Why a rigid drive needs the encoder's counts (appended to the refusal).
+RIGID_NEEDS = (
+    "; a rigid drive (n = 0) is fitted from the current to the encoder: give the "
+    "encoder's counts per revolution (encoder_cpr)"
+)
 
 
 def _strongest(detected: DetectedModes, n: int) -> Modes:
@@ -422,7 +586,9 @@ def _masses(masses: int | str) -> int:
     try:
         n = int(masses)
     except ValueError:
-        n = 0
-    if n < 1 or str(masses).strip() not in (str(n), "auto"):
-        raise IdentificationError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
+        n = -1
+    if n < 0 or str(masses).strip() not in (str(n), "auto"):
+        raise IdentificationError(
+            f"--masses must be a whole number ≥ 0 (0: a rigid drive) or 'auto', got {masses!r}"
+        )
     return n
