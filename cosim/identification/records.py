@@ -221,8 +221,7 @@ TORQUE_STD_FLOOR = 1e-4
 #: Load choices: none, a constant torque, or a constant plus a slow random walk.
 LOADS = ("none", "constant", "slow")
 
-#: Friction forms a fit may carry when the friction is not given: none, viscous (D_m),
-#: Coulomb (f_c), both.
+#: Friction forms a fit of an unknown friction may carry (viscous: D_m, Coulomb: f_c).
 FRICTION_FORMS = ("none", "viscous", "coulomb", "both")
 
 #: Random walk of a ``"slow"`` load (N·m per √s), relative to the rms drive torque.

@@ -25,17 +25,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from arcosim.identification.blas import single_threaded
-from arcosim.identification.encoder_fit import chain_size, refine
+from arcosim.identification.encoder_fit import refine
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.fit_notes import assumptions, missing_modes
 from arcosim.identification.modal_start import (
     DetectedModes,
     Modes,
-    chain_of,
     detect_modes,
     modal_damping,
     record_modes,
@@ -47,15 +47,21 @@ from arcosim.identification.output_error import (
     continued_fit,
 )
 from arcosim.identification.records import (
-    FRICTION_FORMS,
-    LOAD_DRIFT,
     EncoderRecord,
     MotorRecord,
     encoder_opening,
     with_friction,
 )
 from arcosim.identification.rigid_drive import rigid_fit
-from arcosim.identification.structure_choice import RULE, Candidate, choose, scores
+from arcosim.identification.structure_choice import (
+    RULE,
+    Candidate,
+    candidate_of,
+    choose,
+    friction_form,
+    load_check,
+    scores,
+)
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
@@ -258,8 +264,8 @@ def identify_whole_chain(
             n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     selection: dict = {"rule": RULE, "masses": {str(m): v for m, v in criterion.items()}}
     if encoder is not None:
-        result, selection["friction"] = _friction_form(record, encoder, n, result)
-        selection["load"], load_warning = _load_check(encoder, n, result)
+        result, selection["friction"] = friction_form(record, encoder, n, result, CONFIRM_SECONDS)
+        selection["load"], load_warning = load_check(encoder, n, result, CONFIRM_SECONDS)
         if load_warning:
             result.extra.setdefault("structure_warnings", []).append(load_warning)
     result.extra["selection"] = selection
@@ -287,125 +293,6 @@ def identify_whole_chain(
         refused,
         detected.n,
         detected.singular_values,
-    )
-
-
-def _candidate(name: str, fit: ParameterFit) -> Candidate:
-    return Candidate(
-        name,
-        len(fit.values),
-        fit.extra["innovation_variance"],
-        fit.extra["innovation_count"],
-        fit.lag,
-    )
-
-
-def _restart(result: ParameterFit, n: int) -> ParameterFit:
-    """A start for :func:`refine` from ``result``'s chain (its evidence kept)."""
-    chain = np.array(result.values[: chain_size(n)], dtype=float)
-    start = ParameterFit(
-        result.names[: chain_size(n)],
-        chain,
-        np.zeros_like(chain),
-        chain,
-        result.start_note.split("; then")[0],
-        0.0,
-        result.rms_data,
-        1,
-        result.evaluations,
-    )
-    start.extra.update({k: v for k, v in result.extra.items() if k in _EVIDENCE})
-    return start
-
-
-_EVIDENCE = ("modes_rad_s", "damping_ratios", "singular_values")
-
-
-def _with_form(encoder: EncoderRecord, form: str, D_m: float, f_c: float) -> EncoderRecord:
-    """``encoder`` fitting the friction ``form`` from ``D_m``, ``f_c`` (the terms it
-    leaves out at 0); the noise model unchanged, so candidates compare."""
-    return replace(
-        encoder,
-        friction_form=form,
-        D_m=D_m if form in ("viscous", "both") else 0.0,
-        f_c=f_c if form in ("coulomb", "both") else 0.0,
-    )
-
-
-def _friction_form(
-    record: MotorRecord, encoder: EncoderRecord, n: int, result: ParameterFit
-) -> tuple[ParameterFit, dict]:
-    """The friction form chosen by the rule (:mod:`structure_choice`) among none,
-    viscous, Coulomb and both, each fitted on the record's first
-    :data:`CONFIRM_SECONDS` from ``result``'s chain; the whole record refitted with the
-    form chosen when it is not ``result``'s. Given friction: ``result`` as it is."""
-    if encoder.friction_given:
-        return result, {"given": True}
-    short = encoder_opening(encoder, CONFIRM_SECONDS)
-    start = _restart(result, n)
-    D_m = max(result.extra["D_m"], encoder.D_m, 1e-9)
-    f_c = max(result.extra["f_c"], encoder.f_c, 1e-9)
-    candidates, fits = [], {}
-    for form in FRICTION_FORMS:
-        try:
-            fits[form] = refine(_with_form(short, form, D_m, f_c), None, start, n)
-        except (IdentificationError, ValueError, np.linalg.LinAlgError):
-            continue
-        candidates.append(_candidate(form, fits[form]))
-    if len(candidates) < 2:
-        return result, {"candidates": scores(candidates) if candidates else {}}
-    chosen = choose(candidates).name
-    table = {"candidates": scores(candidates), "chosen": chosen}
-    if chosen == "both":
-        return result, table
-    found = fits[chosen].extra
-    final = refine(
-        _with_form(encoder, chosen, max(found["D_m"], 1e-9), max(found["f_c"], 1e-9)),
-        None if n == 0 else record,
-        start,
-        n,
-    )
-    if n == 0:
-        final.rms_residual, final.rms_data = result.rms_residual, result.rms_data
-    if "both" in fits:  # a term the rule left out: at most what the full form allows
-        both = fits["both"].as_dict(), fits["both"].std_dict()
-        final.extra["bounds"] = final.extra.get("bounds", {}) | {
-            name: max(both[0][name], 0.0) + 2.0 * both[1][name]
-            for name in ("D_m", "f_c")
-            if name not in final.names
-        }
-    return final, table
-
-
-def _load_check(encoder: EncoderRecord, n: int, result: ParameterFit) -> tuple[dict, str | None]:
-    """With no load torque modelled: the rule between none and a slow load torque on the
-    record's first :data:`CONFIRM_SECONDS`; a warning naming the load when it takes the
-    slow one."""
-    if encoder.load != "none":
-        return {"modelled": encoder.load}, None
-    short = encoder_opening(encoder, CONFIRM_SECONDS)
-    start = _restart(result, n)
-    D_m, f_c = max(result.extra["D_m"], 1e-9), max(result.extra["f_c"], 1e-9)
-    form = result.extra.get("friction_form", "both")
-    if not encoder.friction_given:
-        short = _with_form(short, form, D_m, f_c)
-    drift = LOAD_DRIFT * float(np.sqrt(np.mean(short.drive**2))) * np.sqrt(short.h)
-    candidates = []
-    for load, record in (("none", short), ("slow", replace(short, load="slow", load_std=drift))):
-        try:
-            candidates.append(_candidate(load, refine(record, None, start, n)))
-        except (IdentificationError, ValueError, np.linalg.LinAlgError):
-            continue
-    if len(candidates) < 2:
-        return {}, None
-    chosen = choose(candidates).name
-    table = {"candidates": scores(candidates), "chosen": chosen}
-    if chosen == "none":
-        return table, None
-    return table, (
-        "the residual holds a slowly varying torque the model leaves out (the selection "
-        "prefers a slow load torque): an unmodelled load torque; fit it with --load slow "
-        "(or constant)"
     )
 
 
@@ -493,7 +380,7 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
                 trial = _prediction_error(None, short, _strongest(detected, m))
         except (IdentificationError, ValueError, np.linalg.LinAlgError):
             return None  # no chain of m masses fits the opening
-        return _candidate(f"n={m}", trial)
+        return candidate_of(f"n={m}", trial)
 
     n = detected.n
     tried = {n: candidate(n)}
@@ -534,52 +421,6 @@ def _mode_evidence(modes: Modes) -> dict:
         "damping_ratios": [float(z) for z in modes.damping],
         "singular_values": [float(x) for x in modes.singular_values[:20]],
     }
-
-
-def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
-    """What the result is conditional on, one line each (for the report)."""
-    scale = (
-        "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
-        "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
-        "homogeneous in torque); one of them alone off distorts the chain unevenly, by "
-        "up to about 1.5 ε (measured on a five-mass chain: k_t +5 % gave J_i, k_i "
-        "−1.5 … +7.3 %, J_m +5 % gave −0.5 … +4.2 %)"
-    )
-    out = {"actuator": scale}
-    if encoder is None:
-        out["fit"] = "output-error fit to τ̂_reac (no encoder counts given: encoder_cpr = 0)"
-        return out
-    out["encoder"] = f"{2 * np.pi / encoder.count:.0f} counts per revolution, error q²/12"
-    if encoder.friction_given:
-        out["friction"] = f"given: D_m = {encoder.D_m:.4g} N·m·s/rad, f_c = {encoder.f_c:.4g} N·m"
-    else:
-        out["friction"] = "fitted (D_m, f_c with standard errors)"
-    out["load"] = {
-        "none": "no load torque modelled",
-        "constant": "a constant load torque on the last mass, fitted",
-        "slow": "a constant plus slowly varying load torque on the last mass, fitted",
-    }[encoder.load]
-    return out
-
-
-def missing_modes(detected: DetectedModes, n: int | None, record: MotorRecord) -> str:
-    """Why the record cannot support n masses (n None: not even one), and what to do."""
-    found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
-    text = (
-        f"the record shows {detected.n} excited mode(s) below {detected.band:.0f} rad/s "
-        f"({found} rad/s)"
-    )
-    if n is not None:
-        text += f", {chain_of(n)} has {n}"
-    if detected.weak:
-        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
-        text += f"; seen but too weakly excited: {weak}"
-    return text + (
-        ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
-        "lines on both sides of each mode, up to the band; a longer record; a finer "
-        f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
-        "see `arcosim.design_excitation`, or fit fewer masses"
-    )
 
 
 def _masses(masses: int | str) -> int:
