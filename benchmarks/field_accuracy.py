@@ -491,6 +491,7 @@ def score_rows(
             r = run_row(row, seed)
             results[name].append(r)
             progress(f"{name}, seed {seed}: n = {r.get('n')}, {r['seconds']:.1f} s")
+            progress("  " + json.dumps(r, default=float))  # every run's numbers, as they come
         summaries[name] = summary(results[name], row)
     return summaries, results
 

@@ -57,7 +57,8 @@ class DriveIdentification:
         The reaction-torque record the fit started from.
     friction : dict of str to float
         The motor friction the result rests on, given or fitted: ``D_m``
-        (N·m·s/rad) and ``f_c`` (N·m).
+        (N·m·s/rad) and ``f_c`` (N·m); a term the selection rule left out is 0 (its
+        bound is in the report).
 
     Examples
     --------
@@ -268,5 +269,5 @@ def identify_drive(
         record=record,
         friction={"D_m": D_m, "f_c": f_c}
         if friction_given
-        else {k: parameters[k] for k in ("D_m", "f_c") if k in parameters},
+        else {k: parameters.get(k, 0.0) for k in ("D_m", "f_c")},  # left out: 0
     )
