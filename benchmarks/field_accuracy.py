@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
@@ -70,6 +71,13 @@ class Row:
         friction_given: the user gives D_m, f_c.
         load: the load model the user asks for.
         note: one line for the table.
+        mistake: a field mistake the user makes, or None: ``"time_ms"`` (the time
+            column in ms), ``"k_t"`` / ``"J_m"`` (the datasheet value given 10 % high),
+            ``"short"`` (a 3 s record).
+        expect: for a row with a mistake or an unmodelled effect, a regular expression
+            the refusal or a warning must match (the cause named).
+        J_load: a rigid drive's load inertia (kg·m²; the drive's J_m holds motor and
+            load, the user gives the motor's ``J_m − J_load``).
     """
 
     name: str
@@ -82,6 +90,9 @@ class Row:
     friction_given: bool = True
     load: str = "none"
     note: str = ""
+    mistake: str | None = None
+    expect: str | None = None
+    J_load: float = 0.0
 
     def log(self, seed: int, duration: float = DURATION) -> field_sim.Log:
         """Simulate the row's record (``duration`` s) for ``seed``."""
@@ -106,6 +117,8 @@ _FIVE = _modal_chain((14.3, 42.3, 70.0, 86.8, 106.6), (0.2, 0.1, 0.05, 0.03, 0.0
 _THREE = ((3e-4, 5e-4, 4e-4), (0.25, 0.4, 0.15))
 _CLOSE = _modal_chain((20.0, 40.0, 42.0), (0.3, 0.1, 0.1))  # two modes 5 % apart
 _BELT = ((6e-4, 3e-4), (20.0, 10.0))
+#: A ball-screw axis: the table's inertia rigidly on the motor (kg·m²).
+_SCREW = 6e-4
 
 ROWS: dict[str, Row] = {
     r.name: r
@@ -156,13 +169,89 @@ ROWS: dict[str, Row] = {
             load="constant",
             note="0.01 N·m on the last mass, held by the speed loop",
         ),
+        Row(
+            "belt, 2^17 counts, Coulomb friction",
+            _drive(
+                *_BELT, J_m=1.2e-4, k_t=0.1, D_m=0.0, f_c=0.01, current_noise=0.01, counts=2**17
+            ),
+            h=2.5e-4,
+            g_dist=400.0,
+            lines=np.geomspace(10.0, 600.0, 40),
+            amplitude=6.0,
+            note="high-resolution encoder, Coulomb friction only (given), lines 10–600, 6 A",
+        ),
+        Row(
+            "three-mass, slow load, no --load",
+            _drive(*_THREE, load_sine=(0.01, 0.3)),
+            expect="load torque",
+            note="0.01 N·m sine at 0.3 rad/s on the last mass, not modelled: must warn",
+        ),
+        Row(
+            "three-mass, viscous-only motor, friction fitted",
+            _drive(*_THREE, f_c=0.0),
+            friction_given=False,
+            note="D_m 2e-5, f_c 0; only k_t, J_m given",
+        ),
+        Row(
+            "three-mass, Coulomb-only motor, friction fitted",
+            _drive(*_THREE, D_m=0.0),
+            friction_given=False,
+            note="D_m 0, f_c 2e-3; only k_t, J_m given",
+        ),
+        Row(
+            "rigid drive (ball screw), friction fitted",
+            field_sim.Drive(
+                J_m=J_M + _SCREW,
+                k_t=K_T,
+                J=(),
+                k=(),
+                B=(),
+                D_m=D_M,
+                f_c=F_C,
+                current_noise=0.005,
+            ),
+            friction_given=False,
+            J_load=_SCREW,
+            note="J_load 6e-4 rigid on the motor, no mode; only k_t, J_m given",
+        ),
+        Row(
+            "mistake: time in ms",
+            _drive(*_THREE),
+            mistake="time_ms",
+            expect="time",
+            note="the log's time column in ms, no --scale",
+        ),
+        Row(
+            "mistake: k_t +10 %",
+            _drive(*_THREE),
+            mistake="k_t",
+            expect="k_t",
+            note="k_t given 10 % high; lines to 150 rad/s = 2.8 × the top mode 53",
+        ),
+        Row(
+            "mistake: J_m +10 %",
+            _drive(*_THREE),
+            mistake="J_m",
+            expect="J_m",
+            note="J_m given 10 % high; lines to 150 rad/s = 2.8 × the top mode 53",
+        ),
+        Row(
+            "mistake: 3 s record",
+            _drive(*_THREE),
+            mistake="short",
+            expect="lasts",
+            note="the README's excitation (40 lines 3–150 rad/s, 3 A), 3 s",
+        ),
     )
 }
+
+#: The rows where a refusal or a warning must name the cause (``Row.expect``).
+CAUSE_ROWS = tuple(name for name, row in ROWS.items() if row.expect)
 
 
 def run_row(row: Row, seed: int, duration: float = DURATION) -> dict:
     """Identify one record of ``row``: errors (%) and standard errors (%) per parameter."""
-    return score_log(row, row.log(seed, duration), seed)
+    return score_log(row, row.log(seed, 3.0 if row.mistake == "short" else duration), seed)
 
 
 def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
@@ -170,26 +259,34 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     parameter, the warnings, or the refusal (``error``)."""
     d = row.drive
     friction = {"D_m": d.D_m, "f_c": d.f_c} if row.friction_given else {}
+    k_t, J_m = d.k_t * (1.1 if row.mistake == "k_t" else 1.0), d.J_m - row.J_load
+    J_m *= 1.1 if row.mistake == "J_m" else 1.0
+    times = log.time * (1e3 if row.mistake == "time_ms" else 1.0)
     wall, cpu = time.perf_counter(), time.process_time()
     out: dict = {"seed": seed, "stuck_fraction": log.stuck_fraction}
     try:
         result = identify_drive(
-            log.time,
+            times,
             log.i_a,
             log.omega_m,
             log.theta_m,
-            k_t=d.k_t,
-            J_m=d.J_m,
+            k_t=k_t,
+            J_m=J_m,
             encoder_cpr=d.counts,
             load=row.load,
             g_dist=row.g_dist,
             **friction,
         )
     except IdentificationError as error:
-        out.update(n=0, error=str(error))
+        out.update(n=None, error=str(error))
         result = None
     out["seconds"] = time.perf_counter() - wall
     out["cpu_seconds"] = time.process_time() - cpu
+    if row.expect:
+        said = [out["error"]] if result is None else result.warnings
+        out["cause_named"] = any(re.search(row.expect, text) for text in said)
+        out["said"] = said
+        out["extend_the_lines"] = any("extend the lines" in text for text in said)
     if result is None:
         return out
     choice = result.choice
@@ -198,6 +295,8 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     out.update(n=n, modes=choice.fit.extra["modes_rad_s"], weak=choice.fit.extra["weak_modes"])
     if n != d.n:
         return out
+    if n == 0:
+        return _rigid_scores(out, result, row)
     fit = choice.fit
     J, k, B = split(fit.values, n)
     std = fit.std
@@ -216,6 +315,24 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     return out
 
 
+def _rigid_scores(out: dict, result, row: Row) -> dict:
+    """A rigid drive's numbers: J_load's error (%), and D_m, f_c against their σ or
+    their bound."""
+    values, std = result.parameters, result.std
+    bounds = result.report().get("bounds", {})
+    truth = row.J_load
+    out["J_load_error_percent"] = 100.0 * (values["J_load"] / truth - 1.0)
+    out["J_load_std_percent"] = 100.0 * std["J_load"] / truth
+    for name, t in (("D_m", row.drive.D_m), ("f_c", row.drive.f_c)):
+        if name in values:
+            out[name] = {"value": values[name], "std": std[name], "truth": t}
+            out[name + "_covered"] = abs(values[name] - t) <= 2 * std[name]
+        else:
+            out[name] = {"bound": bounds.get(name), "truth": t}
+            out[name + "_covered"] = name in bounds and t <= bounds[name]
+    return out
+
+
 def summary(results: list[dict], row: Row) -> dict:
     """Counts over seeds: n right, largest |J_i|, |k_i| error, B_i (and J_i, k_i) within 2σ."""
     right = [r for r in results if r.get("n") == row.drive.n]
@@ -223,6 +340,29 @@ def summary(results: list[dict], row: Row) -> dict:
     def inside(key: str) -> tuple[int, int]:
         hits = sum(abs(e) <= 2 * s for r in right for e, s in zip(r[key], r[key + "_std"]))
         return int(hits), len(right) * row.drive.n
+
+    if row.expect:
+        return {
+            "seeds": len(results),
+            "cause_named": sum(bool(r.get("cause_named")) for r in results),
+            "refused": sum("error" in r for r in results),
+            "extend_the_lines": sum(bool(r.get("extend_the_lines")) for r in results),
+            "n_right": len(right),
+            "JkB_inside_2_sigma": [sum(x) for x in zip(*(inside(key) for key in "JkB"))],
+            "n_chosen": [r.get("n") for r in results],
+            "seconds_median": float(np.median([r["seconds"] for r in results])),
+        }
+    if row.drive.n == 0:
+        errors = [abs(r["J_load_error_percent"]) for r in right]
+        return {
+            "seeds": len(results),
+            "n_right": len(right),
+            "n_chosen": [r.get("n") for r in results],
+            "max_abs_J_load_error_percent": max(errors, default=float("nan")),
+            "D_m_covered": sum(bool(r.get("D_m_covered")) for r in right),
+            "f_c_covered": sum(bool(r.get("f_c_covered")) for r in right),
+            "seconds_median": float(np.median([r["seconds"] for r in results])),
+        }
 
     def worst(key: str) -> float:
         return max((abs(e) for r in right for e in r[key]), default=float("nan"))
@@ -261,6 +401,8 @@ def markdown(summaries: dict[str, dict]) -> str:
     ]
     rows = []
     for name, s in summaries.items():
+        if "B_inside_2_sigma" not in s:
+            continue  # a cause row or the rigid drive: their own table
         b, j, k = s["B_inside_2_sigma"], s["J_inside_2_sigma"], s["k_inside_2_sigma"]
         rows.append(
             [
@@ -275,7 +417,25 @@ def markdown(summaries: dict[str, dict]) -> str:
                 f"{s['cpu_seconds_median']:.1f}",
             ]
         )
-    return markdown_table(header, rows) + "\n"
+    out = markdown_table(header, rows) + "\n"
+    other = [_other_line(name, s) for name, s in summaries.items() if "B_inside_2_sigma" not in s]
+    return out + ("\n" + "\n".join(other) + "\n" if other else "")
+
+
+def _other_line(name: str, s: dict) -> str:
+    """One line for a row scored on its cause named, or the rigid drive."""
+    if "cause_named" in s:
+        return (
+            f"- {name}: cause named on {s['cause_named']} of {s['seeds']} (refused "
+            f"{s['refused']}, 'extend the lines' {s['extend_the_lines']}, n {s['n_chosen']}; "
+            f"J_i, k_i, B_i within 2σ {s['JkB_inside_2_sigma'][0]} of "
+            f"{s['JkB_inside_2_sigma'][1]})"
+        )
+    return (
+        f"- {name}: n = 0 on {s['n_right']} of {s['seeds']}, max |J_load err| "
+        f"{s['max_abs_J_load_error_percent']:.2f} %, D_m covered {s['D_m_covered']}, "
+        f"f_c covered {s['f_c_covered']} of {s['n_right']}"
+    )
 
 
 #: Speed rows: (label, row, record length s).
@@ -340,6 +500,7 @@ def score_rows(
             r = run_row(row, seed)
             results[name].append(r)
             progress(f"{name}, seed {seed}: n = {r.get('n')}, {r['seconds']:.1f} s")
+            progress("  " + json.dumps(r, default=float))  # every run's numbers, as they come
         summaries[name] = summary(results[name], row)
     return summaries, results
 

@@ -51,8 +51,9 @@ def read_chain(path: str | Path) -> dict[str, float]:
     ------
     ChainFileError
         When the file is not JSON, not an object, a value is not a finite number, or
-        ``masses`` is not a whole number, or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing;
-        the message starts with the file's name.
+        ``masses`` is not a whole number, or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing,
+        or the report is a rigid drive's (masses = 0: the message gives the ``--set``
+        for the observer instead); the message starts with the file's name.
     UserError
         When the file is missing, a folder or not UTF-8 text
         (:func:`arcosim.logs.read_text_file`), or n is not a supported number of masses
@@ -83,6 +84,13 @@ def read_chain(path: str | Path) -> dict[str, float]:
     masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
     if masses != int(masses):
         raise ChainFileError(f"{path}: masses = {masses} is not a whole number")
+    if masses == 0 and isinstance(data.get("J_load"), (int, float)):
+        raise ChainFileError(
+            f"{path}: a rigid drive (masses = 0) has no chain: give the observer its load "
+            f"inertia and friction, --set dJm={data['J_load']:.6g} "
+            + " ".join(f"--set {k}={data[k]:.6g}" for k in ("D_m", "f_c") if k in data)
+            + " (the DOB's tau_reac_hat is then the load torque)"
+        )
     n = check_masses(int(masses))
     missing = [
         f"{p}[{i}]" for p in CHAIN_PARAMETERS for i in range(1, n + 1) if f"{p}[{i}]" not in chain

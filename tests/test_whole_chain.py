@@ -98,7 +98,7 @@ def test_a_record_too_short_for_its_modes_is_refused() -> None:
         fit_chain(record(1.0), 5)
 
 
-@pytest.mark.parametrize("masses", ["0", "two", "-1", "2.5"])
+@pytest.mark.parametrize("masses", ["two", "-1", "2.5"])
 def test_a_bad_number_of_masses_is_refused(masses: str) -> None:
     with pytest.raises(IdentificationError, match="masses"):
         identify_whole_chain(record(3.0), masses)

@@ -132,7 +132,8 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         "--masses",
         default="3",
         metavar="N",
-        help="number of load masses (default 3); with --method whole-chain also 'auto'",
+        help="number of load masses (default 3); with --method whole-chain also 0 "
+        "(a rigid drive) and 'auto'",
     )
     p.add_argument(
         "--mode", type=int, choices=(0, 1, 2), help="observer mode (default: the FMU's, 2)"
@@ -215,8 +216,11 @@ def _execute(args: argparse.Namespace) -> int:
     if args.method == "beam":
         return run_beam(args, log)
     if args.method == "whole-chain":
-        masses = args.masses if args.masses == "auto" else masses_option(args.masses)
-        return run_whole_chain(args, log, masses)
+        # whole-chain also fits the rigid drive, n = 0
+        masses = {"auto": "auto", "0": 0}.get(args.masses.strip()) if args.masses else None
+        return run_whole_chain(
+            args, log, masses if masses is not None else masses_option(args.masses)
+        )
     n = int(chain.pop("masses")) if chain else masses_option(args.masses)
     args.set = chain_assignments(chain, args.set) + list(args.set)  # --set wins
     if args.method == "load-torque":

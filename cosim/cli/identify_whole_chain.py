@@ -87,19 +87,33 @@ def _status(masses: int | str, samples: int) -> str:
     Examples
     --------
     >>> _status("auto", 20001)
-    'arcosim identify: fitting the whole chain to 20001 samples, n = 1 … 8 tried (seconds)…'
+    'arcosim identify: fitting the whole chain to 20001 samples, n = 0 … 8 tried (seconds)…'
     """
-    tried = f"n = 1 … {MAX_AUTO_MASSES} tried" if masses == "auto" else f"n = {masses}"
+    tried = f"n = 0 … {MAX_AUTO_MASSES} tried" if masses == "auto" else f"n = {masses}"
     return f"arcosim identify: fitting the whole chain to {samples} samples, {tried} (seconds)…"
 
 
 def _print_report(result: DriveIdentification, report: dict, samples: int) -> None:
     """The report as text, ending with the ``--set`` line for the observer."""
     print(f"{samples} samples, whole-chain fit ({result.masses} masses):")
+    bounds = report.get("bounds", {})
     for key, value in result.parameters.items():
-        print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
+        if key in bounds:
+            print(
+                f"  {key:8s} ≤ {bounds[key]:.2g}  (at its bound 0: the record does not resolve it)"
+            )
+        else:
+            print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
+    for key in set(bounds) - set(result.parameters):
+        print(f"  {key:8s} ≤ {bounds[key]:.2g}  (left out by the selection rule)")
     for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
         print(f"  {key}: {report[key]}")
+    selection = report.get("selection", {})
+    if selection:
+        print(f"  selection rule: {selection['rule']}")
+        for what in ("masses", "friction", "load"):
+            if what in selection:
+                print(f"  selection, {what}: {selection[what]}")
     for key, text in result.assumptions.items():
         print(f"  assumption, {key}: {text}")
     for text in result.warnings:

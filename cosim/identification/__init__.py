@@ -31,8 +31,12 @@ uniform_fit       -- the paper's uniform chain: one k and one B (uniform_chain)
 kalman            -- motor and chain as one linear model; its Kalman predictor, smoother
 encoder_fit       -- the prediction-error fit from the current to the encoder (refine)
 motor_friction    -- the motor's friction when only k_t and J_m are given: its start
+rigid_drive       -- the rigid drive, n = 0: the load inertia J_total − J_m (rigid_fit)
+structure_choice  -- the stated rule that picks n, the friction form, the load model
 whole_chain       -- every J_i, k_i, B_i and n from the motor alone (identify_whole_chain,
                      ChainChoice)
+fit_notes         -- a whole-chain result's assumptions, and why a record cannot
+                     support a chain (missing_modes)
 noise_floor       -- the residual the encoder's counts and the current's noise explain
 
 Flexible link

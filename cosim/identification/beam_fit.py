@@ -91,7 +91,7 @@ def drive_of(model: ModalModel, D_m: float, f_c: float) -> Drive:
     """The Kalman drive model of a link's modes (masses on springs to the hub, the rest
     of the link rigid on it) with the motor friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m)."""
     J, k, B = model.star()
-    return Drive(J, k, B, float(D_m), float(f_c), star=True, J_hub=max(model.J_rest, 0.0))
+    return Drive(J, k, B, float(D_m), float(f_c), star=True, J_rigid=max(model.J_rest, 0.0))
 
 
 @dataclass(frozen=True)

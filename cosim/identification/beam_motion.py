@@ -76,9 +76,9 @@ def tip_motion(record: EncoderRecord, model: ModalModel, D_m: float, f_c: float)
     q = model.participation * (angles[:, 1:] - angles[:, :1])
     springs = angles @ drive.coupling(drive.k)[0] + rates @ drive.coupling(drive.B)[0]
     friction = drive.D_m * rates[:, 0] + drive.f_c * record.sign
-    acceleration = (record.drive - friction - springs) / (record.J_m + drive.J_hub)
+    acceleration = (record.drive - friction - springs) / (record.J_m + drive.J_rigid)
     w_tip = q @ model.tip + model.tip_static * acceleration
-    return TipMotion(w_tip, w_tip / model.L, drive.J_hub * acceleration + springs, q)
+    return TipMotion(w_tip, w_tip / model.L, drive.J_rigid * acceleration + springs, q)
 
 
 def stiffening_warning(omega_m: np.ndarray, first_mode: float) -> str | None:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
+from arcosim.identification.encoder_fit import RIGID_LOAD
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_decision import decide_log
 from arcosim.identification.noise_floor import floor_warning, noise_floor
@@ -31,13 +32,16 @@ class DriveIdentification:
     Parameters
     ----------
     masses : int
-        Number of load masses (a count), read from the record with ``masses="auto"``.
+        Number of load masses (a count), read from the record with ``masses="auto"``;
+        0 for a rigid drive.
     parameters : dict of str to float
         ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad) — the observer
-        FMU's own parameter names — and, when fitted, ``D_m`` (N·m·s/rad), ``f_c``
-        (N·m) and the load torque (N·m).
+        FMU's own parameter names; for a rigid drive ``J_load`` (J_total − J_m, kg·m²)
+        instead — and, when fitted, ``D_m`` (N·m·s/rad), ``f_c`` (N·m) and the load
+        torque (N·m).
     std : dict of str to float
-        Their standard errors (Newey–West), same names and units.
+        Their standard errors (Newey–West), same names and units; none for a
+        parameter at its bound (the report's ``bounds`` give its upper bound instead).
     assumptions : dict of str to str
         What the result is conditional on (k_t and J_m given, the encoder's counts,
         friction given or fitted, the load model), one sentence each.
@@ -52,7 +56,8 @@ class DriveIdentification:
         The reaction-torque record the fit started from.
     friction : dict of str to float
         The motor friction the result rests on, given or fitted: ``D_m``
-        (N·m·s/rad) and ``f_c`` (N·m).
+        (N·m·s/rad) and ``f_c`` (N·m); a term the selection rule left out is 0 (its
+        bound is in the report).
 
     Examples
     --------
@@ -82,7 +87,9 @@ class DriveIdentification:
         ``J[i]``, ``k[i]``, ``B[i]``, the friction ``D_m`` and ``f_c`` (given or fitted),
         and ``estimator = 1``: the model-based observer (the paper's recursion,
         estimator 0, diverges from the second mass on; ``docs/method.md``). Mode 2, the
-        FMU's default, runs them.
+        FMU's default, runs them. A rigid drive (n = 0) has no chain: its load inertia
+        ``J_load`` goes to the motor's (``dJm``, the inertia error the observer adds to
+        J_mo), and the DOB's τ̂_reac is then the load torque.
 
         Examples
         --------
@@ -91,6 +98,8 @@ class DriveIdentification:
         >>> result.observer_parameters()["estimator"], result.observer_parameters()["f_c"]
         (1, 0.002)
         """
+        if RIGID_LOAD in self.parameters:  # a rigid drive: its load is motor inertia
+            return {"dJm": self.parameters[RIGID_LOAD], **self.friction}
         return {**self.chain(), **self.friction, "estimator": 1}
 
     def report(self) -> dict[str, object]:
@@ -119,6 +128,8 @@ class DriveIdentification:
             warnings=list(self.warnings),
             criterion={str(n): v for n, v in self.choice.criterion.items()},
             masses_seen=self.choice.seen,
+            selection=extra.get("selection", {}),
+            bounds=dict(extra.get("bounds", {})),
         )
         if self.choice.singular_values is not None:
             out["singular_values"] = [float(x) for x in self.choice.singular_values[:16]]
@@ -168,7 +179,8 @@ def identify_drive(
         The encoder's counts per revolution (a count); 0 for an angle that is not
         quantized (then the friction must be given and no load torque modelled).
     masses : int or "auto"
-        Number of load masses (a count), or ``"auto"`` to read it from the record.
+        Number of load masses (a count; 0: a rigid drive), or ``"auto"`` to read it
+        from the record (0 included).
     D_m, f_c : float, optional
         Motor viscous (N·m·s/rad) and Coulomb (N·m) friction, when known; fitted
         otherwise.
@@ -245,17 +257,18 @@ def identify_drive(
     above = None
     if load == "none":  # a modelled load's torque is in the τ̂ residual, not in the noise
         chain = split(fit.values, choice.n)
-        floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist)
+        rigid = parameters.get(RIGID_LOAD, 0.0)
+        floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid)
         above = floor_warning(fit.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
-        std=fit.std_dict(),
+        std={k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})},
         assumptions=dict(fit.extra["assumptions"]),
         warnings=decision.warnings + list(fit.extra["warnings"]) + ([above] if above else []),
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}
         if friction_given
-        else {k: parameters[k] for k in ("D_m", "f_c") if k in parameters},
+        else {k: parameters.get(k, 0.0) for k in ("D_m", "f_c")},  # left out: 0
     )

@@ -54,12 +54,32 @@ STUCK_VELOCITY_COUNTS = 20.0
 MAX_ITERATIONS = 40
 
 
+#: The rigid drive's (n = 0) one chain parameter: the load inertia J_total − J_m (kg·m²).
+RIGID_LOAD = "J_load"
+
+
+def chain_size(n: int) -> int:
+    """Chain parameters of an n-mass fit (a count): 3n, or 1 for the rigid drive (n = 0:
+    the load inertia :data:`RIGID_LOAD`)."""
+    return 3 * n if n else 1
+
+
+def fitted_friction(record: EncoderRecord) -> tuple[str, ...]:
+    """The friction terms the fit carries: none when given, else those of the record's
+    ``friction_form`` (``D_m`` for viscous, ``f_c`` for Coulomb, both)."""
+    if record.friction_given:
+        return ()
+    return {"none": (), "viscous": ("D_m",), "coulomb": ("f_c",), "both": ("D_m", "f_c")}[
+        record.friction_form
+    ]
+
+
 def parameter_names(n: int, record: EncoderRecord) -> list[str]:
-    """Fit order: ``J[i]``, ``k[i]``, ``B[i]``, then ``D_m``, ``f_c`` (friction not given),
-    then ``tau_load`` (a load torque modelled)."""
-    names = [f"{p}[{i}]" for p in ("J", "k", "B") for i in range(1, n + 1)]
-    if not record.friction_given:
-        names += ["D_m", "f_c"]
+    """Fit order: ``J[i]``, ``k[i]``, ``B[i]`` (n = 0: ``J_load``, the rigid drive's load
+    inertia J_total − J_m), then ``D_m``, ``f_c`` (friction not given), then
+    ``tau_load`` (a load torque modelled)."""
+    names = [f"{p}[{i}]" for p in ("J", "k", "B") for i in range(1, n + 1)] or [RIGID_LOAD]
+    names += list(fitted_friction(record))
     if record.load != "none":
         names.append("tau_load")
     return names
@@ -68,20 +88,21 @@ def parameter_names(n: int, record: EncoderRecord) -> list[str]:
 def unpack(p: np.ndarray, n: int, record: EncoderRecord) -> Drive:
     """The drive of parameter vector ``p`` (:func:`parameter_names` order)."""
     J, k, B = p[:n], p[n : 2 * n], p[2 * n : 3 * n]
-    j = 3 * n
-    D_m, f_c = record.D_m, record.f_c
-    if not record.friction_given:
-        D_m, f_c = p[j], p[j + 1]
-        j += 2
+    rigid = 0.0 if n else float(p[0])
+    j = chain_size(n)
+    friction = {"D_m": record.D_m, "f_c": record.f_c}
+    for name in fitted_friction(record):
+        friction[name] = p[j]
+        j += 1
+    D_m, f_c = friction["D_m"], friction["f_c"]
     tau = p[j] if record.load != "none" else 0.0
-    return Drive(J, k, B, float(D_m), float(f_c), float(tau))
+    return Drive(J, k, B, float(D_m), float(f_c), float(tau), rigid)
 
 
 def pack(drive: Drive, record: EncoderRecord) -> np.ndarray:
     """Inverse of :func:`unpack`."""
-    p = [*drive.J, *drive.k, *drive.B]
-    if not record.friction_given:
-        p += [drive.D_m, drive.f_c]
+    p = [*drive.J, *drive.k, *drive.B] if len(drive.J) else [drive.J_rigid]
+    p += [{"D_m": drive.D_m, "f_c": drive.f_c}[name] for name in fitted_friction(record)]
     if record.load != "none":
         p.append(drive.tau_load)
     return np.array(p, dtype=float)
@@ -132,10 +153,15 @@ def refine(
         :func:`parameter_names`) with standard errors; ``extra`` holds the criterion,
         the innovations' variance, the friction and the load.
     """
-    chain = np.asarray(start.values[: 3 * n], dtype=float).copy()
-    floor = 1e-3 * np.mean(chain[2 * n :]) if np.any(chain[2 * n :] > 0) else 1e-9
-    chain[2 * n :] = np.maximum(chain[2 * n :], floor)
-    first = pack(Drive(chain[:n], chain[n : 2 * n], chain[2 * n :], record.D_m, record.f_c), record)
+    chain = np.asarray(start.values[: chain_size(n)], dtype=float).copy()
+    if n:
+        floor = 1e-3 * np.mean(chain[2 * n :]) if np.any(chain[2 * n :] > 0) else 1e-9
+        chain[2 * n :] = np.maximum(chain[2 * n :], floor)
+    rigid = 0.0 if n else float(chain[0])
+    first = pack(
+        Drive(chain[:n], chain[n : 2 * n], chain[2 * n :], record.D_m, record.f_c, 0.0, rigid),
+        record,
+    )
     values, residual, jac, evaluations = _least_squares(record, first, n)
     drive = unpack(values, n, record)
     with np.errstate(all="ignore"):
@@ -153,11 +179,14 @@ def refine(
     std = np.sqrt(np.clip(np.diag(newey_west_covariance(jac, residual, lag)), 0.0, None))
     extra = {
         **start.extra,
+        "bounds": at_bound(parameter_names(n, record), values, std, first),
         "information_criterion": innovation_criterion(residual, len(values)),
         "start_fit": start.as_dict(),
         "innovation_variance": float(np.mean(residual**2)),
+        "innovation_count": len(residual),
         "torque_std": record.torque_std,
         "friction": "given" if record.friction_given else "fitted",
+        "friction_form": "given" if record.friction_given else record.friction_form,
         "load": record.load,
         "D_m": drive.D_m,
         "f_c": drive.f_c,
@@ -167,7 +196,7 @@ def refine(
         load = drive.tau_load + states[:, -1]
         extra["load_torque_range"] = [float(load.min()), float(load.max())]
     rms = start.rms_residual
-    if motor is not None:
+    if motor is not None and n:
         tau_residual = predict(motor, drive.J, drive.k, drive.B) - motor.tau_hat
         rms = float(np.sqrt(np.mean(tau_residual**2)))
     return ParameterFit(
@@ -183,6 +212,27 @@ def refine(
         evaluations=start.evaluations + evaluations + more,
         extra=extra,
     )
+
+
+def at_bound(
+    names: list[str], values: np.ndarray, std: np.ndarray, first: np.ndarray
+) -> dict[str, float]:
+    """The parameters at their lower bound 0 (a damping, D_m, f_c), each with the
+    upper bound the record allows: its value + 2σ, or its start when σ is degenerate
+    (0: the record does not resolve it). Units: each parameter's own.
+
+    Examples
+    --------
+    >>> at_bound(["B[1]", "D_m"], np.array([1e-5, 1e-15]), np.array([1e-6, 0.0]),
+    ...          np.array([1e-5, 3e-6]))
+    {'D_m': 3e-06}
+    """
+    out = {}
+    for name, value, sigma, start in zip(names, values, std, first):
+        if name[0] in "BDf" and value <= 1e-6 * max(abs(start), 1e-12):
+            resolved = sigma > 1e-6 * abs(start)
+            out[name] = float(value + 2.0 * sigma) if resolved else float(abs(start))
+    return out
 
 
 def innovation_criterion(innovations: np.ndarray, parameters: int) -> float:

@@ -44,8 +44,9 @@ class Drive:
         The masses each hang on their own spring and damper from the motor (a flexible
         link's modes, :meth:`arcosim.identification.beam_model.ModalModel.star`)
         instead of the chain's k_1 from the motor to J_1, k_2 from J_1 to J_2, ….
-    J_hub : float
-        Inertia rigid on the motor besides the record's J_m (kg·m²).
+    J_rigid : float
+        Inertia rigid on the motor besides the record's J_m (kg·m²): the load of a rigid
+        drive (n = 0, ``J_total − J_m``), a link's part rigid on the hub; 0 for a chain.
     """
 
     J: np.ndarray
@@ -55,7 +56,7 @@ class Drive:
     f_c: float
     tau_load: float = 0.0
     star: bool = False
-    J_hub: float = 0.0
+    J_rigid: float = 0.0
 
     def coupling(self, values: np.ndarray) -> np.ndarray:
         """Stiffness (``values`` = k) or damping (``values`` = B) matrix on the angles
@@ -191,10 +192,11 @@ def innovations(record: EncoderRecord, drive: Drive) -> np.ndarray:
 def discrete_drive(record: EncoderRecord, drive: Drive) -> tuple[np.ndarray, np.ndarray]:
     """Motor + chain over one step of ``record`` (its step, motor inertia and load
     model) for ``drive``: state ``[θ_m, θ_1…θ_n, ω_m, ω_1…ω_n]`` (rad, rad/s; then the
-    slow load's random walk, N·m), inputs (motor torque, load torque on the last mass;
+    slow load's random walk, N·m; n = 0: the rigid drive, its load inertia on the
+    motor), inputs (motor torque, load torque on the last mass;
     N·m) held over the step. Returns ``(A, Bd)``, shapes ``(S, S)`` and ``(S, 2)``."""
     m = len(drive.J) + 1
-    inverse = 1.0 / np.array([record.J_m + drive.J_hub, *drive.J])
+    inverse = 1.0 / np.array([record.J_m + drive.J_rigid, *drive.J])
     K = drive.coupling(drive.k)
     C = drive.coupling(drive.B)
     C[0, 0] += drive.D_m

@@ -287,7 +287,7 @@ def _modes(
         decision.problems.append(str(error))
         return
     decision.detected = detected
-    why = refusal(detected, masses, record)
+    why = refusal(detected, masses, record, decision.encoder is not None)
     if why:
         decision.problems.append(why)
     for w, t in detected.weak:

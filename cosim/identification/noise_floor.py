@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.output_error import predict
+from arcosim.identification.output_error import predict, rigid_predict
 from arcosim.identification.records import motor_record
 
 #: A residual this many times the noise floor (dimensionless) warns. Noise alone gives
@@ -73,6 +73,7 @@ def noise_floor(
     J_m: float,
     encoder_cpr: int,
     g_dist: float,
+    J_load: float = 0.0,
 ) -> tuple[float, float]:
     """The RMS τ̂ residual (N·m) the encoder's counts and the current's noise alone leave.
 
@@ -83,7 +84,8 @@ def noise_floor(
     i_a : ndarray
         The logged current (A), shape ``(N,)``: its noise is estimated from it.
     chain : tuple of three sequences of float
-        The fitted J_i (kg·m²), k_i (N·m/rad), B_i (N·m·s/rad).
+        The fitted J_i (kg·m²), k_i (N·m/rad), B_i (N·m·s/rad); empty for a rigid
+        drive (n = 0).
     k_t : float
         Torque constant (N·m/A).
     J_m : float
@@ -92,6 +94,8 @@ def noise_floor(
         Encoder counts per revolution (a count); 0: no rounding.
     g_dist : float
         Bandwidth of the disturbance observer (rad/s).
+    J_load : float
+        A rigid drive's load inertia J_total − J_m (kg·m²), used when ``chain`` is empty.
 
     Returns
     -------
@@ -106,7 +110,8 @@ def noise_floor(
     current = sigma_i * rng.standard_normal(len(time))
     omega = np.concatenate([[0.0], np.diff(theta)]) / float(np.mean(np.diff(time)))
     record = motor_record(time, current, omega, theta, Actuator(J_m, k_t), g_dist)
-    residual = predict(record, *chain) - record.tau_hat
+    model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
+    residual = model - record.tau_hat
     return float(np.sqrt(np.mean(residual**2))), sigma_i
 
 

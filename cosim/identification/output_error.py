@@ -79,6 +79,24 @@ def predict(
     return np.concatenate([[0.0], through_g(torque, record.g_dist, record.h)])
 
 
+def rigid_predict(record: MotorRecord, J_load: float) -> np.ndarray:
+    """τ̂_reac a load inertia ``J_load`` (kg·m²) rigidly on the motor would give on
+    ``record`` (n = 0): ``G[J_load Δω / h]``, with the velocity the DOB was given (its
+    own acceleration). Shape ``(N,)``, N·m.
+
+    Raises
+    ------
+    ValueError
+        For a record that did not keep its velocity.
+    """
+    if record.velocity is None:
+        raise ValueError("the rigid drive's τ̂ needs the record's velocity")
+    accel = np.concatenate([[0.0], np.diff(record.velocity) / record.h])
+    torque = through_g(J_load * accel, record.g_dist, record.h)
+    torque[0] = 0.0
+    return torque
+
+
 @dataclass
 class ParameterFit:
     """Fitted parameters with their standard errors and the evidence behind them: the

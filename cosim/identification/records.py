@@ -43,6 +43,9 @@ class MotorRecord:
         The DOB bandwidth used for ``tau_hat`` (rad/s).
     velocity_source : str
         Which motor velocity the DOB was given (a sentence for the report).
+    velocity : ndarray or None
+        That velocity (rad/s), shape ``(N,)``: the rigid drive's prediction of τ̂ reads
+        its differences as the DOB does; None when not kept.
     """
 
     h: float
@@ -50,6 +53,7 @@ class MotorRecord:
     tau_hat: np.ndarray
     g_dist: float
     velocity_source: str = "measured"
+    velocity: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -175,7 +179,7 @@ def motor_record(
             f"(at most {MAX_TORQUE:g}): check J_m, k_t, g_dist and the units of the log's "
             "columns"
         )
-    return MotorRecord(h, np.asarray(theta_m, dtype=float), tau, g_dist, source)
+    return MotorRecord(h, np.asarray(theta_m, dtype=float), tau, g_dist, source, velocity)
 
 
 def is_backward_difference(theta_m: np.ndarray, omega_m: np.ndarray, h: float) -> bool:
@@ -207,6 +211,7 @@ def motor_opening(record: MotorRecord, seconds: float) -> MotorRecord:
         record.tau_hat[:count],
         record.g_dist,
         record.velocity_source,
+        None if record.velocity is None else record.velocity[:count],
     )
 
 
@@ -215,6 +220,9 @@ TORQUE_STD_FLOOR = 1e-4
 
 #: Load choices: none, a constant torque, or a constant plus a slow random walk.
 LOADS = ("none", "constant", "slow")
+
+#: Friction forms a fit of an unknown friction may carry (viscous: D_m, Coulomb: f_c).
+FRICTION_FORMS = ("none", "viscous", "coulomb", "both")
 
 #: Random walk of a ``"slow"`` load (N·m per √s), relative to the rms drive torque.
 LOAD_DRIFT = 0.05
@@ -252,6 +260,9 @@ class EncoderRecord:
         Random walk of a ``"slow"`` load (N·m per step).
     friction_sign : ndarray or None
         s_k over each step (−1 … 1, dimensionless), shape ``(N,)``; None: sgn(velocity).
+    friction_form : str
+        Which of D_m, f_c a fit of an unknown friction carries (one of
+        :data:`FRICTION_FORMS`); the others stay at their value here (0).
     """
 
     h: float
@@ -267,6 +278,7 @@ class EncoderRecord:
     load: str = "none"
     load_std: float = 0.0
     friction_sign: np.ndarray | None = None
+    friction_form: str = "both"
 
     @property
     def sign(self) -> np.ndarray:

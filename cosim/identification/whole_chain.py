@@ -32,10 +32,10 @@ import numpy as np
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import refine
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.fit_notes import assumptions, missing_modes
 from arcosim.identification.modal_start import (
     DetectedModes,
     Modes,
-    chain_of,
     detect_modes,
     modal_damping,
     record_modes,
@@ -51,6 +51,16 @@ from arcosim.identification.records import (
     MotorRecord,
     encoder_opening,
     with_friction,
+)
+from arcosim.identification.rigid_drive import rigid_fit
+from arcosim.identification.structure_choice import (
+    RULE,
+    Candidate,
+    candidate_of,
+    choose,
+    friction_form,
+    load_check,
+    scores,
 )
 
 #: Largest chain ``masses="auto"`` tries.
@@ -197,7 +207,8 @@ def identify_whole_chain(
     record : MotorRecord
         The log's reaction-torque record (:func:`~arcosim.motor_record`).
     masses : int or "auto"
-        Number of load masses (a count), or ``"auto"``.
+        Number of load masses (a count; 0: a rigid drive, fitted as ``J_load`` =
+        J_total − J_m with the friction), or ``"auto"`` (0 included).
     encoder : EncoderRecord, optional
         The same log's current → encoder record (:func:`~arcosim.encoder_record`).
 
@@ -210,8 +221,9 @@ def identify_whole_chain(
     Raises
     ------
     IdentificationError
-        When ``masses`` is neither a positive integer nor ``"auto"``, or the record
-        cannot support the chain asked for.
+        When ``masses`` is neither a whole number ≥ 0 nor ``"auto"``, or the record
+        cannot support the chain asked for (it shows fewer modes than asked; n = 0, the
+        rigid drive, needs the encoder record).
 
     Examples
     --------
@@ -243,6 +255,13 @@ def identify_whole_chain(
             encoder = with_friction(encoder, D_m, f_c)
             detected = again
             n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    selection: dict = {"rule": RULE, "masses": {str(m): v for m, v in criterion.items()}}
+    if encoder is not None:
+        result, selection["friction"] = friction_form(record, encoder, n, result, CONFIRM_SECONDS)
+        selection["load"], load_warning = load_check(encoder, n, result, CONFIRM_SECONDS)
+        if load_warning:
+            result.extra.setdefault("structure_warnings", []).append(load_warning)
+    result.extra["selection"] = selection
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
@@ -253,7 +272,8 @@ def identify_whole_chain(
             f"{T_CONFIRM:g}); the information criterion chose {n} masses"
             for w, t in zip(detected.frequency, detected.t_value)
             if t < T_CONFIRM
-        ],
+        ]
+        + result.extra.get("structure_warnings", []),
     )
     refused = {}
     if detected.weak:
@@ -281,7 +301,7 @@ def first_reading(
     check_excited(record)
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     detected = detect_modes(record, largest)
-    if encoder is not None and not encoder.friction_given and detected.n:
+    if encoder is not None and not encoder.friction_given and detected.n and n_asked != 0:
         # τ̂ was computed without friction: take it out, read the modes again
         modes = _strongest(detected, detected.n if auto else min(n_asked, detected.n))
         record, D_m, f_c, detected = friction_cleaned(record, encoder, modes, largest)
@@ -289,13 +309,21 @@ def first_reading(
     return record, encoder, detected
 
 
-def refusal(detected: DetectedModes, masses: int | str, record: MotorRecord) -> str | None:
+def refusal(
+    detected: DetectedModes, masses: int | str, record: MotorRecord, encoder: bool = True
+) -> str | None:
     """Why the modes read cannot support ``masses`` (a count, or ``"auto"``), or None:
-    the one rule :func:`identify_whole_chain` refuses by and ``check`` judges by."""
+    the one rule :func:`identify_whole_chain` refuses by and ``check`` judges by.
+
+    An n asked for is refused only when the record shows fewer modes (weak ones are
+    fitted with a warning); n = 0, the rigid drive, needs the encoder record
+    (``encoder``); without it, ``auto`` refuses a record whose modes are all weak."""
     n = detected.n if masses == "auto" else int(masses)
-    if n < 1 or detected.n < n:
-        return missing_modes(detected, n if n >= 1 else None, record)
-    if float(np.max(detected.t_value)) < T_CONFIRM:
+    if n > detected.n:
+        return missing_modes(detected, n, record)
+    if n == 0 and not encoder:
+        return missing_modes(detected, None, record) + RIGID_NEEDS
+    if not encoder and masses == "auto" and float(np.max(detected.t_value)) < T_CONFIRM:
         t = ", ".join(f"{t:.0f}" for t in detected.t_value)
         why = f"residue t values {t}, all under {T_CONFIRM:g}"
         return f"every mode the record shows is weakly determined ({why}): " + missing_modes(
@@ -340,36 +368,65 @@ def _choose_and_fit(
     auto: bool,
     n_asked: int | None,
 ) -> tuple[int, ParameterFit, dict[int, float]]:
-    """n (read, or asked and checked), the fit, and the criterion per n tried."""
+    """n (read, or asked and checked), the fit, and the criterion per n tried.
+
+    ``auto`` starts from the modes the record shows (all of them, weak ones too) and
+    drops the weakest one at a time while the information criterion falls, down to the
+    rigid drive (n = 0). An n asked for is fitted when the record shows that many
+    modes (weak ones with a warning, the caller's) and refused when it does not."""
     n = detected.n if auto else n_asked
-    why = refusal(detected, "auto" if auto else n_asked, record)
+    why = refusal(detected, "auto" if auto else n_asked, record, encoder is not None)
     if why:
         raise IdentificationError(why)
     criterion: dict[int, float] = {}
+    if n == 0:
+        return 0, rigid_fit(encoder, record), criterion
     if encoder is None:
         result = fit_chain(record, n, _strongest(detected, n))
         criterion[n] = information_criterion(result, record)
         return n, result, criterion
-    if auto and n >= 2:
-        # the data decide: BIC of the fits without the weakest modes, on the record's
-        # first CONFIRM_SECONDS, as long as dropping one more lowers it (a pole of the
-        # noise or of an excitation line adds nothing to the prediction of the encoder)
-        short = encoder_opening(encoder, CONFIRM_SECONDS)
-
-        def bic(m: int) -> float:
-            try:
-                trial = _prediction_error(None, short, _strongest(detected, m))
-                return trial.extra["information_criterion"]
-            except (IdentificationError, ValueError, np.linalg.LinAlgError):
-                return float("inf")  # no chain of m masses fits the opening
-
-        criterion[n] = bic(n)
-        while n >= 2:
-            criterion[n - 1] = bic(n - 1)
-            if not criterion[n - 1] < criterion[n]:
-                break
-            n -= 1
+    if auto:
+        n, criterion = _auto_masses(encoder, detected)
+        if n == 0:
+            return 0, rigid_fit(encoder, record), criterion
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
+
+
+def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, dict]:
+    """n by the rule (:mod:`~arcosim.identification.structure_choice`) on the record's
+    first :data:`CONFIRM_SECONDS`: from the modes seen, the weakest dropped one at a
+    time as long as the rule prefers the chain without it, down to the rigid drive (a
+    pole of the noise or of an excitation line adds nothing to the prediction of the
+    encoder). Returns n and, per n tried, its scores."""
+    short = encoder_opening(encoder, CONFIRM_SECONDS)
+
+    def candidate(m: int) -> Candidate | None:
+        try:
+            if m == 0:
+                trial = rigid_fit(short, None)
+            else:
+                trial = _prediction_error(None, short, _strongest(detected, m))
+        except (IdentificationError, ValueError, np.linalg.LinAlgError):
+            return None  # no chain of m masses fits the opening
+        return candidate_of(f"n={m}", trial)
+
+    n = detected.n
+    tried = {n: candidate(n)}
+    while n >= 1:
+        tried[n - 1] = candidate(n - 1)
+        pair = [c for c in (tried[n - 1], tried[n]) if c is not None]
+        if not pair or choose(pair).name != f"n={n - 1}":
+            break
+        n -= 1
+    table = scores([c for c in tried.values() if c is not None])
+    return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
+
+
+#: Why a rigid drive needs the encoder's counts (appended to the refusal).
+RIGID_NEEDS = (
+    "; a rigid drive (n = 0) is fitted from the current to the encoder: give the "
+    "encoder's counts per revolution (encoder_cpr)"
+)
 
 
 def _strongest(detected: DetectedModes, n: int) -> Modes:
@@ -394,57 +451,13 @@ def _mode_evidence(modes: Modes) -> dict:
     }
 
 
-def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
-    """What the result is conditional on, one line each (for the report)."""
-    scale = (
-        "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
-        "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
-        "homogeneous in torque); one of them alone off distorts the chain unevenly, by "
-        "up to about 1.5 ε (measured on a five-mass chain: k_t +5 % gave J_i, k_i "
-        "−1.5 … +7.3 %, J_m +5 % gave −0.5 … +4.2 %)"
-    )
-    out = {"actuator": scale}
-    if encoder is None:
-        out["fit"] = "output-error fit to τ̂_reac (no encoder counts given: encoder_cpr = 0)"
-        return out
-    out["encoder"] = f"{2 * np.pi / encoder.count:.0f} counts per revolution, error q²/12"
-    if encoder.friction_given:
-        out["friction"] = f"given: D_m = {encoder.D_m:.4g} N·m·s/rad, f_c = {encoder.f_c:.4g} N·m"
-    else:
-        out["friction"] = "fitted (D_m, f_c with standard errors)"
-    out["load"] = {
-        "none": "no load torque modelled",
-        "constant": "a constant load torque on the last mass, fitted",
-        "slow": "a constant plus slowly varying load torque on the last mass, fitted",
-    }[encoder.load]
-    return out
-
-
-def missing_modes(detected: DetectedModes, n: int | None, record: MotorRecord) -> str:
-    """Why the record cannot support n masses (n None: not even one), and what to do."""
-    found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
-    text = (
-        f"the record shows {detected.n} excited mode(s) below {detected.band:.0f} rad/s "
-        f"({found} rad/s)"
-    )
-    if n is not None:
-        text += f", {chain_of(n)} has {n}"
-    if detected.weak:
-        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
-        text += f"; seen but too weakly excited: {weak}"
-    return text + (
-        ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
-        "lines on both sides of each mode, up to the band; a longer record; a finer "
-        f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
-        "see `arcosim.design_excitation`, or fit fewer masses"
-    )
-
-
 def _masses(masses: int | str) -> int:
     try:
         n = int(masses)
     except ValueError:
-        n = 0
-    if n < 1 or str(masses).strip() not in (str(n), "auto"):
-        raise IdentificationError(f"--masses must be a whole number ≥ 1 or 'auto', got {masses!r}")
+        n = -1
+    if n < 0 or str(masses).strip() not in (str(n), "auto"):
+        raise IdentificationError(
+            f"--masses must be a whole number ≥ 0 (0: a rigid drive) or 'auto', got {masses!r}"
+        )
     return n

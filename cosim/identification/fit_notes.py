@@ -1,0 +1,56 @@
+"""The sentences a whole-chain result carries (offline): what it rests on
+(:func:`assumptions`) and why a record cannot support a chain (:func:`missing_modes`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from arcosim.identification.modal_start import DetectedModes, chain_of
+from arcosim.identification.records import EncoderRecord, MotorRecord
+
+
+def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
+    """What the result is conditional on, one line each (for the report)."""
+    scale = (
+        "k_t and J_m are given, not fitted: if both are off by a relative ε, every J_i, "
+        "k_i, B_i (and D_m, f_c, the load torque) is off by the same ε (the model is "
+        "homogeneous in torque); one of them alone off distorts the chain unevenly, by "
+        "up to about 1.5 ε (measured on a five-mass chain: k_t +5 % gave J_i, k_i "
+        "−1.5 … +7.3 %, J_m +5 % gave −0.5 … +4.2 %)"
+    )
+    out = {"actuator": scale}
+    if encoder is None:
+        out["fit"] = "output-error fit to τ̂_reac (no encoder counts given: encoder_cpr = 0)"
+        return out
+    out["encoder"] = f"{2 * np.pi / encoder.count:.0f} counts per revolution, error q²/12"
+    if encoder.friction_given:
+        out["friction"] = f"given: D_m = {encoder.D_m:.4g} N·m·s/rad, f_c = {encoder.f_c:.4g} N·m"
+    else:
+        out["friction"] = "fitted (D_m, f_c with standard errors)"
+    out["load"] = {
+        "none": "no load torque modelled",
+        "constant": "a constant load torque on the last mass, fitted",
+        "slow": "a constant plus slowly varying load torque on the last mass, fitted",
+    }[encoder.load]
+    return out
+
+
+def missing_modes(detected: DetectedModes, n: int | None, record: MotorRecord) -> str:
+    """Why the record cannot support n masses (n None: not even one), and what to do."""
+    found = ", ".join(f"{w:.1f}" for w in detected.frequency) or "none"
+    text = (
+        f"the record shows {detected.n} excited mode(s) below {detected.band:.0f} rad/s "
+        f"({found} rad/s)"
+    )
+    if n is not None:
+        text += f", {chain_of(n)} has {n}"
+    if detected.weak:
+        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
+        text += f"; seen but too weakly excited: {weak}"
+    return text + (
+        ": excite every mode (more current per line: fewer lines, or a higher amplitude; "
+        "lines on both sides of each mode, up to the band; a longer record; a finer "
+        f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
+        "see `arcosim.design_excitation`, or fit fewer masses"
+    )

@@ -1,0 +1,140 @@
+"""Structure chosen by evidence (issue 25): the rigid drive (n = 0), the selection rule on
+the final fit, parameters at a bound, and decisions that do not flip when the user
+restates a value the tool fitted. The independent simulator
+(:mod:`benchmarks.field_sim`) writes every log."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from arcosim.fmu.flexchain import defaults
+from arcosim.identification.drive import identify_drive
+from arcosim.identification.errors import IdentificationError
+from benchmarks import field_sim
+
+LINES = np.geomspace(3.0, 150.0, 40)
+#: A ball-screw axis: the table's inertia rigidly on the motor, no mode in the band.
+J_LOAD = 6e-4
+
+
+def rigid(**kw) -> field_sim.Drive:
+    base = dict(J_m=defaults.J_M + J_LOAD, k_t=defaults.K_T, D_m=defaults.D_M, f_c=defaults.F_C)
+    base.update(J=(), k=(), B=(), current_noise=0.005)
+    base.update(kw)
+    return field_sim.Drive(**base)
+
+
+def identify(d: field_sim.Drive, log: field_sim.Log, friction_given=False, **kw):
+    friction = {"D_m": d.D_m, "f_c": d.f_c} if friction_given else {}
+    return identify_drive(
+        log.time,
+        log.i_a,
+        log.omega_m,
+        log.theta_m,
+        k_t=d.k_t,
+        J_m=defaults.J_M,
+        encoder_cpr=d.counts,
+        **friction,
+        **kw,
+    )
+
+
+@pytest.fixture(scope="module")
+def rigid_log() -> tuple[field_sim.Drive, field_sim.Log]:
+    d = rigid()
+    return d, field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))
+
+
+def test_a_rigid_drive_is_n_0_with_its_load_inertia_and_friction(rigid_log) -> None:
+    """auto includes n = 0: no refusal "excite every mode"; J_total − J_m within 0.5 %,
+    f_c within 5 % (its 2σ: the test below)."""
+    d, log = rigid_log
+    result = identify(d, log)
+    assert result.masses == 0
+    values, std = result.parameters, result.std
+    assert values["J_load"] == pytest.approx(J_LOAD, rel=5e-3) and std["J_load"] > 0
+    bounds = result.report()["bounds"]
+    assert "f_c" not in bounds and values["f_c"] == pytest.approx(d.f_c, rel=0.05)
+    # the observer takes the load as motor inertia (no chain to estimate)
+    assert result.observer_parameters()["dJm"] == values["J_load"]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="measured: the rigid fit's D_m comes out ≈ 0 ± 5e-7 (true 2e-5) with friction "
+    "unknown, f_c +3 % ± 0.6 %: the bound the rule reports misses D_m; open",
+)
+def test_the_rigid_drive_friction_is_covered(rigid_log) -> None:
+    d, log = rigid_log
+    result = identify(d, log)
+    bounds, values, std = result.report()["bounds"], result.parameters, result.std
+    for name, truth in (("D_m", d.D_m), ("f_c", d.f_c)):
+        if name in bounds:
+            assert truth <= bounds[name], name
+        else:
+            assert abs(values[name] - truth) <= 2 * std[name], name
+
+
+def test_masses_0_is_accepted(rigid_log) -> None:
+    d, log = rigid_log
+    result = identify(d, log, friction_given=True, masses=0)
+    assert result.masses == 0 and "J_load" in result.report()
+
+
+def test_masses_below_0_are_refused(rigid_log) -> None:
+    d, log = rigid_log
+    with pytest.raises(IdentificationError, match="≥ 0"):
+        identify(d, log, masses=-1)
+
+
+THREE = dict(J=(3e-4, 5e-4, 4e-4), k=(0.25, 0.4, 0.15), B=(1.2e-5, 1.5e-5, 6e-6))
+
+
+def chain(**kw) -> field_sim.Drive:
+    base = dict(J_m=defaults.J_M, k_t=defaults.K_T, D_m=defaults.D_M, f_c=defaults.F_C)
+    base.update(THREE, current_noise=0.005)
+    base.update(kw)
+    return field_sim.Drive(**base)
+
+
+@pytest.mark.slow
+def test_restating_the_fitted_friction_never_changes_the_decision() -> None:
+    """The flexible link's flip: accepted with the friction fitted, refused when the
+    user passed back the D_m, f_c the tool fitted. Here: the same n either way, and the
+    friction form and the candidates' scores in the report."""
+    d = chain()
+    log = field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))
+    fitted = identify_drive(
+        log.time, log.i_a, log.omega_m, log.theta_m, k_t=d.k_t, J_m=d.J_m, encoder_cpr=d.counts
+    )
+    friction = {k: fitted.parameters[k] for k in ("D_m", "f_c") if k in fitted.parameters}
+    friction = {"D_m": 0.0, "f_c": 0.0} | friction
+    restated = identify_drive(
+        log.time,
+        log.i_a,
+        log.omega_m,
+        log.theta_m,
+        k_t=d.k_t,
+        J_m=d.J_m,
+        encoder_cpr=d.counts,
+        **friction,
+    )
+    assert fitted.masses == restated.masses == 3
+    selection = fitted.report()["selection"]
+    assert set(selection["friction"]["candidates"]) == {"none", "viscous", "coulomb", "both"}
+    assert "BIC on the effective sample count" in selection["rule"]
+    np.testing.assert_allclose([restated.parameters[f"k[{i}]"] for i in (1, 2, 3)], d.k, rtol=5e-3)
+
+
+def test_a_rigid_drive_chain_file_says_what_the_observer_takes(tmp_path) -> None:
+    """A rigid drive's report has no chain: reading it as one names the --set that
+    gives the observer its load (dJm = J_load) instead of "must be 1 to 20"."""
+    import json
+
+    from arcosim.chainfile import ChainFileError, read_chain
+
+    path = tmp_path / "rigid.json"
+    path.write_text(json.dumps({"masses": 0, "J_load": 6e-4, "D_m": 2e-5, "f_c": 2e-3}))
+    with pytest.raises(ChainFileError, match=r"rigid drive.*--set dJm=0\.0006"):
+        read_chain(path)
