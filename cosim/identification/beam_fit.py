@@ -42,7 +42,7 @@ from arcosim.identification.modal_start import DetectedModes, detect_modes
 from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
 from arcosim.identification.output_error import SCAN_SECONDS, ParameterFit
 from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_opening
-from arcosim.identification.whole_chain import T_CONFIRM, missing_modes
+from arcosim.identification.fit_notes import T_CONFIRM, missing_modes
 
 #: Damping ratio every mode starts from (dimensionless).
 START_ZETA = 0.01

@@ -1,5 +1,6 @@
 """The sentences a whole-chain result carries (offline): what it rests on
-(:func:`assumptions`) and why a record cannot support a chain (:func:`missing_modes`).
+(:func:`assumptions`), why a record cannot support a chain (:func:`missing_modes`), and
+the one rule the fit refuses by and ``check`` judges by (:func:`refusal`).
 """
 
 from __future__ import annotations
@@ -8,6 +9,16 @@ import numpy as np
 
 from arcosim.identification.modal_start import DetectedModes, chain_of
 from arcosim.identification.records import EncoderRecord, MotorRecord
+
+#: A mode whose residue is below this many standard errors is reported as weakly
+#: determined (the result's warnings).
+T_CONFIRM = 30.0
+
+#: Why a rigid drive needs the encoder's counts (appended to the refusal).
+RIGID_NEEDS = (
+    "; a rigid drive (n = 0) is fitted from the current to the encoder: give the "
+    "encoder's counts per revolution (encoder_cpr)"
+)
 
 
 def assumptions(encoder: EncoderRecord | None) -> dict[str, str]:
@@ -54,3 +65,27 @@ def missing_modes(detected: DetectedModes, n: int | None, record: MotorRecord) -
         f"encoder; band = min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s), "
         "see `arcosim.design_excitation`, or fit fewer masses"
     )
+
+
+def refusal(
+    detected: DetectedModes, masses: int | str, record: MotorRecord, encoder: bool = True
+) -> str | None:
+    """Why the modes read cannot support ``masses`` (a count, or ``"auto"``), or None:
+    the one rule :func:`~arcosim.identification.whole_chain.identify_whole_chain`
+    refuses by and ``check`` judges by.
+
+    An n asked for is refused only when the record shows fewer modes (weak ones are
+    fitted with a warning); n = 0, the rigid drive, needs the encoder record
+    (``encoder``); without it, ``auto`` refuses a record whose modes are all weak."""
+    n = detected.n if masses == "auto" else int(masses)
+    if n > detected.n:
+        return missing_modes(detected, n, record)
+    if n == 0 and not encoder:
+        return missing_modes(detected, None, record) + RIGID_NEEDS
+    if not encoder and masses == "auto" and float(np.max(detected.t_value)) < T_CONFIRM:
+        t = ", ".join(f"{t:.0f}" for t in detected.t_value)
+        why = f"residue t values {t}, all under {T_CONFIRM:g}"
+        return f"every mode the record shows is weakly determined ({why}): " + missing_modes(
+            detected, None, record
+        )
+    return None

@@ -32,7 +32,12 @@ import numpy as np
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import refine
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.fit_notes import assumptions, missing_modes
+from arcosim.identification.fit_notes import (
+    T_CONFIRM,
+    assumptions,
+    missing_modes,
+    refusal,
+)
 from arcosim.identification.modal_start import (
     DetectedModes,
     Modes,
@@ -65,9 +70,6 @@ from arcosim.identification.structure_choice import (
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
-#: A mode whose residue is below this many standard errors is reported as weakly
-#: determined (the result's warnings).
-T_CONFIRM = 30.0
 #: Length (s) of the opening the order check's fits run on (``auto``: the n modes seen,
 #: then without the weakest, one at a time while the BIC falls).
 CONFIRM_SECONDS = 5.0
@@ -309,29 +311,6 @@ def first_reading(
     return record, encoder, detected
 
 
-def refusal(
-    detected: DetectedModes, masses: int | str, record: MotorRecord, encoder: bool = True
-) -> str | None:
-    """Why the modes read cannot support ``masses`` (a count, or ``"auto"``), or None:
-    the one rule :func:`identify_whole_chain` refuses by and ``check`` judges by.
-
-    An n asked for is refused only when the record shows fewer modes (weak ones are
-    fitted with a warning); n = 0, the rigid drive, needs the encoder record
-    (``encoder``); without it, ``auto`` refuses a record whose modes are all weak."""
-    n = detected.n if masses == "auto" else int(masses)
-    if n > detected.n:
-        return missing_modes(detected, n, record)
-    if n == 0 and not encoder:
-        return missing_modes(detected, None, record) + RIGID_NEEDS
-    if not encoder and masses == "auto" and float(np.max(detected.t_value)) < T_CONFIRM:
-        t = ", ".join(f"{t:.0f}" for t in detected.t_value)
-        why = f"residue t values {t}, all under {T_CONFIRM:g}"
-        return f"every mode the record shows is weakly determined ({why}): " + missing_modes(
-            detected, None, record
-        )
-    return None
-
-
 def _prediction_error(
     record: MotorRecord | None, encoder: EncoderRecord, modes: Modes
 ) -> ParameterFit:
@@ -420,13 +399,6 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
         n -= 1
     table = scores([c for c in tried.values() if c is not None])
     return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
-
-
-#: Why a rigid drive needs the encoder's counts (appended to the refusal).
-RIGID_NEEDS = (
-    "; a rigid drive (n = 0) is fitted from the current to the encoder: give the "
-    "encoder's counts per revolution (encoder_cpr)"
-)
 
 
 def _strongest(detected: DetectedModes, n: int) -> Modes:
