@@ -37,12 +37,12 @@ from arcosim.identification.beam_model import Link, ModalModel, modal_model, mod
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import innovation_criterion, stuck_aware_sign
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.fit_notes import T_CONFIRM, missing_modes
 from arcosim.identification.kalman import Drive, Kalman, innovations
 from arcosim.identification.modal_start import DetectedModes, detect_modes
 from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
 from arcosim.identification.output_error import SCAN_SECONDS, ParameterFit
 from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_opening
-from arcosim.identification.fit_notes import T_CONFIRM, missing_modes
 
 #: Damping ratio every mode starts from (dimensionless).
 START_ZETA = 0.01

@@ -96,7 +96,7 @@ def unpack(p: np.ndarray, n: int, record: EncoderRecord) -> Drive:
         j += 1
     D_m, f_c = friction["D_m"], friction["f_c"]
     tau = p[j] if record.load != "none" else 0.0
-    return Drive(J, k, B, float(D_m), float(f_c), float(tau), rigid)
+    return Drive(J, k, B, float(D_m), float(f_c), float(tau), J_rigid=rigid)
 
 
 def pack(drive: Drive, record: EncoderRecord) -> np.ndarray:
@@ -159,7 +159,9 @@ def refine(
         chain[2 * n :] = np.maximum(chain[2 * n :], floor)
     rigid = 0.0 if n else float(chain[0])
     first = pack(
-        Drive(chain[:n], chain[n : 2 * n], chain[2 * n :], record.D_m, record.f_c, 0.0, rigid),
+        Drive(
+            chain[:n], chain[n : 2 * n], chain[2 * n :], record.D_m, record.f_c, 0.0, J_rigid=rigid
+        ),
         record,
     )
     values, residual, jac, evaluations = _least_squares(record, first, n)

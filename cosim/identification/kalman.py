@@ -12,7 +12,7 @@ the fit's second pass).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 import scipy.linalg
@@ -55,6 +55,7 @@ class Drive:
     D_m: float
     f_c: float
     tau_load: float = 0.0
+    _: KW_ONLY  # the two below by name only: a positional slip would swap them
     star: bool = False
     J_rigid: float = 0.0
 
