@@ -127,7 +127,8 @@ def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS
     Returns
     -------
     list of Path
-        The three FMUs, ``ActionReaction.ssp`` and ``FlexLinkPlant.fmu``.
+        The chain plant, observer, source and controller FMUs, ``ActionReaction.ssp``,
+        ``MotionControl.ssp`` and ``FlexLinkPlant.fmu``.
 
     Examples
     --------
@@ -136,7 +137,8 @@ def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS
     >>> paths = arcosim.build_all(2, Path(tempfile.mkdtemp()) / "fmus")
     >>> [p.name for p in paths]  # doctest: +NORMALIZE_WHITESPACE
     ['MotorChainPlant.fmu', 'ReactionTorqueObserver.fmu', 'ExcitationSource.fmu',
-     'ActionReaction.ssp', 'FlexLinkPlant.fmu']
+     'ActionReactionController.fmu', 'ActionReaction.ssp', 'MotionControl.ssp',
+     'FlexLinkPlant.fmu']
     """
     check_masses(n)
     check_elements(elements)
