@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from arcosim.cli import main
 from arcosim.errors import UserError
 from arcosim.experiments.flexible_link import EXPERIMENT_RIG, LINK_FMU, STEP, simulate_link
 from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
@@ -20,6 +22,7 @@ from arcosim.fmu.flexchain.link_observer import StarLink
 from arcosim.fmu.flexchain.observer import Observer, ObserverSettings
 from arcosim.host.instance import FmuInstance
 from arcosim.identification.beam_model import Link, ModalModel, modal_model, observer_parameters
+from arcosim.logs import write_csv
 
 #: Scores skip the first second (the observer's start from rest, the excitation's).
 SETTLE = 1.0
@@ -113,19 +116,49 @@ def test_tip_angle_online_within_ten_percent_and_the_fmu_runs_the_same(
 
     start = {"J_mo": actuator.J_mo, "k_to": actuator.k_to, "D_m": actuator.D_m}
     start.update(f_c=actuator.f_c, encoder_cpr=settings.encoder_cpr, **parameters)
-    online = np.zeros((len(alpha), 2))
-    with FmuInstance(fmus / "ReactionTorqueObserver.fmu", "observer") as o:
-        o.set({"omega_m": columns[1][0], "theta_m": columns[2][0]})
-        o.initialize(start)
-        read = o.reader(["alpha_tip_hat", "w_tip_hat"])
-        for k in range(1, len(alpha)):
-            o.set({"i_a": columns[0][k], "omega_m": columns[1][k], "theta_m": columns[2][k]})
-            assert o.do_step((k - 1) * STEP, STEP) == 0
-            online[k] = read()
-        assert not o.messages, o.messages
+    online = run_observer_fmu(fmus / "ReactionTorqueObserver.fmu", start, signals)
     assert np.allclose(online[:, 0], alpha, rtol=1e-9, atol=1e-12)
     assert np.allclose(online[:, 1], online[:, 0] * parameters["L_link"], rtol=1e-12)
     assert ratio(online[:, 0], signals["alpha_tip"], plant_run.time) <= 0.1
+
+
+def run_observer_fmu(fmu: Path, start: dict, signals: dict) -> np.ndarray:
+    """The observer FMU over a plant run: ``alpha_tip_hat`` (rad) and ``w_tip_hat`` (m)
+    after each step, shape ``(N, 2)``."""
+    columns = [signals[c].tolist() for c in ("i_a", "omega_m", "theta_m")]
+    tip = np.zeros((len(columns[0]), 2))
+    with FmuInstance(fmu, "observer") as o:
+        o.set({"omega_m": columns[1][0], "theta_m": columns[2][0]})
+        o.initialize(start)
+        read = o.reader(["alpha_tip_hat", "w_tip_hat"])
+        for k in range(1, len(tip)):
+            o.set({"i_a": columns[0][k], "omega_m": columns[1][k], "theta_m": columns[2][k]})
+            assert o.do_step((k - 1) * STEP, STEP) == 0
+            tip[k] = read()
+        assert not o.messages, o.messages
+    return tip
+
+
+@pytest.mark.slow
+def test_the_identified_link_sets_the_observer(fmus: Path, tmp_path, capsys) -> None:
+    """``arcosim identify --method beam --json`` from the hub's log alone; its
+    ``observer_parameters`` set on the observer FMU as they are: the tip angle within
+    10 % of the plant's after the first second."""
+    rig = EXPERIMENT_RIG
+    run = simulate_link(fmus / LINK_FMU, rig, 20.0)
+    units = {"time": "s", "i_a": "A", "omega_m": "rad/s", "theta_m": "rad"}
+    path = write_csv(tmp_path / "link.csv", run.log(), units=units)
+    motor = {"k_to": rig.value("k_t"), "J_mo": rig.value("J_m"), "D_m": rig.value("D_m")}
+    motor.update(f_c=rig.value("f_c"), encoder_cpr=int(rig.value("encoder_cpr")))
+    known = {p: rig.value(p) for p in ("L", "m_tip", "r_hub")}
+    given = [x for name, v in {**motor, **known}.items() for x in ("--set", f"{name}={v}")]
+    assert main(["identify", str(path), *given, "--method", "beam", "--json"]) == 0
+    parameters = json.loads(capsys.readouterr().out)["observer_parameters"]
+    tip = run_observer_fmu(
+        fmus / "ReactionTorqueObserver.fmu", {**motor, **parameters}, run.signals
+    )
+    score = ratio(tip[:, 0], run.signals["alpha_tip"], run.time)
+    assert score <= 0.1, score
 
 
 @pytest.mark.parametrize(
