@@ -168,6 +168,7 @@ def test_the_identified_link_sets_the_observer(fmus: Path, tmp_path, capsys) -> 
         ({"estimator": 1, "link_modes": 5}, "link_modes = 5 is not allowed"),
         ({"estimator": 1, "link_modes": 1, "omega_link[1]": 0.0}, "omega_link[1] = 0.0"),
         ({"estimator": 1, "link_modes": 1, "b_link[1]": 0.0}, "b_link[1] = 0: a mode"),
+        ({"estimator": 1, "link_modes": 1, "omega_link[1]": 2e6}, "omega_link[1] = 2e+06 and"),
         (
             {"estimator": 1, "link_modes": 1, "load_mass": 1},
             "link_modes > 0 and load_mass > 0 exclude each other",

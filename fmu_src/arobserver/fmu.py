@@ -28,7 +28,7 @@ from ..fmukit import (
     par,
     range_problems,
 )
-from ..fmukit.checks import chain_rate_problems
+from ..fmukit.checks import FASTEST_RATE, chain_rate_problems
 
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
 IDENTIFICATION_OUTPUTS = (
@@ -335,6 +335,16 @@ class ReactionTorqueObserver(FmuSlave):
             for name in indexed("b_link", m)
             if self.value(name) == 0.0
         ]
+        if problems:
+            return problems
+        for w, z in zip(indexed("omega_link", m), indexed("zeta_link", m)):
+            fastest = max(self.value(w), 2.0 * self.value(z) * self.value(w))  # rad/s, 1/s
+            if fastest > FASTEST_RATE:
+                problems.append(
+                    f"parameters {w} = {self.value(w):g} and {z} = {self.value(z):g} make a "
+                    f"mode or decay of {fastest:.3g} 1/s; the FMU integrates up to "
+                    f"{FASTEST_RATE:g} (lower link_modes to the modes in band)"
+                )
         return problems
 
     def link(self) -> StarLink | None:
