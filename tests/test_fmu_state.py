@@ -40,6 +40,7 @@ CASES = [
     ("ReactionTorqueObserver", {"mode": 1, "f_c": 2e-3}),
     ("ReactionTorqueObserver", {"mode": 2}),
     ("ReactionTorqueObserver", {"mode": 2, "estimator": 1, "load_mass": 3}),
+    ("ReactionTorqueObserver", {"mode": 2, "estimator": 1, "link_modes": 2}),
     ("ExcitationSource", {"signal": 3}),
     ("ExcitationSource", {"signal": 1}),
     ("ActionReactionController", {}),

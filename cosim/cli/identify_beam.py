@@ -24,7 +24,7 @@ from arcosim.cli.identify_options import write_report
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
 from arcosim.errors import UserError
 from arcosim.identification.beam_fit import Geometry, fit_link, fit_modes, modal_of
-from arcosim.identification.beam_model import ModalModel
+from arcosim.identification.beam_model import ModalModel, observer_parameters
 from arcosim.identification.beam_motion import link_assumptions, stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_check import log_plausibility
@@ -221,6 +221,7 @@ def _report(
             J_tip=geometry.J_tip,
             r_hub=geometry.r_hub,
             tip_shape_m=[float(p) for p in model.tip],
+            observer_parameters=observer_parameters(model),
         )
     out.update(
         equivalent_chain=dict(chain),

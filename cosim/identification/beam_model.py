@@ -22,7 +22,8 @@ b_i² on its own spring b_i² ω_i² and damper 2 ζ_i ω_i b_i² to the hub (th
 ``q_i = b_i (θ_i − θ)``), the modes left out of the model rigid on the hub
 (``J_rest = J_link − Σ b_i²``): exactly the modal equations above.
 :func:`equivalent_chain` is the lumped chain with the same modes seen from the hub (the
-cross-check a report carries), :func:`modal_report` the model as a report gives it.
+cross-check a report carries), :func:`modal_report` the model as a report gives it,
+:func:`observer_parameters` the observer FMU's parameters for it (the tip online).
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.codes import Estimator
+from arcosim.fmu.flexchain.link_observer import star_chain
 from arcosim.identification.chain_modes import chain_from_modes
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import Modes, modal_damping
@@ -138,9 +142,12 @@ class ModalModel:
     def star(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The modes as masses on their own springs to the hub: ``(J, k, B)`` (kg·m²,
         N·m/rad, N·m·s/rad), shape ``(M,)`` each; with :attr:`J_rest` on the hub this
-        is the modal model exactly."""
-        J = self.participation**2
-        return J, J * self.frequency**2, 2.0 * self.damping * self.frequency * J
+        is the modal model exactly (:func:`~arcosim.fmu.flexchain.link_observer.star_chain`,
+        the observer FMU's arithmetic)."""
+        J, k, B = star_chain(
+            self.frequency.tolist(), self.damping.tolist(), self.participation.tolist()
+        )
+        return np.array(J), np.array(k), np.array(B)
 
     def residues(self) -> np.ndarray:
         """Driving-point residues r_i = b_i² ω_i⁴ (N·m/rad·s⁻²) of
@@ -161,6 +168,50 @@ def modal_report(model: ModalModel) -> dict:
         "J_rest": float(model.J_rest),
         "chain": equivalent_chain(model),
     }
+
+
+def observer_parameters(model: ModalModel) -> dict[str, float | int]:
+    """The observer FMU's parameters for the link (``ReactionTorqueObserver``, estimator 1
+    on ``link_modes`` modes; docs/fmus/observer.md), by the FMU's names: ``estimator``,
+    ``link_modes``, ``omega_link[i]`` (rad/s), ``zeta_link[i]``, ``b_link[i]`` (√kg·m),
+    ``phi_tip[i]`` (m per modal unit), ``J_link_rigid`` (kg·m²) and ``L_link`` (m).
+
+    At most :data:`~arcosim.fmu.flexchain.defaults.LINK_MODES_MAX` modes (the FMU's
+    arrays): the modes past them count rigid on the hub, in ``J_link_rigid``, which is
+    the link's inertia outside the modes kept (0 if the fit left it negative).
+
+    Parameters
+    ----------
+    model : ModalModel
+        The link's modal model (:func:`modal_model`, or an identification's).
+
+    Returns
+    -------
+    dict of str to float or int
+        Name → value, for ``--set NAME=VALUE`` or an FMU's start values.
+
+    Examples
+    --------
+    >>> model = modal_model(Link(EI=1.0, rhoA=0.1, L=0.4), modes=1)
+    >>> sorted(observer_parameters(model))  # doctest: +NORMALIZE_WHITESPACE
+    ['J_link_rigid', 'L_link', 'b_link[1]', 'estimator', 'link_modes', 'omega_link[1]',
+     'phi_tip[1]', 'zeta_link[1]']
+    """
+    kept = model.first(min(len(model.frequency), defaults.LINK_MODES_MAX))
+    out: dict[str, float | int] = {
+        "estimator": int(Estimator.MODEL_BASED),
+        "link_modes": len(kept.frequency),
+    }
+    columns = (
+        ("omega_link", kept.frequency),
+        ("zeta_link", kept.damping),
+        ("b_link", kept.participation),
+        ("phi_tip", kept.tip),
+    )
+    for name, values in columns:
+        out.update({f"{name}[{i}]": float(v) for i, v in enumerate(values, start=1)})
+    out.update(J_link_rigid=max(float(kept.J_rest), 0.0), L_link=float(kept.L))
+    return out
 
 
 def equivalent_chain(model: ModalModel) -> dict[str, float]:

@@ -17,7 +17,7 @@ from dataclasses import KW_ONLY, dataclass
 import numpy as np
 import scipy.linalg
 
-from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.chain import spring_matrix, star_matrix
 from arcosim.identification.modal_recursion import linear_recursion, output_recursion
 from arcosim.identification.records import EncoderRecord
 
@@ -63,11 +63,8 @@ class Drive:
         """Stiffness (``values`` = k) or damping (``values`` = B) matrix on the angles
         ``[θ_m, θ_1…θ_n]``, shape ``(n + 1, n + 1)``: the chain's or the star's."""
         values = np.asarray(values, dtype=float)
-        if not self.star:
-            return np.array(spring_matrix([float(x) for x in values]))
-        matrix = np.diag(np.concatenate([[np.sum(values)], values]))
-        matrix[0, 1:] = matrix[1:, 0] = -values
-        return matrix
+        laplacian = star_matrix if self.star else spring_matrix
+        return np.array(laplacian([float(x) for x in values]))
 
 
 @dataclass(frozen=True)

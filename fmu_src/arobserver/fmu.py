@@ -14,6 +14,7 @@ from ..flexchain import defaults
 from ..flexchain.codes import Mode
 from ..flexchain.dob import Actuator
 from ..flexchain.least_squares import MIN_ROWS, RCOND_MIN
+from ..flexchain.link_observer import StarLink
 from ..flexchain.load_observer import SMOOTHING_RATIO
 from ..flexchain.observer import Observer, ObserverSettings
 from ..flexchain.self_identification import SETTLE
@@ -27,7 +28,7 @@ from ..fmukit import (
     par,
     range_problems,
 )
-from ..fmukit.checks import chain_rate_problems
+from ..fmukit.checks import FASTEST_RATE, chain_rate_problems
 
 #: Outputs of modes 0 and 1, solved from the normal equations only when read.
 IDENTIFICATION_OUTPUTS = (
@@ -209,6 +210,71 @@ class ReactionTorqueObserver(FmuSlave):
                 f"reciprocal condition number >= {RCOND_MIN:g} (mode 1: and k_hat > 0)",
                 "Boolean",
             ),
+            *cls.link_variables(),
+        ]
+
+    @staticmethod
+    def link_variables() -> list[Variable]:
+        """The flexible link's modal model and the tip's estimates (declared last, so the
+        chain's variables keep their value references)."""
+        m = defaults.LINK_MODES_MAX
+        return [
+            par(
+                "link_modes",
+                defaults.LINK_MODES,
+                "",
+                f"Estimator 1: 0 = the chain of J, k, B; 1 to {m} = a flexible link's first "
+                "hub-locked modes (omega_link, zeta_link, b_link, phi_tip, J_link_rigid, "
+                "L_link, as arcosim identify --method beam reports them); theta_hat and "
+                "omega_hat are then not written",
+            ),
+            *array(
+                par,
+                "omega_link",
+                list(defaults.LINK_OMEGA),
+                "rad/s",
+                lambda i: f"Link mode {i}: hub-locked (clamped) frequency",
+            ),
+            *array(
+                par,
+                "zeta_link",
+                list(defaults.LINK_ZETA),
+                "1",
+                lambda i: f"Link mode {i}: damping ratio",
+            ),
+            *array(
+                par,
+                "b_link",
+                list(defaults.LINK_PARTICIPATION),
+                "1",
+                lambda i: (
+                    f"Link mode {i}: hub participation b (sqrt(kg).m: kg.m per unit of "
+                    "the mass-normalized modal coordinate; the mode's inertia on the hub is b^2)"
+                ),
+            ),
+            *array(
+                par,
+                "phi_tip",
+                list(defaults.LINK_TIP_SHAPE),
+                "1",
+                lambda i: (
+                    f"Link mode {i}: tip shape value (m of tip deflection per unit of the "
+                    "mass-normalized modal coordinate, 1/sqrt(kg))"
+                ),
+            ),
+            par(
+                "J_link_rigid",
+                defaults.LINK_J_RIGID,
+                "kg.m2",
+                "The link's inertia outside its modes, rigid on the hub beyond J_mo",
+            ),
+            par("L_link", defaults.LINK_L, "m", "Link length: alpha_tip_hat = w_tip_hat / L_link"),
+            out("w_tip_hat", "m", "link_modes > 0: estimated tip deflection; 0 otherwise"),
+            out(
+                "alpha_tip_hat",
+                "rad",
+                "link_modes > 0: estimated tip deflection angle w_tip_hat / L_link; 0 otherwise",
+            ),
         ]
 
     def check_parameters(self) -> list[str]:
@@ -236,14 +302,62 @@ class ReactionTorqueObserver(FmuSlave):
             ],
             finite=["dkt", "dJm"],
         )
+        problems += self.link_problems()
         if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
             problems.append("parameters J_mo + dJm must be > 0 (the motor inertia)")
-        if not problems and self.value("mode") == Mode.STATE_ESTIMATION:  # the chain is a model
+        chain = not self.value("link_modes")
+        if not problems and chain and self.value("mode") == Mode.STATE_ESTIMATION:
             problems += chain_rate_problems(
                 self.value, None, indexed("J", n), indexed("k", n), indexed("B", n)
             )
         # the observer's own rules; its noise levels only once every number is in range
         return problems + self.settings().problems(noise=not problems)
+
+    def link_problems(self) -> list[str]:
+        """The link's numbers out of range, one sentence each (none when link_modes = 0)."""
+        m = self.value("link_modes")
+        if not 0 <= m <= defaults.LINK_MODES_MAX:
+            return [
+                f"parameter link_modes = {m} is not allowed (use 0 = the chain, or 1 to "
+                f"{defaults.LINK_MODES_MAX} link modes)"
+            ]
+        if not m:
+            return []
+        problems = range_problems(
+            self.value,
+            positive=[*indexed("omega_link", m), "L_link"],
+            non_negative=[*indexed("zeta_link", m), "J_link_rigid"],
+            finite=[*indexed("b_link", m), *indexed("phi_tip", m)],
+        )
+        problems += [
+            f"parameter {name} = 0: a mode the hub does not move is not observable from it; "
+            "lower link_modes"
+            for name in indexed("b_link", m)
+            if self.value(name) == 0.0
+        ]
+        if problems:
+            return problems
+        for w, z in zip(indexed("omega_link", m), indexed("zeta_link", m)):
+            fastest = max(self.value(w), 2.0 * self.value(z) * self.value(w))  # rad/s, 1/s
+            if fastest > FASTEST_RATE:
+                problems.append(
+                    f"parameters {w} = {self.value(w):g} and {z} = {self.value(z):g} make a "
+                    f"mode or decay of {fastest:.3g} 1/s; the FMU integrates up to "
+                    f"{FASTEST_RATE:g} (lower link_modes to the modes in band)"
+                )
+        return problems
+
+    def link(self) -> StarLink | None:
+        """The link's modal model of the parameters (None when link_modes = 0)."""
+        m = self.value("link_modes")
+        if not m:
+            return None
+        return StarLink(
+            *(tuple(self.values(indexed(name, m))) for name in ("omega_link", "zeta_link")),
+            *(tuple(self.values(indexed(name, m))) for name in ("b_link", "phi_tip")),
+            self.value("J_link_rigid"),
+            self.value("L_link"),
+        )
 
     def settings(self) -> ObserverSettings:
         """The parameters as the observer's settings."""
@@ -266,6 +380,7 @@ class ReactionTorqueObserver(FmuSlave):
             tau_noise_std=v("tau_noise_std"),
             load_mass=v("load_mass"),
             load_torque_bandwidth=v("load_torque_bandwidth"),
+            link=self.link() if 0 <= v("link_modes") <= defaults.LINK_MODES_MAX else None,
         )
 
     def initialize(self) -> None:
@@ -289,8 +404,9 @@ class ReactionTorqueObserver(FmuSlave):
         )
         self.lazy = frozenset(self.indices(IDENTIFICATION_OUTPUTS))
         self.out_load = self.vr["tau_load_hat"] if settings.load_mass else None
+        self.out_tip = self.indices(["w_tip_hat", "alpha_tip_hat"]) if settings.link else None
 
-        if settings.mode == Mode.STATE_ESTIMATION:
+        if settings.mode == Mode.STATE_ESTIMATION and not settings.link:
             for i, x in zip(self.out_theta, self.observer.estimator.theta):
                 self.v[i] = x
 
@@ -304,7 +420,11 @@ class ReactionTorqueObserver(FmuSlave):
         v[tau] = dob.tau_reac_hat
         v[alpha] = dob.alpha_hat
         estimator = obs.estimator
-        if estimator is not None:
+        if self.out_tip is not None:
+            tip_w, tip_alpha = self.out_tip
+            v[tip_w] = estimator.w_tip
+            v[tip_alpha] = estimator.alpha_tip
+        elif estimator is not None:
             v[t0:t1] = estimator.theta
             v[w0:w1] = estimator.omega
             if self.out_load is not None:

@@ -37,6 +37,8 @@ The observer
 * :mod:`~arcosim.fmu.flexchain.model_observer` — mode 2, estimator 1: the model-based
   observer and the noise levels its Kalman design solves.
 * :mod:`~arcosim.fmu.flexchain.load_observer` — the same with the torque on one load mass.
+* :mod:`~arcosim.fmu.flexchain.link_observer` — the same on a flexible link's modes: the
+  tip's deflection.
 * :mod:`~arcosim.fmu.flexchain.observer` — the settings, their rules
   (``ObserverSettings.problems``) and the observer that runs the configured mode.
 

@@ -40,6 +40,36 @@ def spring_matrix(gains: Sequence[float]) -> Matrix:
     return m
 
 
+def star_matrix(gains: Sequence[float]) -> Matrix:
+    """The ``(n+1) × (n+1)`` Laplacian of a star of n springs, each from body 0 (the
+    hub) to its own body i (a link's modes, :mod:`arcosim.fmu.flexchain.link`).
+
+    Parameters
+    ----------
+    gains : Sequence[float]
+        ``k_1 … k_n`` (N·m/rad) or ``B_1 … B_n`` (N·m·s/rad), one per spring, shape
+        ``(n,)``.
+
+    Returns
+    -------
+    Matrix
+        The Laplacian, shape ``(n + 1, n + 1)``, in the unit of ``gains``.
+
+    Examples
+    --------
+    >>> star_matrix([1.0, 2.0])
+    [[3.0, -1.0, -2.0], [-1.0, 1.0, 0.0], [-2.0, 0.0, 2.0]]
+    """
+    n = len(gains)
+    m = zeros(n + 1, n + 1)
+    for i, g in enumerate(gains, start=1):
+        m[0][0] += g
+        m[i][i] += g
+        m[0][i] -= g
+        m[i][0] -= g
+    return m
+
+
 def spring_torques(
     k: Sequence[float], B: Sequence[float], theta: Sequence[float], omega: Sequence[float]
 ) -> list[float]:

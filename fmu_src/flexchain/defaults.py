@@ -97,3 +97,19 @@ MOTOR_FRICTION_BANDWIDTH = 20.0
 #: the observer's 1e-4 the bench's two-mass loop held a 37 mrad limit cycle when the
 #: model's J were 10 % high and its k 10 % low; at 1e-3 it settled (1e-2: unstable).
 CONTROL_TORQUE_NOISE_STD = 1e-3
+
+
+# -- the observer on a flexible link (star of modes, ReactionTorqueObserver; issue 28) ----
+#: The most link modes the observer FMU declares parameters for (a count).
+LINK_MODES_MAX = 4
+LINK_MODES = 0  #: link modes the observer runs on (0 = the chain of J, k, B)
+#: The default link's (LINK_EI … LINK_BETA above) hub-locked modes as
+#: ``arcosim.identification.beam_model.modal_model`` gives them (24 elements, rounded):
+#: frequencies ω_i (rad/s), damping ratios β ω_i / 2, hub participations b_i (kg·m per
+#: modal unit, i.e. √kg·m) and tip shape values φ_i(L) (m per modal unit).
+LINK_OMEGA = (39.8506, 334.044, 1021.83, 2096.2)
+LINK_ZETA = (0.0009963, 0.008351, 0.02555, 0.05241)
+LINK_PARTICIPATION = (0.0743893, 0.0102678, 0.00362431, 0.00188969)
+LINK_TIP_SHAPE = (5.81171, -2.61984, 1.70307, -1.24195)
+#: The default link's inertia outside its four modes, rigid on the hub (kg·m²).
+LINK_J_RIGID = 3.42719e-6

@@ -26,11 +26,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from . import linalg
+from .chain import star_matrix
 from .linalg import Matrix
 
 
 def continuous_matrices(
-    J: Sequence[float], k: Sequence[float], B: Sequence[float]
+    J: Sequence[float], k: Sequence[float], B: Sequence[float], star: bool = False
 ) -> tuple[Matrix, Matrix]:
     """``ẋ = A x + E [θ_m, θ̇_m]`` for the load state ``x = [θ_1…θ_n, ω_1…ω_n]``.
 
@@ -41,12 +42,18 @@ def continuous_matrices(
     k, B : Sequence[float]
         Stiffness (N·m/rad) and damping (N·m·s/rad) of springs 1 … n, shape ``(n,)``
         each.
+    star : bool
+        False: a chain (spring i joins body i − 1 and body i); True: a star (spring i
+        joins the motor and body i, :func:`~arcosim.fmu.flexchain.chain.star_matrix`:
+        a link's modes).
 
     Returns
     -------
     tuple of Matrix
         ``A``, shape ``(2n, 2n)``, and ``E``, shape ``(2n, 2)`` (SI units: 1/s, 1/s²).
     """
+    if star:
+        return _star_matrices(J, k, B)
     n = len(J)
     A = linalg.zeros(2 * n, 2 * n)
     E = linalg.zeros(2 * n, 2)
@@ -68,6 +75,24 @@ def continuous_matrices(
             row[n + i] -= B[i + 1] / J[i]
             row[i + 1] += k[i + 1] / J[i]
             row[n + i + 1] += B[i + 1] / J[i]
+    return A, E
+
+
+def _star_matrices(
+    J: Sequence[float], k: Sequence[float], B: Sequence[float]
+) -> tuple[Matrix, Matrix]:
+    """:func:`continuous_matrices` of a star, from its Laplacians (body 0 the motor)."""
+    n = len(J)
+    K, C = star_matrix(k), star_matrix(B)
+    A = linalg.zeros(2 * n, 2 * n)
+    E = linalg.zeros(2 * n, 2)
+    for i in range(n):
+        A[i][n + i] = 1.0
+        row = A[n + i]
+        for j in range(n):
+            row[j] = -K[i + 1][j + 1] / J[i]
+            row[n + j] = -C[i + 1][j + 1] / J[i]
+        E[n + i] = [-K[i + 1][0] / J[i], -C[i + 1][0] / J[i]]
     return A, E
 
 
@@ -123,6 +148,7 @@ def discretize(
     B: Sequence[float],
     h: float,
     expm: Callable[[Matrix], Matrix] = linalg.expm,
+    star: bool = False,
 ) -> DiscreteChain:
     """Exact discrete chain for a motor angle linear over each step of ``h`` s.
 
@@ -139,13 +165,15 @@ def discretize(
     expm : callable
         The matrix exponential (:func:`~arcosim.fmu.flexchain.linalg.expm`, or scipy's
         offline).
+    star : bool
+        The springs as a star from the motor, not a chain (:func:`continuous_matrices`).
 
     Returns
     -------
     DiscreteChain
         ``Ad`` and ``Bd`` for this step.
     """
-    A, E = continuous_matrices(J, k, B)
+    A, E = continuous_matrices(J, k, B, star)
     m = len(A)
     F = linalg.zeros(m + 2, m + 2)
     for r in range(m):

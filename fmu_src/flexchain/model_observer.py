@@ -161,6 +161,7 @@ def step_model(
     g_dist: float,
     noise: NoiseModel,
     h: float,
+    star: bool = False,
 ) -> StepModel:
     """Discrete model with the DOB's filter, and its steady-state Kalman gain.
 
@@ -175,6 +176,9 @@ def step_model(
         The noise levels the gain is designed for.
     h : float
         Step (s).
+    star : bool
+        The springs as a star from the motor (a link's modes,
+        :mod:`arcosim.fmu.flexchain.link_observer`), not a chain.
 
     Returns
     -------
@@ -187,7 +191,7 @@ def step_model(
     ValueError
         If the Riccati iteration fails (noise outside :data:`NOISE_RANGE`).
     """
-    chain = discretize(J, k, B, h)
+    chain = discretize(J, k, B, h, star=star)
     n = chain.n
     m = 2 * n + 1
     a = lowpass_pole(g_dist, h)

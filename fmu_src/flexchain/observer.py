@@ -6,7 +6,8 @@ three modes (:class:`~arcosim.fmu.flexchain.codes.Mode`), advanced one sample at
 * mode 1 — chain identification from a rigid maneuver
   (:mod:`~arcosim.fmu.flexchain.rigid_identification`)
 * mode 2 — state estimation: the paper's recursion (:mod:`~arcosim.fmu.flexchain.recursion`)
-  or the model-based observer (:mod:`~arcosim.fmu.flexchain.model_observer`)
+  or the model-based observer (:mod:`~arcosim.fmu.flexchain.model_observer`), on a chain
+  or on a flexible link's modes (:mod:`~arcosim.fmu.flexchain.link_observer`)
 
 :class:`ObserverSettings` holds the configuration and states its rules
 (:meth:`ObserverSettings.problems`), for the FMU, the CLI and the library alike; the
@@ -21,6 +22,7 @@ from dataclasses import dataclass
 from . import defaults
 from .codes import ESTIMATOR_NAMES, MODE_NAMES, Estimator, Mode, choice_problem
 from .dob import Actuator, ReactionObserver
+from .link_observer import LinkObserver, StarLink
 from .load_observer import LoadTorqueObserver
 from .model_observer import NOISE_RANGE, NOISE_RATIO, ModelObserver, NoiseModel
 from .recursion import ChainRecursion
@@ -71,6 +73,9 @@ class ObserverSettings:
         torque is estimated too (:mod:`arcosim.fmu.flexchain.load_observer`).
     load_torque_bandwidth : float
         Bandwidth of that estimate (rad/s), > 0.
+    link : StarLink or None
+        Model-based observer: a flexible link's modal model in place of the chain of
+        ``J``, ``k``, ``B`` (:mod:`~arcosim.fmu.flexchain.link_observer`); None: the chain.
 
     Examples
     --------
@@ -97,6 +102,7 @@ class ObserverSettings:
     tau_noise_std: float = defaults.TAU_NOISE_STD
     load_mass: int = defaults.LOAD_MASS
     load_torque_bandwidth: float = defaults.LOAD_TORQUE_BANDWIDTH
+    link: StarLink | None = None
 
     def angle_offset(self) -> float:
         """Half a count of the encoder.
@@ -165,6 +171,7 @@ class ObserverSettings:
         if noise and self.model_based:
             found.append(noise_problem(self.torque_noise_std, self.tau_noise_std))
         found.append(load_mass_problem(self.load_mass, len(self.J), self.model_based))
+        found.append(link_problem(self.link is not None, self.model_based, self.load_mass))
         return [problem for problem in found if problem is not None]
 
 
@@ -232,6 +239,36 @@ def load_mass_problem(load_mass: int, n: int, model_based: bool) -> str | None:
     return None
 
 
+def link_problem(link: bool, model_based: bool, load_mass: int) -> str | None:
+    """A sentence if a link's modal model is set where the observer cannot run it: only
+    the model-based observer runs on a link, and without a load torque state.
+
+    Parameters
+    ----------
+    link : bool
+        Whether the settings carry a link (``link_modes`` > 0 in the FMU).
+    model_based : bool
+        Whether the observer runs the model-based observer
+        (:attr:`ObserverSettings.model_based`).
+    load_mass : int
+        0 (off) or the load mass whose torque is estimated.
+
+    Returns
+    -------
+    str or None
+        The sentence, naming the fix; None when the link (or none) can run.
+    """
+    if link and not model_based:
+        return (
+            f"parameter link_modes > 0 needs mode = {int(Mode.STATE_ESTIMATION)} and "
+            f"estimator = {int(Estimator.MODEL_BASED)} (the model-based observer); set "
+            "link_modes = 0 otherwise"
+        )
+    if link and load_mass:
+        return "parameters link_modes > 0 and load_mass > 0 exclude each other: set load_mass = 0"
+    return None
+
+
 def _short(x: float) -> str:
     """``x`` in the shortest scientific notation: 1e-4, 1.5e-3."""
     mantissa, exponent = f"{x:e}".split("e")
@@ -262,11 +299,14 @@ class Observer:
         self.settings = settings
         s = settings
         problem = load_mass_problem(s.load_mass, len(s.J), s.model_based)
+        if problem is None:
+            problem = link_problem(s.link is not None, s.model_based, s.load_mass)
         if problem is not None:
             raise ValueError(problem)
         self.dob = ReactionObserver(s.actuator, s.g_dist, theta0, omega0)
         self.identifier: ActuatorIdentifier | RigidChainIdentifier | None = None
         self.estimator: ChainRecursion | ModelObserver | LoadTorqueObserver | None = None
+        self.rigid = s.link.J_rigid if s.link is not None else 0.0  # off τ̂_reac, on the hub
         self.offset = s.angle_offset() if s.mode == Mode.STATE_ESTIMATION else 0.0
         if s.mode == Mode.SELF_IDENTIFICATION:
             self.identifier = ActuatorIdentifier(s.g_dist, s.omega_min, s.actuator.k_to, s.g_id)
@@ -285,6 +325,8 @@ class Observer:
                 s.load_mass,
                 s.load_torque_bandwidth,
             )
+        elif s.estimator == Estimator.MODEL_BASED and s.link is not None:
+            self.estimator = LinkObserver(s.link, s.g_dist, s.noise(), theta0 + self.offset)
         elif s.estimator == Estimator.MODEL_BASED:
             self.estimator = ModelObserver(s.J, s.k, s.B, s.g_dist, s.noise(), theta0 + self.offset)
         else:
@@ -306,7 +348,8 @@ class Observer:
         dob.step(h, i_a, omega, theta)
         estimator = self.estimator
         if estimator is not None:  # mode 2, the one that runs in control loops: test it first
-            estimator.step(h, dob.tau_reac_hat, theta + self.offset)
+            tau = dob.tau_reac_hat - self.rigid * dob.alpha_hat if self.rigid else dob.tau_reac_hat
+            estimator.step(h, tau, theta + self.offset)
         elif self.settings.mode == Mode.SELF_IDENTIFICATION:
             self.identifier.step(h, i_a, dob.velocity, dob.accel, dob.friction_sign, dob.d_hat)
         else:
