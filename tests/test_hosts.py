@@ -74,7 +74,7 @@ def test_ssp_in_ecos_matches_the_fmpy_jacobi_run(build_fmus, tmp_path) -> None:
             scale = max(np.max(np.abs(mine)), 1e-300)
             assert np.max(np.abs(mine - theirs[:, j + 1])) <= 1e-9 * scale, f"{component}.{name}"
             compared += 1
-    assert compared == 35  # 1 source + 16 plant + 18 observer outputs
+    assert compared == 37  # 1 source + 16 plant + 20 observer outputs (w_tip_hat, alpha_tip_hat)
 
 
 def test_a_missing_system_library_skips_ecos_naming_its_package(
