@@ -11,8 +11,9 @@
 - :mod:`benchmarks.link_frequencies`: the flexible-link FMU's frequencies against the
   continuous beam's, for 2, 4 and 8 elements (``python -m benchmarks.link_frequencies``).
 - :mod:`benchmarks.published_link`: a link we did not write, Quanser's rotary flexible
-  link from its published parameters, on the link FMU and identified from the hub
-  (``python -m benchmarks.published_link``).
+  link from its published parameters, on the link FMU and on the continuous beam's modes
+  (:mod:`benchmarks.modal_link`, a simulator written apart from the FMU), identified
+  from the hub (``python -m benchmarks.published_link``).
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """

@@ -1,5 +1,6 @@
 """A link we did not write: Quanser's Rotary Flexible Link on its SRV02 servo (high gear),
-from the parameters Quanser publishes, simulated by the link plant FMU and identified
+from the parameters Quanser publishes, simulated by the link plant FMU and, apart from
+it, by the continuous beam's own modes (``benchmarks/modal_link.py``), and identified
 from the hub alone.
 
 Published (Quanser's courseware for the rig: ``config_flexgage_exp.m`` of the Rotary
@@ -26,8 +27,9 @@ The fit gets what a user of the rig knows (k_t, J_eq, the friction, the counts, 
 m_tip = 0) and finds EI, ρA and the damping; the modes, EI, ρA and the tip angle
 (rms(α̂ − α)/rms(α) after the first second) against the published values and the plant.
 
-Run: ``python -m benchmarks.published_link [--seeds 3] [--fmus dist] [--out FILE.json]``
-(prints the markdown table of docs/identification.md).
+Run: ``python -m benchmarks.published_link [--seeds 3] [--fmus dist] [--simulator
+plant|modal|both] [--out FILE.json]`` (prints the markdown tables of
+docs/identification.md, one per simulator).
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ from arcosim.experiments.flexible_link import (
     simulate_link,
 )
 from arcosim.experiments.report import markdown_table
+from benchmarks.modal_link import simulate_modal_link
 
 INCH = 0.0254
 #: The link (config_flexgage_exp.m): length (m), mass (kg), measured frequency (rad/s).
@@ -112,13 +115,20 @@ RIG = LinkRig(
 )
 
 
-def score(fmu: Path, seeds: Sequence[int]) -> list[dict]:
-    """The rig identified from its hub, one dict per seed (JSON-able)."""
+#: The simulators of the rig: the link plant FMU (finite elements) and the continuous
+#: beam's modes, written apart from it.
+SIMULATORS = ("plant", "modal")
+
+
+def score(fmu: Path, seeds: Sequence[int], simulator: str = "plant") -> list[dict]:
+    """The rig simulated by ``simulator`` (one of :data:`SIMULATORS`) and identified from
+    its hub, one dict per seed (JSON-able)."""
     rows = []
     for seed in seeds:
         rig = replace(RIG, seed=seed)
-        found = identify_link(simulate_link(fmu, rig), rig)
-        rows.append({"seed": seed, **found.as_dict()})
+        run = simulate_link(fmu, rig) if simulator == "plant" else simulate_modal_link(rig)
+        found = identify_link(run, rig)
+        rows.append({"seed": seed, "simulator": simulator, **found.as_dict()})
     return rows
 
 
@@ -157,6 +167,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--fmus", type=Path, help="folder of the FMUs (default: the cache)")
+    parser.add_argument(
+        "--simulator", choices=(*SIMULATORS, "both"), default="both",
+        help="the link plant FMU, the continuous beam's modes, or both (default)",
+    )  # fmt: skip
     parser.add_argument("--out", type=Path)
     args = parser.parse_args(argv)
     fmu = ensure_built(3, args.fmus) / LINK_FMU
@@ -166,13 +180,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"EI = {p['EI']:.4g} N.m², rhoA = {p['rhoA']:.4g} kg/m, L = {p['L']:.4g} m, "
         f"clamped modes {np.round(clamped_frequencies(RIG, 3), 2).tolist()} rad/s"
     )
-    rows = score(fmu, list(range(1, args.seeds + 1)))
-    for r in rows:
-        print(f"  seed {r['seed']}: peak hub speed {r['peak_speed_rad_s']:.2f} rad/s, "
-              f"fit {r['seconds']:.1f} s")  # fmt: skip
-    print(markdown(rows))
+    every = []
+    for simulator in SIMULATORS if args.simulator == "both" else (args.simulator,):
+        rows = score(fmu, list(range(1, args.seeds + 1)), simulator)
+        print(f"simulated by the {'link plant FMU' if simulator == 'plant' else 'beam modes'}:")
+        for r in rows:
+            print(f"  seed {r['seed']}: peak hub speed {r['peak_speed_rad_s']:.2f} rad/s, "
+                  f"fit {r['seconds']:.1f} s")  # fmt: skip
+        print(markdown(rows))
+        every += rows
     if args.out:
-        args.out.write_text(json.dumps(rows, indent=1), encoding="utf-8")
+        args.out.write_text(json.dumps(every, indent=1), encoding="utf-8")
     return 0
 
 

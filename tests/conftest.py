@@ -88,3 +88,21 @@ def fmus(build_fmus: Callable[[int], Path]) -> Path:
 def plant_fmu(build_fmus: Callable[[int], Path]) -> Path:
     """The plant FMU for the paper's bench (n = 3)."""
     return build_fmus(3) / "MotorChainPlant.fmu"
+
+
+@pytest.fixture(scope="session")
+def venvs(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], str]:
+    """``venvs(label)`` → python of a venv with fmpy for that CPython (tests/foreign_hosts.py),
+    made once per session, or kept in ARCOSIM_HOST_VENVS."""
+    from tests.foreign_hosts import venv_maker
+
+    keep = os.environ.get("ARCOSIM_HOST_VENVS")
+    return venv_maker(Path(keep) if keep else tmp_path_factory.mktemp("venvs"))
+
+
+@pytest.fixture(scope="session")
+def libcosim_python(venvs: Callable[[str], str]) -> str:
+    """A venv of a CPython other than the building one with libcosimpy (from PyPI)."""
+    from tests.foreign_hosts import libcosim_venv
+
+    return libcosim_venv(venvs)

@@ -1,7 +1,8 @@
-"""The controller FMU in hosts that are not Python, as the observer runs in them: the
-closed loop (MotionControl.ssp, controller ↔ plant) in the C host of tests/hosts
-(dlopen, no Python linked, a bare PATH) and in the ecos C++ engine, both against the
-SSP runner's Jacobi run of the same system."""
+"""The controller FMU in the hosts the observer runs in: the closed loop (MotionControl.ssp,
+controller ↔ plant) in the C host of tests/hosts (dlopen, no Python linked, a bare PATH),
+the ecos C++ engine, fmpy under each other CPython and libcosim (libcosimpy), the last two
+with the building Python's installation hidden (tests/foreign_hosts.py), every one
+against the SSP runner's Jacobi run of the same system."""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ import pytest
 from arcosim.build.ssp import MOTION_CONTROL, motion_control_sets, write_ssp
 from arcosim.host.ecos import ecos_binary, run_ecos
 from arcosim.host.ssp import run_ssp
-from tests.chain_harness import compile_c_host
+from tests.chain_harness import compile_c_host, run_chain
+from tests.foreign_hosts import WANTED, bare_env, hidden
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only"),
@@ -118,3 +120,81 @@ def test_the_closed_loop_ssp_in_ecos(build_fmus, tmp_path) -> None:
         compared += _assert_same(ours, theirs, rows)
     assert compared >= 19
     print(json.dumps({"compared": compared}))
+
+
+# -- fmpy under other CPythons and libcosim, the building Python hidden ------------------
+
+
+def _loop_spec(folder: Path) -> dict:
+    """tests/hosts/chain_run.py's SPEC of the closed loop's ``move`` set."""
+    return {
+        "components": {c: str(folder / f"{stem}.fmu") for c, stem in MOTION_CONTROL.components},
+        "parameters": SETS["move"],
+        "connections": [list(c) for c in MOTION_CONTROL.connections],
+        "stop": STOP,
+        "h": H,
+        "shadow": None,
+    }
+
+
+def _assert_same_outputs(ours, produced: dict[str, dict[str, np.ndarray]], rows: int) -> int:
+    """Every Real output of both FMUs over ``rows`` samples; return how many compared."""
+    theirs = {
+        (component, name): np.asarray(values, dtype=float)
+        for component, signals in produced.items()
+        for name, values in signals.items()
+        if f"{component}.{name}" in ours.signals
+    }
+    for (component, name), values in theirs.items():
+        assert len(values) >= rows, f"{component}.{name}: {len(values)} samples"
+    return _assert_same(ours, theirs, rows)
+
+
+@pytest.mark.parametrize("label", WANTED)
+def test_the_closed_loop_in_fmpy_of_another_python(build_fmus, venvs, tmp_path, label) -> None:
+    """The controller embeds the host's Python: a fresh venv of each other CPython, the
+    building one hidden, runs the loop to the SSP runner's Jacobi results."""
+    folder = build_fmus(3)
+    python = venvs(label)
+    out = run_chain(python, _loop_spec(folder), tmp_path, bare_env(python), hidden)
+    assert out["environ_changed"] == [], out["environ_changed"]
+    assert len(out["libpython_after"]) <= 1
+    ours = run_ssp(folder / "MotionControl.ssp", "move", STOP, H)
+    rows = round(STOP / H) + 1
+    assert _assert_same_outputs(ours, out["outputs"], rows) == 19  # 4 + 15 Real outputs
+    assert 0.5 < ours["plant.theta[3]"][-1] < 1.05
+
+
+def test_the_closed_loop_in_libcosim_under_another_python(
+    build_fmus, libcosim_python, tmp_path
+) -> None:
+    from fmpy import read_model_description
+
+    folder = build_fmus(3)
+    spec = _loop_spec(folder)
+    variables = {
+        c: {v.name: [v.valueReference, v.type] for v in read_model_description(p).modelVariables}
+        for c, p in spec["components"].items()
+    }
+    traces = {c: str(tmp_path / f"trace_{c}.csv") for c in spec["components"]}
+    (tmp_path / "spec.json").write_text(
+        json.dumps({**spec, "variables": variables, "traces": traces})
+    )
+    runner = Path(__file__).parent / "hosts"
+    env = {**bare_env(libcosim_python), "PYTHONPATH": str(runner)}
+    command = [libcosim_python, str(runner / "libcosim_run.py"), "spec.json", "out.json"]
+    result = hidden(command, env, tmp_path)
+    assert result.returncode == 0, result.stderr[-3000:]
+    out = json.loads((tmp_path / "out.json").read_text())
+    assert out["simulated"] and out["environ_changed"] == [], out
+    assert len(out["libpython_after"]) == 1
+    produced, rows = {}, []
+    for component, path in traces.items():
+        names = Path(path).read_text().splitlines()[0].split(",")[1:]
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        assert np.allclose(data[:, 0], np.arange(len(data)) * H, rtol=0, atol=1e-9)
+        produced[component] = {n: data[:, j + 1] for j, n in enumerate(names)}
+        rows.append(len(data))
+    assert min(rows) >= round(STOP / H)
+    ours = run_ssp(folder / "MotionControl.ssp", "move", STOP, H)
+    assert _assert_same_outputs(ours, produced, min(rows)) == 19

@@ -23,12 +23,9 @@ keep them between sessions.
 
 from __future__ import annotations
 
-import functools
 import glob
 import json
 import os
-import shutil
-import subprocess
 import sys
 import zipfile
 from collections.abc import Callable
@@ -39,6 +36,7 @@ import pytest
 
 from arcosim.build.ssp import BENCH, CONNECTIONS
 from tests.chain_harness import chain_fmus, chain_spec, compile_c_host, run_chain
+from tests.foreign_hosts import HIDDEN, WANTED, bare_env, hidden
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux hosts only"),
@@ -48,45 +46,6 @@ pytestmark = [
 HERE = Path(__file__).parent / "hosts"
 STOP, H = 1.0, 1e-3
 RTOL = 1e-9
-HIDDEN = Path(sys.base_prefix).resolve()
-BARE_PATH = "/usr/bin:/bin"
-FMPY_PACKAGES = ["fmpy", "numpy", "lxml", "attrs"]
-
-
-# -- the namespace --------------------------------------------------------------------
-
-
-@functools.cache
-def namespace_problem() -> str | None:
-    """Why the building Python cannot be hidden here, or None."""
-    if shutil.which("unshare") is None:
-        return "unshare (util-linux) is not installed"
-    probe = subprocess.run(
-        ["unshare", "-m", "sh", "-c", f"mount -t tmpfs tmpfs {HIDDEN} && ls -A {HIDDEN}"],
-        capture_output=True,
-        text=True,
-    )
-    if probe.returncode != 0:
-        return f"unshare -m with a tmpfs over {HIDDEN} is not permitted: {probe.stderr.strip()}"
-    if probe.stdout.strip():
-        return f"{HIDDEN} is still visible inside the namespace"
-    return None
-
-
-def hidden(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 300):
-    """Run ``command`` with the building Python's installation hidden."""
-    why = namespace_problem()
-    if why:
-        pytest.skip(why)
-    script = f'{shutil.which("mount")} -t tmpfs tmpfs "{HIDDEN}" && exec "$@"'
-    return subprocess.run(
-        [shutil.which("unshare"), "-m", "/bin/sh", "-c", script, "sh", *command],
-        capture_output=True,
-        text=True,
-        env=env,
-        cwd=cwd,
-        timeout=timeout,
-    )
 
 
 # -- the FMUs and the reference -----------------------------------------------------
@@ -135,64 +94,6 @@ def assert_matches(reference, outputs, rows: int | None = None) -> int:
             worst = max(worst, error / scale)
     print(f"worst relative error over {compared} outputs: {worst:.3g}")  # shown with -s
     return compared
-
-
-# -- venvs with fmpy ------------------------------------------------------------------
-
-
-def pythons() -> dict[str, str]:
-    """label → interpreter: pyenv 3.9, 3.10, 3.12, 3.13 and Debian's python3."""
-    found = {}
-    root = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv")) / "versions"
-    for minor in (9, 10, 12, 13):
-        candidates = sorted(glob.glob(str(root / f"3.{minor}.*" / "bin" / f"python3.{minor}")))
-        if candidates:
-            found[f"3.{minor}"] = candidates[-1]
-    if Path("/usr/bin/python3").is_file():
-        found["debian"] = "/usr/bin/python3"
-    return found
-
-
-WANTED = ["3.9", "3.10", "3.12", "3.13", "debian"]
-
-
-@pytest.fixture(scope="session")
-def venvs(tmp_path_factory):
-    """``venvs(label)`` → python of a venv with fmpy for that interpreter (made once)."""
-    keep = os.environ.get("ARCOSIM_HOST_VENVS")
-    root = Path(keep) if keep else tmp_path_factory.mktemp("venvs")
-    made: dict[str, str] = {}
-
-    def get(label: str) -> str:
-        if label in made:
-            return made[label]
-        base = pythons().get(label)
-        if base is None:
-            pytest.skip(f"no CPython {label} on this machine")
-        venv = root / f"fmpy-{label}"
-        python = venv / "bin" / "python"
-        if not (venv / ".ready").is_file():
-            shutil.rmtree(venv, ignore_errors=True)
-            result = subprocess.run([base, "-m", "venv", str(venv)], capture_output=True, text=True)
-            if result.returncode != 0:
-                pytest.skip(f"{base} -m venv failed: {result.stderr.strip()[-300:]}")
-            result = subprocess.run(
-                [str(python), "-m", "pip", "install", "-q", "--no-deps", *FMPY_PACKAGES],
-                capture_output=True,
-                text=True,
-            )
-            assert result.returncode == 0, result.stderr[-2000:]
-            (venv / ".ready").touch()
-        made[label] = str(python)
-        return made[label]
-
-    return get
-
-
-def bare_env(python: str | None = None) -> dict[str, str]:
-    """What a user's shell might hand a host: HOME and a PATH without the venv."""
-    path = BARE_PATH if python is None else f"{Path(python).parent}:{BARE_PATH}"
-    return {"PATH": path, "HOME": str(Path.home()), "LANG": "C.UTF-8"}
 
 
 # -- fmpy hosts ---------------------------------------------------------------------
@@ -386,21 +287,6 @@ def test_chain_in_ecos_with_a_bare_path(fmus, reference, tmp_path, declared_outp
 
 
 # -- libcosimpy ---------------------------------------------------------------------
-
-
-@pytest.fixture(scope="session")
-def libcosim_python(venvs) -> str:
-    """A venv of a CPython other than the building one with libcosimpy (from PyPI)."""
-    for label in ("3.12", "3.13", "3.10"):
-        if label not in pythons() or f"3.{sys.version_info.minor}" == label:
-            continue
-        python = venvs(label)
-        result = subprocess.run(
-            [python, "-m", "pip", "install", "-q", "libcosimpy"], capture_output=True, text=True
-        )
-        if result.returncode == 0:
-            return python
-    pytest.skip("libcosimpy installs under none of CPython 3.12, 3.13, 3.10 here")
 
 
 @pytest.mark.slow

@@ -10,6 +10,7 @@ here against the exponential in 50-digit decimal arithmetic.
 
 from __future__ import annotations
 
+import itertools
 import shutil
 import subprocess
 import zipfile
@@ -320,3 +321,54 @@ def test_c_host_that_sums_its_time_ends_on_a_sub_nanosecond_step(fmus, tmp_path)
     for (component, name), x0, x1 in zip(order, data[-2, 1:], data[-1, 1:]):
         before[component][name], after[component][name] = x0, x1
     _held(before, after)
+
+
+# -- a host's clock rounding: the same step on every host ------------------------------
+
+
+def _closed_loop(folder: Path, steps: list[float]) -> dict[str, list[float]]:
+    """MotionControl's ``move`` (controller ↔ plant, Jacobi) over ``steps`` (s)."""
+    from arcosim.build.ssp import MOTION_CONTROL, motion_control_sets
+
+    sets = motion_control_sets(3)["move"]
+    instances = {c: FmuInstance(folder / f"{stem}.fmu", c) for c, stem in MOTION_CONTROL.components}
+    try:
+        for component, fmu in instances.items():
+            fmu.initialize(sets.get(component, {}))
+        names = {c: fmu.output_names() for c, fmu in instances.items()}
+        t, log = 0.0, {f"{c}.{n}": [] for c in instances for n in names[c]}
+        for h in steps:
+            values = {a: dict(zip(names[a], instances[a].get(names[a]))) for a in instances}
+            for a, out, b, inp in MOTION_CONTROL.connections:
+                instances[b].set({inp: values[a][out]})
+            for fmu in instances.values():
+                assert fmu.do_step(t, h) == 0, fmu.messages[-3:]
+            t += h
+            for c, fmu in instances.items():
+                for n, v in zip(names[c], fmu.get(names[c])):
+                    log[f"{c}.{n}"].append(v)
+    finally:
+        for fmu in instances.values():
+            fmu.close()
+    return log
+
+
+def test_a_nanosecond_clock_gives_the_results_of_exact_steps(build_fmus) -> None:
+    """libcosim keeps its time in integer nanoseconds and hands the FMUs
+    t_k+1 − t_k: 1 ms give or take units in the last place. The closed loop through the
+    encoder's counts must not follow that rounding (STEP_JITTER): the same outputs, to
+    the bit, as with every step exactly 1 ms. Without it the two runs part after about
+    0.6 s (the controller's current by 0.4 A)."""
+    from arcosim.fmu.fmukit.checks import STEP_JITTER
+
+    folder = build_fmus(3)
+    n = 1000
+    clock = [k * 1_000_000 / 1e9 for k in range(n + 1)]  # ns → s, as libcosim converts
+    jittered = [b - a for a, b in itertools.pairwise(clock)]
+    assert len(set(jittered)) > 1  # the host's steps do differ in their last places
+    assert max(abs(h - 1e-3) for h in jittered) <= STEP_JITTER * 1e-3
+    exact = _closed_loop(folder, [1e-3] * n)
+    rounded = _closed_loop(folder, jittered)
+    differ = [name for name in exact if exact[name] != rounded[name]]
+    assert not differ, differ
+    assert max(exact["plant.theta[3]"]) > 0.3  # the move is under way

@@ -108,7 +108,7 @@ class ControllerDesign:
     @property
     def inertia(self) -> float:
         """Motor and load inertia together, J_tot (kg·m²)."""
-        return self.J_m + sum(self.J)
+        return self.J_m + math.fsum(self.J)
 
     def load_offset(self, d: float) -> tuple[list[float], float]:
         """Where the chain rests when a torque d holds the controlled mass at its target.
@@ -221,7 +221,7 @@ def regulator_gain(F: Matrix, g: Sequence[float], Q: Matrix, r: float) -> list[f
     G = [[g[i] * g[j] / r for j in range(m)] for i in range(m)]
     X = solve_doubling(F, G, Q)
     Xg = linalg.matvec(X, list(g))
-    denominator = r + sum(a * b for a, b in zip(g, Xg))
+    denominator = r + math.fsum(a * b for a, b in zip(g, Xg))
     gXF = linalg.matvec(linalg.transpose(F), Xg)  # Fᵀ X g = (gᵀ X F)ᵀ
     return [v / denominator for v in gXF]
 
@@ -249,7 +249,7 @@ def cost_weights(
     """
     n = len(J)
     m = n + 1
-    stiffness = J_m + sum(J)
+    stiffness = J_m + math.fsum(J)
     stiffness *= bandwidth**2  # J_tot ω_c² (N·m/rad): the rigid loop's
     q_angle = (stiffness / k_t) ** 2
     q_energy = ENERGY_WEIGHT * q_angle / stiffness

@@ -106,8 +106,8 @@ def reciprocal_condition(a: list[list[float]]) -> float:
         inv = solve(a, [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)])
     except ValueError:
         return 0.0
-    norm = max(sum(abs(a[i][j]) for i in range(n)) for j in range(n))
-    norm_inv = max(sum(abs(inv[i][j]) for i in range(n)) for j in range(n))
+    norm = max(math.fsum(abs(a[i][j]) for i in range(n)) for j in range(n))
+    norm_inv = max(math.fsum(abs(inv[i][j]) for i in range(n)) for j in range(n))
     if not (math.isfinite(norm_inv) and norm > 0.0 and norm_inv > 0.0):
         return 0.0
     return 1.0 / (norm * norm_inv)

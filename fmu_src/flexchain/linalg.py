@@ -34,12 +34,12 @@ def transpose(a: Matrix) -> Matrix:
 def matmul(a: Matrix, b: Matrix) -> Matrix:
     """``a @ b`` for ``(r × k) @ (k × c)``."""
     columns = list(zip(*b))
-    return [[sum(map(mul, row, col)) for col in columns] for row in a]
+    return [[math.fsum(map(mul, row, col)) for col in columns] for row in a]
 
 
 def matvec(a: Matrix, x: Vector) -> Vector:
     """``a @ x``."""
-    return [sum(map(mul, row, x)) for row in a]
+    return [math.fsum(map(mul, row, x)) for row in a]
 
 
 def add(a: Matrix, b: Matrix, scale_b: float = 1.0) -> Matrix:
@@ -54,7 +54,7 @@ def scaled(a: Matrix, s: float) -> Matrix:
 
 def norm_inf(a: Matrix) -> float:
     """Largest absolute row sum."""
-    return max((sum(abs(p) for p in row) for row in a), default=0.0)
+    return max((math.fsum(abs(p) for p in row) for row in a), default=0.0)
 
 
 def solve(a: Matrix, b: Matrix) -> Matrix:

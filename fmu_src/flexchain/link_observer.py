@@ -24,6 +24,7 @@ Standard library only.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -145,5 +146,5 @@ class LinkObserver(ModelObserver):
         """
         super().step(h, tau_reac_hat, theta_m)
         u = self.u_prev
-        self.w_tip = w = sum(g * (x - u) for g, x in zip(self.gains, self.s))
+        self.w_tip = w = math.fsum(g * (x - u) for g, x in zip(self.gains, self.s))
         self.alpha_tip = w / self.link.L

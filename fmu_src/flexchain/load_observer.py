@@ -224,7 +224,7 @@ def load_step_model(
     a = lowpass_pole(g_dist, h)
     b = 1.0 - a
     c, du = chain.torque_row()
-    e_d = sum(J[i] / h * b_d[n + i] for i in range(n)) - 1.0  # τ̄ per unit d over the step
+    e_d = math.fsum(J[i] / h * b_d[n + i] for i in range(n)) - 1.0  # τ̄ per unit d over the step
     F = linalg.zeros(m, m)
     for i in range(2 * n):
         F[i][: 2 * n] = chain.Ad[i][:]

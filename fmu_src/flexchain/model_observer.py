@@ -21,6 +21,7 @@ angle, so the numbers stay small however far the drive has turned.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from operator import mul
@@ -286,7 +287,9 @@ class ModelObserver:
         u = theta_m - self.theta0
         w0, w1 = self.u_prev, (u - self.u_prev) / h
         s = self.s
-        pred = [sum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)]
+        pred = [
+            math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
+        ]
         e = tau_reac_hat - pred[-1]
         self.s = s = [p + kk * e for p, kk in zip(pred, sm.K)]
         self.innovation = e

@@ -35,6 +35,7 @@ velocity at t_k); the returned ``i_ref`` is meant to be held over [t_k, t_k + h]
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from . import defaults
@@ -363,4 +364,4 @@ def heading(design: ControllerDesign, x: Sequence[float], i: float, h: float) ->
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:
     """``Σ a_i b_i``."""
-    return sum(p * q for p, q in zip(a, b))
+    return math.fsum(p * q for p, q in zip(a, b))

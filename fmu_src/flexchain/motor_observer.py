@@ -134,6 +134,6 @@ class MotorObserver:
         F, Gamma, gain = self.model(h)
         w = (i_a, theta_1, omega_1, friction)
         s = self.s
-        pred = [sum(map(mul, row, s)) + sum(map(mul, g, w)) for row, g in zip(F, Gamma)]
+        pred = [math.fsum(map(mul, row, s)) + math.fsum(map(mul, g, w)) for row, g in zip(F, Gamma)]
         e = theta - pred[2]
         self.s = [p + k * e for p, k in zip(pred, gain)]

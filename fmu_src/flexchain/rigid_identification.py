@@ -34,6 +34,7 @@ Multi-mass correction. For n > 1 the rigid motion is the centre of mass, not
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from .dob import sign
@@ -59,8 +60,8 @@ def kappa(J: Sequence[float]) -> float:
     float
         κ ≥ 1 (dimensionless); 1 for one mass.
     """
-    tails = [sum(J[i:]) for i in range(len(J))]
-    return sum(s * s for s in tails) / (tails[0] * tails[0])
+    tails = [math.fsum(J[i:]) for i in range(len(J))]
+    return math.fsum(s * s for s in tails) / (tails[0] * tails[0])
 
 
 class RigidChainIdentifier:
@@ -96,7 +97,7 @@ class RigidChainIdentifier:
     def __init__(
         self, J: Sequence[float], g: float, correct: bool, theta0: float, f_c: float = 0.0
     ) -> None:
-        self.total_inertia = float(sum(J))
+        self.total_inertia = math.fsum(J)
         self.kappa = kappa(J) if correct else 1.0
         self.g = g
         self.f_c = f_c

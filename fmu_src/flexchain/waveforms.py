@@ -140,7 +140,7 @@ def multisine(
     float
         The current command at ``t`` (A).
     """
-    total = sum(math.sin(w * t + p) for w, p in zip(frequencies, phases))
+    total = math.fsum(math.sin(w * t + p) for w, p in zip(frequencies, phases))
     return amplitude * total / len(frequencies)
 
 

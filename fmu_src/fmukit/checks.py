@@ -21,6 +21,12 @@ LARGEST = 1e15
 #: max(1, |t|)``) and was the refusal limit before, so every step taken before is
 #: integrated as before.
 SMALLEST_STEP = 1e-9
+#: Relative change of the step (s) below which a step is taken as the previous one: a host
+#: that keeps its time in integer nanoseconds (libcosim) hands the FMU t_k+1 − t_k, which
+#: for 1 ms steps is 1e-3 give or take a few units in the last place, and the models are
+#: discretized per step, so a closed loop through the encoder's counts would otherwise
+#: follow the host's rounding. The same step on every host, the same results.
+STEP_JITTER = 1e-12
 #: Fastest mode (rad/s) or decay rate (1/s) of a motor–spring–mass chain the models
 #: integrate; a stiffer or more damped chain is refused at initialization.
 FASTEST_RATE = 1e6

@@ -36,7 +36,7 @@ from xml.etree.ElementTree import Element
 # arcosim.fmu.pythonfmu, which re-exports the installed one.
 from ..pythonfmu.enums import Fmi2Status
 from ..pythonfmu.fmi2slave import Fmi2Slave
-from .checks import LARGEST, SMALLEST_STEP, number_problem
+from .checks import LARGEST, SMALLEST_STEP, STEP_JITTER, number_problem
 from .model_description import ModelInfo, model_description
 from .state import restore, snapshot
 from .variables import Value, Variable, par
@@ -154,6 +154,7 @@ class FmuSlave(Fmi2Slave):
         self._last_read: list[int] = []  # the last Reals read, and their getter
         self._read_last = _tuple_getter([])
         self.time: float | None = None
+        self._h = 0.0  # the step last taken (s): see STEP_JITTER
         self.stale = False
         self.lazy: frozenset[int] = frozenset()
         self.initialized = False
@@ -265,8 +266,10 @@ class FmuSlave(Fmi2Slave):
                 return False
             if step_size < SMALLEST_STEP:
                 return self._hold(current_time + step_size)
+        if abs(step_size - self._h) > STEP_JITTER * self._h:
+            self._h = step_size
         try:
-            self.step(current_time, step_size)
+            self.step(current_time, self._h)
         except StepRefusedError as refusal:
             self.report(str(refusal), Fmi2Status.discard)
             return False

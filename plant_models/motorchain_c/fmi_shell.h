@@ -32,8 +32,8 @@
 
 #define TEXT 2048
 #define PATH 1024
-/* LARGEST, SMALLEST_STEP and FASTEST_RATE come with plant_variables.h, from
- * fmukit/checks.py (the same for every FMU). */
+/* LARGEST, SMALLEST_STEP, STEP_JITTER and FASTEST_RATE come with plant_variables.h,
+ * from fmukit/checks.py (the same for every FMU). */
 
 /* Everything an FMU state holds (copied whole by get/set/serialize). */
 typedef struct {
@@ -59,6 +59,7 @@ typedef struct {
     char name[256];
     int logging;
     int mode; /* where the FMI 2.0 co-simulation state machine stands: one of MODE_* */
+    double h_taken; /* the step last integrated (s): see STEP_JITTER */
 } Plant;
 
 /* The states of FMI 2.0's co-simulation state machine an instance can be in, as bits,
@@ -437,6 +438,10 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
         return fmi2Discard;
     }
     if (step_problem(p, t, h)) return fmi2Discard;
+    /* a step within STEP_JITTER of the last is that step (a host's clock rounding) */
+    if (fabs(h - p->h_taken) > STEP_JITTER * p->h_taken) p->h_taken = h;
+    double t_end = t + h;
+    h = p->h_taken;
     PLANT_STATE saved = core->physics;
     if (plant_advance(core, p->cache, h)) {
         core->physics = saved;
@@ -470,7 +475,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
             core->sample = sample;
             return fmi2Discard;
         }
-    core->time = t + h;
+    core->time = t_end;
     core->time_known = 1;
     if (p->trace) write_trace(p);
     return fmi2OK;
