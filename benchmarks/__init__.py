@@ -13,6 +13,9 @@
 - :mod:`benchmarks.published_link`: a link we did not write, Quanser's rotary flexible
   link from its published parameters, on the link FMU and identified from the hub
   (``python -m benchmarks.published_link``).
+- :mod:`benchmarks.thirdparty_chain`: a chain assembled from Dymola-exported FMUs
+  (:mod:`benchmarks.thirdparty_plant`), identified and controlled
+  (``arcosim bench thirdparty --fmus DIR``).
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """
