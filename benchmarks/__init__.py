@@ -15,7 +15,8 @@
   (``python -m benchmarks.published_link``).
 - :mod:`benchmarks.thirdparty_chain`: a chain assembled from Dymola-exported FMUs
   (:mod:`benchmarks.thirdparty_plant`), identified and controlled
-  (``arcosim bench thirdparty --fmus DIR``).
+  (``arcosim bench thirdparty --fmus DIR``); :mod:`benchmarks.thirdparty_cosim`, the same
+  chain coupled explicitly in co-simulation (one-off, why it is not).
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """
