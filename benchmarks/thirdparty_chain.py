@@ -283,11 +283,16 @@ def identification_table(per_seed: dict) -> str:
         got = [i["parameters"][name] for i in ids if name in i["parameters"]]
         err = [abs(g["error_percent"]) for g in got]
         covered = sum(abs(g["error_sigmas"]) <= 2.0 for g in got)
-        rows.append([name, f"{got[0]['true']:.4g}", f"{np.median(err):.3f}", f"{max(err):.3f}",
+        rows.append([name, f"{got[0]['true']:.4g}", _pct(np.median(err)), _pct(max(err)),
                      f"{np.median([g['error_sigmas'] for g in got]):+.1f}",
                      f"{covered}/{len(got)}"])  # fmt: skip
     head = ["parameter", "true", "|error| median (%)", "worst (%)", "median error/σ", "within 2σ"]
     return f"n found = {CHAIN.n} on {right}/{len(ids)} seeds\n\n{markdown_table(head, rows)}\n"
+
+
+def _pct(value: float) -> str:
+    """A percentage, or a dash for a true value of 0 (then the value is 0 exactly or not)."""
+    return "—" if math.isnan(value) else f"{value:.3f}"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
