@@ -266,7 +266,7 @@ def coupling_table(check: dict) -> str:
     modes = markdown_table(["", "model (rad/s)", "FMU chain (rad/s)", "ζ model", "ζ FMU"], rows)
     names = ["motor", *(f"mass {i}" for i in range(1, CHAIN.n + 1))]
     steps = markdown_table(
-        ["", "largest |Δθ| (rad)", "relative to the swing"],
+        ["", "largest abs. Δθ (rad)", "relative to the swing"],
         [[m, f"{e:.2e}", f"{r:.2e}"] for m, e, r in
          zip(names, check["step_error"], check["step_error_relative"])],
     )  # fmt: skip
@@ -286,7 +286,7 @@ def identification_table(per_seed: dict) -> str:
         rows.append([name, f"{got[0]['true']:.4g}", _pct(np.median(err)), _pct(max(err)),
                      f"{np.median([g['error_sigmas'] for g in got]):+.1f}",
                      f"{covered}/{len(got)}"])  # fmt: skip
-    head = ["parameter", "true", "|error| median (%)", "worst (%)", "median error/σ", "within 2σ"]
+    head = ["parameter", "true", "median abs. error (%)", "worst (%)", "median err/σ", "in 2σ"]
     return f"n found = {CHAIN.n} on {right}/{len(ids)} seeds\n\n{markdown_table(head, rows)}\n"
 
 
