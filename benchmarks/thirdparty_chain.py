@@ -57,6 +57,7 @@ from arcosim.experiments.scenarios import IDENTIFICATION_DURATION, identificatio
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR, I_NOISE_STD, STEP
 from arcosim.identification.drive import DriveIdentification, identify_drive
+from arcosim.logs import write_csv
 from benchmarks import control_accuracy
 from benchmarks.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
 
@@ -151,39 +152,65 @@ def coupling(
     }
 
 
-def identify(folder: Path | None, seed: int) -> DriveIdentification:
-    """:data:`CHAIN` identified from a 20 s log of the assembled plant (the
-    ``identification`` multi-sine), n and the friction found from the log; with
-    ``folder`` None, of the project's plant with the same chain (:data:`OWN_PLANT`)."""
+def identification_log(folder: Path | None, seed: int) -> LoopRun:
+    """A 20 s log of the ``identification`` multi-sine on the assembled plant (seed
+    ``seed``); with ``folder`` None, on the project's plant with the same chain
+    (:data:`OWN_PLANT`)."""
     t = np.arange(round(IDENTIFICATION_DURATION / STEP)) * STEP
     excitation = OpenLoop(identification_current(t))
     if folder is None:
         own = {**OWN_PLANT, "seed": seed}
-        log = run_closed_loop(
+        return run_closed_loop(
             ensure_built(CHAIN.n), CHAIN.n, excitation, 0.0, IDENTIFICATION_DURATION, plant=own
         )
-    else:
-        with open_plant(folder, seed) as plant:
-            log = run_loop(plant, excitation, 0.0, IDENTIFICATION_DURATION)
+    with open_plant(folder, seed) as plant:
+        return run_loop(plant, excitation, 0.0, IDENTIFICATION_DURATION)
+
+
+def identify(folder: Path | None, seed: int) -> DriveIdentification:
+    """:data:`CHAIN` identified from :func:`identification_log`, n and the friction found
+    from the log (k_t and J_m given)."""
+    log = identification_log(folder, seed)
     return identify_drive(log.time, log.i_a, log.omega_m, log.theta_m, k_t=defaults.K_T,
                           J_m=defaults.J_M, encoder_cpr=ENCODER_CPR)  # fmt: skip
 
 
+def write_log(run: LoopRun, path: Path) -> Path:
+    """``run`` as a log in the project's format (CSV and ``.units.json``: ``time``,
+    ``i_a``, ``omega_m``, ``theta_m`` and the masses' true angles), for ``arcosim
+    identify``."""
+    columns = {"time": run.time, "i_a": run.i_a, "omega_m": run.omega_m, "theta_m": run.theta_m}
+    columns.update({f"theta_{i}_true": run.theta[i] for i in range(1, len(run.theta))})
+    units = {f"theta_{i}_true": "rad" for i in range(1, len(run.theta))}
+    return write_csv(path, columns, units=units, force=True, option="--log")
+
+
 def identification_errors(result: DriveIdentification) -> dict[str, object]:
-    """n, and every J_i, k_i, B_i and the friction: value, σ, error (%), error / σ."""
+    """n, and every J_i, k_i, B_i and the friction: value, σ (or the upper bound of a
+    parameter at its bound), error (%), error / σ (a bound counts as covering the truth,
+    0, when the truth lies within it)."""
     p, s = {**result.friction, **result.parameters}, result.std
+    bounds = dict(result.report().get("bounds", {}))
     truth = {"D_m": D_M, "f_c": 0.0, **CHAIN.plant_values()}
     rows = {}
     for name, true in truth.items():
         if name not in p:
             continue
         value, sigma = float(p[name]), float(s.get(name, math.nan))
+        bound = bounds.get(name)
+        if sigma > 0:
+            off = (value - true) / sigma
+        elif bound is not None:
+            off = 0.0 if 0.0 <= true <= float(bound) else math.inf
+        else:
+            off = _off(value, true)
         rows[name] = {
             "true": true,
             "value": value,
             "sigma": sigma,
+            "bound": bound,
             "error_percent": 100.0 * (value / true - 1.0) if true else math.nan,
-            "error_sigmas": (value - true) / sigma if sigma > 0 else _off(value, true),
+            "error_sigmas": off,
         }
     return {"masses": result.masses, "parameters": rows, "warnings": list(result.warnings)}
 
@@ -306,6 +333,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--fmus", type=Path, required=True, help=f"folder holding {FMU_FILE}")
     p.add_argument("--seeds", type=int, default=5, help="plant seeds (default 5)")
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the tables")
+    p.add_argument("--log", type=Path, help="also write the first seed's identification log "
+                   "(CSV) for `arcosim identify`")  # fmt: skip
     p.set_defaults(execute=_execute)
 
 
@@ -315,6 +344,8 @@ def _execute(args: argparse.Namespace) -> int:
     if not (args.fmus / FMU_FILE).is_file():
         print(f"skip: {where(args.fmus)}")
         return 0
+    if args.log:
+        print(f"wrote {write_log(identification_log(args.fmus, 1), args.log)}")
     result = run(args.fmus, args.out, range(1, args.seeds + 1), _progress)
     for table in result["tables"].values():
         print(table)
