@@ -14,6 +14,10 @@
   link from its published parameters, on the link FMU and on the continuous beam's modes
   (:mod:`benchmarks.modal_link`, a simulator written apart from the FMU), identified
   from the hub (``python -m benchmarks.published_link``).
+- :mod:`benchmarks.thirdparty_chain`: a chain assembled from Dymola-exported FMUs
+  (:mod:`benchmarks.thirdparty_plant`), identified and controlled
+  (``arcosim bench thirdparty --fmus DIR``); :mod:`benchmarks.thirdparty_cosim`, the same
+  chain coupled explicitly in co-simulation (one-off, why it is not).
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """

@@ -1,4 +1,5 @@
-"""``arcosim bench accuracy|speed|control|public [ARGS...]``: run a benchmark of a source checkout.
+"""``arcosim bench NAME [ARGS...]``: run a benchmark (accuracy, speed, control, public,
+thirdparty) of a source checkout.
 
 The benchmarks live in the repository's ``benchmarks/`` folder (they are not part of
 the installed package); this command finds that folder from the current directory
@@ -21,6 +22,7 @@ BENCHMARKS = {
     "speed": "speed",
     "control": "control_accuracy",
     "public": "public_records",
+    "thirdparty": "thirdparty_chain",
 }
 
 
@@ -29,7 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p = add_command(
         subparsers,
         "bench",
-        summary="run a benchmark of the source checkout (accuracy, speed, control, public)",
+        summary="run a benchmark of the source checkout (accuracy, speed, control, public, …)",
         description="""
 Run one of the benchmarks in a source checkout's benchmarks/ folder (they are not
 part of the installed package): the folder is found from the current directory
@@ -37,7 +39,8 @@ upwards, and ARGS go to the benchmark (arcosim bench NAME --help lists them)."""
         examples="""
 arcosim bench accuracy
 arcosim bench speed --help
-arcosim bench public --data DIR     # public measured records, see its --help""",
+arcosim bench public --data DIR     # public measured records, see its --help
+arcosim bench thirdparty --fmus DIR # a chain of Dymola-exported FMUs, see its --help""",
     )
     p.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
     p.add_argument("args", nargs=argparse.REMAINDER, help="the benchmark's own arguments")

@@ -1,0 +1,59 @@
+"""A chain assembled from a plant we did not write (Dymola's ``edrive_mass.fmu``) against the
+project's exact plant FMU.
+
+The FMU is not in the repository: name the folder that holds it with
+``ARCOSIM_THIRDPARTY_FMUS`` (where to get it: :data:`benchmarks.thirdparty_plant.SOURCE`);
+without it the test skips saying so.
+
+The tolerance comes from the coupling: every stage of the classic Runge–Kutta step goes
+through the FMUs (model exchange, no co-simulation delay), so the assembled chain differs
+from ``MotorChainPlant``'s matrix exponential by RK4's phase error alone, at most
+ω T (ω s)⁴ / 120 rad at the fastest mode ω after T seconds with steps of s; an angle
+swinging over A radians is then off by at most A times that. Halving s must divide the
+difference by about 2⁴ (fourth order), which an explicitly coupled spring (first order,
+its torque a step late) would not.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from benchmarks import thirdparty_chain
+from benchmarks.thirdparty_plant import ENV, FMU_FILE, where
+
+
+@pytest.fixture(scope="module")
+def folder() -> Path:
+    named = os.environ.get(ENV)
+    path = Path(named) if named else None
+    if path is None or not (path / FMU_FILE).is_file():
+        pytest.skip(where(path))
+    return path
+
+
+@pytest.mark.slow
+@pytest.mark.system
+def test_assembled_chain_rings_as_the_project_plant(folder):
+    check = thirdparty_chain.coupling(folder, substeps=1, duration=1.0)
+    # the linear map through the FMUs has the model's modes and damping
+    assert np.allclose(check["fmu_modes"], check["modes"], rtol=1e-6)
+    assert np.allclose(check["fmu_zeta"], check["zeta"], rtol=1e-4)
+    # a current step and free ringing: within RK4's phase-error bound at the fastest mode
+    omega, s, T = max(check["modes"]), thirdparty_chain.STEP, check["duration"]
+    bound = omega * T * (omega * s) ** 4 / 120.0
+    assert max(check["step_error_relative"]) < bound
+    finer = thirdparty_chain.coupling(folder, substeps=2, duration=1.0)
+    ratio = check["step_error"][0] / finer["step_error"][0]
+    assert ratio > 8.0, f"halving the step divided the motor's error by {ratio:.1f} only"
+
+
+def test_benchmark_skips_naming_the_source_when_the_fmu_is_absent(tmp_path, capsys):
+    from benchmarks import main
+
+    assert main("thirdparty", thirdparty_chain.add_parser, ["--fmus", str(tmp_path)]) == 0
+    said = capsys.readouterr().out
+    assert "skip" in said and FMU_FILE in said and "OMSimulator" in said
