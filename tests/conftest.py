@@ -106,3 +106,36 @@ def libcosim_python(venvs: Callable[[str], str]) -> str:
     from tests.foreign_hosts import libcosim_venv
 
     return libcosim_venv(venvs)
+
+
+def _needs_data(item: pytest.Item) -> str | None:
+    """The environment variable a ``data`` test's folder is named by, when it is unset."""
+    marker = item.get_closest_marker("data")
+    if marker is None or os.environ.get(marker.args[0]):
+        return None
+    return marker.args[0]
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Deselect the tests that read fetched files whose folder is not named (marker
+    ``data``): CI has no such files and skips nothing; the summary says what to set."""
+    unnamed = {item: _needs_data(item) for item in items}
+    left_out = [item for item, variable in unnamed.items() if variable]
+    if left_out:
+        config.hook.pytest_deselected(items=left_out)
+        items[:] = [item for item in items if not unnamed[item]]
+        config.stash[_DATA_LEFT_OUT] = sorted({v for v in unnamed.values() if v})
+
+
+_DATA_LEFT_OUT = pytest.StashKey[list[str]]()
+
+
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    """Name the variables that would run the deselected ``data`` tests."""
+    variables = config.stash.get(_DATA_LEFT_OUT, [])
+    if variables:
+        terminalreporter.write_line(
+            "deselected: tests that read fetched files; name their folder with "
+            + ", ".join(f"{v}=DIR" for v in variables)
+            + " (where to get them: docs/control.md, docs/identification.md)"
+        )

@@ -3,7 +3,8 @@ project's exact plant FMU.
 
 The FMU is not in the repository: name the folder that holds it with
 ``ARCOSIM_THIRDPARTY_FMUS`` (where to get it: :data:`benchmarks.thirdparty_plant.SOURCE`);
-without it the test skips saying so.
+without it the test is deselected (marker ``data``) and the run's summary says so; a
+folder without the file skips, naming where to get it.
 
 The tolerance comes from the coupling: every stage of the classic Runge–Kutta step goes
 through the FMUs (model exchange, no co-simulation delay), so the assembled chain differs
@@ -37,6 +38,7 @@ def folder() -> Path:
 
 @pytest.mark.slow
 @pytest.mark.system
+@pytest.mark.data(ENV)
 def test_assembled_chain_rings_as_the_project_plant(folder):
     check = thirdparty_chain.coupling(folder, substeps=1, duration=1.0)
     # the linear map through the FMUs has the model's modes and damping
