@@ -60,12 +60,10 @@ def test_a_rigid_drive_is_n_0_with_its_load_inertia_and_friction(rigid_log) -> N
     assert result.observer_parameters()["dJm"] == values["J_load"]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="measured: the rigid fit's D_m comes out ≈ 0 ± 5e-7 (true 2e-5) with friction "
-    "unknown, f_c +3 % ± 0.6 %: the bound the rule reports misses D_m; open",
-)
 def test_the_rigid_drive_friction_is_covered(rigid_log) -> None:
+    """D_m and f_c within 2σ, or the truth inside the bound reported (the sign of the
+    friction smoothed until its reversals stop lagging; a term the rule leaves out
+    widens the σ of the ones it keeps by how far they move without it)."""
     d, log = rigid_log
     result = identify(d, log)
     bounds, values, std = result.report()["bounds"], result.parameters, result.std
