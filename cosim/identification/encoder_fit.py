@@ -55,7 +55,8 @@ SIGN_ITERATIONS = 4
 
 #: Passes of a rigid drive's fit (n = 0, cheap) after the first, each with the sign
 #: smoothed with the pass before's drive: the sign of a slow slide or a stop settles
-#: over passes (D_m 0 → 1.2e-5 → 1.4e-5, truth 2e-5, on a 10 s ball-screw record).
+#: over passes (on a 10 s ball-screw record, truth 2e-5: D_m 0 without them, 1.0e-5
+#: with 3 passes, 1.3e-5 with 6 passes of 8 smoothings: it settles slowly).
 RIGID_PASSES = 3
 
 #: Iterations of each least-squares pass (a start from the record's modes converges
@@ -169,9 +170,10 @@ def smoothed_sign(record: EncoderRecord, drive: Drive) -> EncoderRecord | None:
     The smoother pins the angle to the encoder, so a friction sign that turns late
     drives its velocity through 0 late too (the torque ±f_c it holds too long bends
     the velocity that the counts fix): the sign of one smoothing keeps its own lag
-    (1.5 ms on the ball-screw axis, enough to take 10 % of D_m and 0.2 % of J_load
-    for Coulomb friction). Smoothing again with the sign it gave takes the lag out in
-    2–3 rounds (to < 0.1 ms).
+    (1.5 ms on a ball-screw record, enough to take 10 % of D_m for Coulomb friction).
+    Smoothing again with the sign it gave takes the lag out in 2–3 rounds (to < 0.1 ms
+    with the true drive). The first round's sign is :func:`stuck_aware_sign`, the
+    others :func:`settled_sign`.
     """
     for round in range(SIGN_ITERATIONS):
         with np.errstate(all="ignore"):

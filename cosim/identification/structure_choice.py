@@ -181,8 +181,7 @@ def friction_start(result: ParameterFit, encoder: EncoderRecord, name: str) -> f
     """Start of the friction term ``name`` (``"D_m"`` N·m·s/rad or ``"f_c"`` N·m) for
     the candidates: ``result``'s fitted value, or the record's start where the fit left
     it at its bound (at least 1e-9). Not the larger of the two: the record's start is a
-    rough rigid-body reading (D_m 38× the truth on a ball-screw axis), and a candidate
-    started there ended above the form without the term (BIC) in its 40 iterations."""
+    rough rigid-body reading (D_m 38× the truth on a ball-screw axis)."""
     fitted = float(result.extra[name])
     if name in result.extra.get("bounds", {}) or fitted <= 0.0:
         return max(getattr(encoder, name), 1e-9)
