@@ -49,8 +49,10 @@ from arcosim.identification.records import EncoderRecord, MotorRecord, mean_sign
 #: stuck in the second pass: its friction is the torque that holds it (within ±f_c).
 STUCK_VELOCITY_COUNTS = 20.0
 
-#: Smoothings that set the friction's sign in the second pass, each with the sign the
-#: one before found (:func:`smoothed_sign`; one leaves a lag of ~1.5 ms at reversals).
+#: Smoothings that set a rigid drive's friction sign in the second pass, each with the
+#: sign the one before found (:func:`smoothed_sign`; one leaves a lag of ~1.5 ms at
+#: reversals). A chain keeps one: more tipped a three-mass chain's friction form to
+#: Coulomb only (B_1 +120 %, ``tests/test_field_identification.py``); open.
 SIGN_ITERATIONS = 4
 
 #: Passes of a rigid drive's fit (n = 0, cheap) after the first, each with the sign
@@ -169,7 +171,7 @@ def settled_sign(record: EncoderRecord, drive: Drive, states: np.ndarray) -> np.
 
 def smoothed_sign(record: EncoderRecord, drive: Drive, rounds: int) -> EncoderRecord | None:
     """``record`` with the friction's sign (:func:`stuck_aware_sign`) and velocity of
-    the Kalman smoother's states for ``drive``, smoothed :data:`SIGN_ITERATIONS` times,
+    the Kalman smoother's states for ``drive``, smoothed ``rounds`` times (a count),
     each with the sign the one before found; None when the smoother diverges.
 
     The smoother pins the angle to the encoder, so a friction sign that turns late
