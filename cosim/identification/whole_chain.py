@@ -376,7 +376,9 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
     first :data:`CONFIRM_SECONDS`: from the modes seen, the weakest dropped one at a
     time as long as the rule prefers the chain without it, down to the rigid drive (a
     pole of the noise or of an excitation line adds nothing to the prediction of the
-    encoder). Returns n and, per n tried, its scores."""
+    encoder); where the descent stops above 0, the rigid drive against the chain it
+    stopped at (two spurious modes can fit the noise better than one). Returns n and,
+    per n tried, its scores."""
     short = encoder_opening(encoder, CONFIRM_SECONDS)
 
     def candidate(m: int) -> Candidate | None:
@@ -397,6 +399,11 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
         if not pair or choose(pair).name != f"n={n - 1}":
             break
         n -= 1
+    if n >= 1 and 0 not in tried:  # a spurious chain between may stop the descent early
+        tried[0] = candidate(0)
+        pair = [c for c in (tried[0], tried[n]) if c is not None]
+        if pair and choose(pair).name == "n=0":
+            n = 0
     table = scores([c for c in tried.values() if c is not None])
     return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
 
