@@ -173,6 +173,13 @@ class ChainChoice:
         :func:`~arcosim.identification.modal_start.detect_modes`).
     singular_values : ndarray or None
         The subspace step's singular values, relative to the first (dimensionless).
+    leaner : ParameterFit or None
+        When the chosen chain keeps weakly determined modes (residue t under
+        :data:`~arcosim.identification.fit_notes.T_CONFIRM`): the fit without them, so
+        its residual can be held against the noise floor (a wrong k_t adds an inertia
+        on the motor that a weak extra mode takes up); None otherwise.
+    leaner_dropped : list of float
+        The weakly determined modes ``leaner`` leaves out (rad/s).
     """
 
     n: int
@@ -182,6 +189,8 @@ class ChainChoice:
     refused: dict[int, str] = field(default_factory=dict)
     seen: int | None = None
     singular_values: np.ndarray | None = None
+    leaner: ParameterFit | None = None
+    leaner_dropped: list[float] = field(default_factory=list)
 
 
 @single_threaded
@@ -280,6 +289,7 @@ def identify_whole_chain(
     refused = {}
     if detected.weak:
         refused[n + 1] = missing_modes(detected, n + 1, record)
+    leaner, dropped = _without_weak_modes(record, encoder, detected, n)
     return ChainChoice(
         n,
         result,
@@ -288,7 +298,31 @@ def identify_whole_chain(
         refused,
         detected.n,
         detected.singular_values,
+        leaner,
+        dropped,
     )
+
+
+def _without_weak_modes(
+    record: MotorRecord, encoder: EncoderRecord | None, detected: DetectedModes, n: int
+) -> tuple[ParameterFit | None, list[float]]:
+    """The prediction-error fit of the chain without the weakly determined modes the
+    n-mass chain keeps (residue t under :data:`T_CONFIRM`), and those modes (rad/s);
+    ``(None, [])`` when it keeps none, without the encoder, or when it does not fit."""
+    if encoder is None or n < 1:
+        return None, []
+    kept = _strongest(detected, n)
+    t = {float(w): float(v) for w, v in zip(detected.frequency, detected.t_value)}
+    dropped = [float(w) for w in kept.frequency if t.get(float(w), np.inf) < T_CONFIRM]
+    if not dropped:
+        return None, []
+    m = n - len(dropped)
+    try:
+        if m == 0:
+            return rigid_fit(encoder, record), dropped
+        return _prediction_error(record, encoder, _strongest(detected, m)), dropped
+    except (IdentificationError, ValueError, np.linalg.LinAlgError):
+        return None, []
 
 
 def first_reading(
