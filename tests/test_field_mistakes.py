@@ -21,10 +21,10 @@ def test_the_record_s_length_against_its_lowest_mode() -> None:
     assert mode_record_length(np.arange(3001) * 1e-3, None) is None
 
 
-def _named(name: str, seed: int) -> dict:
+def _named(name: str, seed: int, seconds: float = 20.0) -> dict:
     from benchmarks import field_accuracy
 
-    return field_accuracy.run_row(field_accuracy.ROWS[name], seed)
+    return field_accuracy.run_row(field_accuracy.ROWS[name], seed, seconds)
 
 
 @pytest.mark.slow
@@ -45,5 +45,5 @@ def test_k_t_high_with_a_weak_extra_mode_kept_names_k_t() -> None:
 
 @pytest.mark.slow
 def test_a_current_in_a_read_as_ma_names_the_current_scale() -> None:
-    r = _named("mistake: current in A, --scale i_a=0.001", 1)
+    r = _named("mistake: current in A, --scale i_a=0.001", 1, 10.0)
     assert r["cause_named"], r["said"]

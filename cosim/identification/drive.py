@@ -266,9 +266,8 @@ def identify_drive(
         above = floor_warning(fit.rms_residual, floor, sigma_i)
         if above is None and choice.leaner is not None:
             # a weak mode kept may take up what a wrong k_t or J_m leaves: the fit without
-            above = weak_mode_floor_warning(
-                choice.leaner_dropped, choice.leaner.rms_residual, floor, sigma_i
-            )
+            dropped = choice.leaner.extra["dropped_weak_modes_rad_s"]
+            above = weak_mode_floor_warning(dropped, choice.leaner.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -67,6 +68,7 @@ from arcosim.identification.structure_choice import (
     load_check,
     scores,
 )
+from arcosim.identification.weak_modes import without_weak_modes
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
@@ -174,12 +176,8 @@ class ChainChoice:
     singular_values : ndarray or None
         The subspace step's singular values, relative to the first (dimensionless).
     leaner : ParameterFit or None
-        When the chosen chain keeps weakly determined modes (residue t under
-        :data:`~arcosim.identification.fit_notes.T_CONFIRM`): the fit without them, so
-        its residual can be held against the noise floor (a wrong k_t adds an inertia
-        on the motor that a weak extra mode takes up); None otherwise.
-    leaner_dropped : list of float
-        The weakly determined modes ``leaner`` leaves out (rad/s).
+        The fit without the weakly determined modes n keeps (those in its ``extra``,
+        :func:`~arcosim.identification.weak_modes.without_weak_modes`).
     """
 
     n: int
@@ -190,7 +188,6 @@ class ChainChoice:
     seen: int | None = None
     singular_values: np.ndarray | None = None
     leaner: ParameterFit | None = None
-    leaner_dropped: list[float] = field(default_factory=list)
 
 
 @single_threaded
@@ -289,7 +286,7 @@ def identify_whole_chain(
     refused = {}
     if detected.weak:
         refused[n + 1] = missing_modes(detected, n + 1, record)
-    leaner, dropped = _without_weak_modes(record, encoder, detected, n)
+    leaner = without_weak_modes(detected, n, encoder and partial(_fit_m, record, encoder, detected))
     return ChainChoice(
         n,
         result,
@@ -299,30 +296,7 @@ def identify_whole_chain(
         detected.n,
         detected.singular_values,
         leaner,
-        dropped,
     )
-
-
-def _without_weak_modes(
-    record: MotorRecord, encoder: EncoderRecord | None, detected: DetectedModes, n: int
-) -> tuple[ParameterFit | None, list[float]]:
-    """The prediction-error fit of the chain without the weakly determined modes the
-    n-mass chain keeps (residue t under :data:`T_CONFIRM`), and those modes (rad/s);
-    ``(None, [])`` when it keeps none, without the encoder, or when it does not fit."""
-    if encoder is None or n < 1:
-        return None, []
-    kept = _strongest(detected, n)
-    t = {float(w): float(v) for w, v in zip(detected.frequency, detected.t_value)}
-    dropped = [float(w) for w in kept.frequency if t.get(float(w), np.inf) < T_CONFIRM]
-    if not dropped:
-        return None, []
-    m = n - len(dropped)
-    try:
-        if m == 0:
-            return rigid_fit(encoder, record), dropped
-        return _prediction_error(record, encoder, _strongest(detected, m)), dropped
-    except (IdentificationError, ValueError, np.linalg.LinAlgError):
-        return None, []
 
 
 def first_reading(
@@ -365,6 +339,13 @@ def _prediction_error(
     if record is not None:
         result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
     return result
+
+
+def _fit_m(record: MotorRecord, encoder: EncoderRecord, detected: DetectedModes, m: int):
+    """The prediction-error fit of the m strongest modes (m = 0: the rigid drive)."""
+    if m == 0:
+        return rigid_fit(encoder, record)
+    return _prediction_error(record, encoder, _strongest(detected, m))
 
 
 def _same_modes(a: DetectedModes, b: DetectedModes, tolerance: float = 5e-3) -> bool:
