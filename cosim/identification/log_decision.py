@@ -210,13 +210,14 @@ def decide_log(
 
 
 def _length_against_modes(decision: LogDecision, time: np.ndarray) -> None:
-    """The record's length against the lowest mode the fit reads (the modes that count
-    and those seen too weakly excited to, t ≥ :data:`WEAK_T`), a plausibility warning:
-    it does not rest on finding the lines."""
+    """The record's length against the lowest mode the fit reads (of the modes that
+    count; when none does, of those seen too weakly excited to, t ≥ :data:`WEAK_T`), a
+    plausibility warning: it does not rest on finding the lines."""
     detected = decision.detected
     if detected is None:
         return
-    seen = [float(w) for w in detected.frequency] + [w for w, t in detected.weak if t >= WEAK_T]
+    seen = [float(w) for w in detected.frequency]
+    seen = seen or [w for w, t in detected.weak if t >= WEAK_T]
     if not seen:
         return
     found = mode_record_length(time, min(seen))
