@@ -73,7 +73,8 @@ class Row:
         note: one line for the table.
         mistake: a field mistake the user makes, or None: ``"time_ms"`` (the time
             column in ms), ``"k_t"`` / ``"J_m"`` (the datasheet value given 10 % high),
-            ``"short"`` (a 3 s record).
+            ``"short"`` (a 3 s record), ``"i_a_scale"`` (the current logged in A but
+            read with the README's ``--scale i_a=0.001``: 1000 × too small).
         expect: for a row with a mistake or an unmodelled effect, a regular expression
             the refusal or a warning must match (the cause named).
         J_load: a rigid drive's load inertia (kg·m²; the drive's J_m holds motor and
@@ -218,29 +219,36 @@ ROWS: dict[str, Row] = {
             "mistake: time in ms",
             _drive(*_THREE),
             mistake="time_ms",
-            expect="time",
+            expect=r"--scale time=0\.001",
             note="the log's time column in ms, no --scale",
         ),
         Row(
             "mistake: k_t +10 %",
             _drive(*_THREE),
             mistake="k_t",
-            expect="k_t",
+            expect=r"noise floor.*check k_t and J_m",
             note="k_t given 10 % high; lines to 150 rad/s = 2.8 × the top mode 53",
         ),
         Row(
             "mistake: J_m +10 %",
             _drive(*_THREE),
             mistake="J_m",
-            expect="J_m",
+            expect=r"noise floor.*check k_t and J_m",
             note="J_m given 10 % high; lines to 150 rad/s = 2.8 × the top mode 53",
         ),
         Row(
             "mistake: 3 s record",
             _drive(*_THREE),
             mistake="short",
-            expect="lasts",
+            expect=r"the record lasts .* periods of its lowest mode",
             note="the README's excitation (40 lines 3–150 rad/s, 3 A), 3 s",
+        ),
+        Row(
+            "mistake: current in A, --scale i_a=0.001",
+            _drive(*_THREE),
+            mistake="i_a_scale",
+            expect=r"--scale i_a",
+            note="the current logged in A, read as mA (the README's --scale left in)",
         ),
     )
 }
@@ -262,12 +270,13 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     k_t, J_m = d.k_t * (1.1 if row.mistake == "k_t" else 1.0), d.J_m - row.J_load
     J_m *= 1.1 if row.mistake == "J_m" else 1.0
     times = log.time * (1e3 if row.mistake == "time_ms" else 1.0)
+    current = log.i_a * (1e-3 if row.mistake == "i_a_scale" else 1.0)
     wall, cpu = time.perf_counter(), time.process_time()
     out: dict = {"seed": seed, "stuck_fraction": log.stuck_fraction}
     try:
         result = identify_drive(
             times,
-            log.i_a,
+            current,
             log.omega_m,
             log.theta_m,
             k_t=k_t,

@@ -38,6 +38,8 @@ whole_chain       -- every J_i, k_i, B_i and n from the motor alone (identify_wh
 fit_notes         -- a whole-chain result's assumptions, and why a record cannot
                      support a chain (missing_modes)
 noise_floor       -- the residual the encoder's counts and the current's noise explain
+weak_modes        -- the chain without the weak modes it keeps, for the floor's check
+                     (without_weak_modes)
 
 Flexible link
 -------------
@@ -57,7 +59,8 @@ offline_observer  -- the observer FMU's algorithms run over a log
 Checks
 ------
 plausibility      -- are the log's units and length plausible? (the step against the
-                     motion, the torque balance, the record's length)
+                     motion, the torque balance, the record's length against the
+                     lowest line and the lowest mode)
 log_decision      -- the one set of decisions check reports and identify refuses by
                      (decide_log, LogDecision)
 log_check         -- can a log support identification? (check_log, CheckReport)

@@ -20,7 +20,11 @@ from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.encoder_fit import RIGID_LOAD
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_decision import decide_log
-from arcosim.identification.noise_floor import floor_warning, noise_floor
+from arcosim.identification.noise_floor import (
+    floor_warning,
+    noise_floor,
+    weak_mode_floor_warning,
+)
 from arcosim.identification.records import LOADS, MotorRecord
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
@@ -260,6 +264,10 @@ def identify_drive(
         rigid = parameters.get(RIGID_LOAD, 0.0)
         floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid)
         above = floor_warning(fit.rms_residual, floor, sigma_i)
+        if above is None and choice.leaner is not None:
+            # a weak mode kept may take up what a wrong k_t or J_m leaves: the fit without
+            dropped = choice.leaner.extra["dropped_weak_modes_rad_s"]
+            above = weak_mode_floor_warning(dropped, choice.leaner.rms_residual, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,

@@ -10,7 +10,8 @@ exactly when ``identify`` goes on to fit, and every warning ``check`` gives,
 - the sample step: increasing, at least 16 samples, constant (a problem otherwise: the
   fits need a constant step);
 - the log's plausibility (:mod:`arcosim.identification.plausibility`: its units, the
-  torque balance, the record's length against the lowest frequency excited), warnings;
+  torque balance, the record's length against the lowest frequency excited and, once
+  the modes are read, against the lowest mode seen), warnings;
 - the motion: an encoder range under :data:`LEAST_RANGE_COUNTS` counts, a motor
   standing still more than :data:`STUCK_LIMIT` of the time (Coulomb friction then holds
   it), warnings;
@@ -37,7 +38,7 @@ from arcosim.identification.band import search_band
 from arcosim.identification.encoder_fit import STUCK_VELOCITY_COUNTS
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import DetectedModes
-from arcosim.identification.plausibility import plausibility_warnings
+from arcosim.identification.plausibility import mode_record_length, plausibility_warnings
 from arcosim.identification.records import (
     EncoderRecord,
     MotorRecord,
@@ -204,7 +205,25 @@ def decide_log(
             friction,
             load,
         )
+        _length_against_modes(decision, time)
     return decision
+
+
+def _length_against_modes(decision: LogDecision, time: np.ndarray) -> None:
+    """The record's length against the lowest mode the fit reads (of the modes that
+    count; when none does, of those seen too weakly excited to, t ≥ :data:`WEAK_T`), a
+    plausibility warning: it does not rest on finding the lines."""
+    detected = decision.detected
+    if detected is None:
+        return
+    seen = [float(w) for w in detected.frequency]
+    seen = seen or [w for w, t in detected.weak if t >= WEAK_T]
+    if not seen:
+        return
+    found = mode_record_length(time, min(seen))
+    if found:
+        decision.plausibility.append(found)
+        decision.warnings.insert(len(decision.plausibility) - 1, found)
 
 
 def _step(decision: LogDecision, steps: np.ndarray) -> float:

@@ -32,6 +32,12 @@ from arcosim.identification.records import motor_record
 #: 10 % off gives 3.2–16× (the sample log 4.3×, its J_m 10 % high 3.1×: missed). 4
 #: keeps every good log measured quiet and catches k_t 10 % off on 5 of 8 logs.
 FLOOR_FACTOR = 4.0
+#: The likely causes of a residual above the floor, and what to try (one clause).
+CAUSES = (
+    "check k_t and J_m (--set k_to=…, --set J_mo=…; 10 % off gives 3–16 ×), "
+    "the columns' units (--scale), an unmodelled load torque (--load slow), the "
+    "friction (--set D_m=… f_c=…) or a mode outside the band"
+)
 #: Seed of the simulated noise (the floor is a property of the log, not a draw).
 FLOOR_SEED = 0
 
@@ -145,7 +151,48 @@ def floor_warning(rms_residual: float, floor: float, sigma_i: float) -> str | No
         f"the residual ({rms_residual:.3g} N·m) is {rms_residual / floor:.2g} × the noise "
         f"floor the encoder and the current noise explain ({floor:.3g} N·m; current noise "
         f"{sigma_i:.3g} A estimated from the record; warns above {FLOOR_FACTOR:g} ×): "
-        "check k_t and J_m (--set k_to=…, --set J_mo=…; 10 % off gives 3–16 ×), "
-        "the columns' units (--scale), an unmodelled load torque (--load slow), the "
-        "friction (--set D_m=… f_c=…) or a mode outside the band"
+        f"{CAUSES}"
+    )
+
+
+def weak_mode_floor_warning(
+    dropped: Sequence[float], rms_without: float, floor: float, sigma_i: float
+) -> str | None:
+    """A warning when the fit without its weakly determined modes is above
+    :data:`FLOOR_FACTOR` × the noise floor: those modes may be real, or take up what a
+    wrong k_t or J_m leaves (k_t high puts 0.1·J_m·α into τ̂, an inertia on the motor
+    that a weak mode above the others fits).
+
+    Parameters
+    ----------
+    dropped : sequence of float
+        The weakly determined modes the fit keeps (rad/s).
+    rms_without : float
+        The RMS τ̂ residual of the fit without them (N·m).
+    floor : float
+        The noise floor (N·m, :func:`noise_floor`).
+    sigma_i : float
+        The current noise the floor assumed (A).
+
+    Returns
+    -------
+    str or None
+        The warning, naming the modes and the likely causes; None at or near the floor.
+
+    Examples
+    --------
+    >>> weak_mode_floor_warning([137.0], 1e-3, 5e-4, 0.01) is None
+    True
+    >>> weak_mode_floor_warning([137.0], 3.5e-3, 5e-4, 0.01)[:45]
+    'the weakly determined mode at 137 rad/s takes'
+    """
+    if not (floor > 0 and rms_without > FLOOR_FACTOR * floor):
+        return None
+    modes = ", ".join(f"{w:.4g}" for w in dropped)
+    return (
+        f"the weakly determined mode at {modes} rad/s takes up the misfit: without it the "
+        f"residual ({rms_without:.3g} N·m) is {rms_without / floor:.2g} × the noise floor "
+        f"the encoder and the current noise explain ({floor:.3g} N·m; current noise "
+        f"{sigma_i:.3g} A estimated from the record; warns above {FLOOR_FACTOR:g} ×): "
+        f"it may be a mode, or stand in for an error: {CAUSES}"
     )

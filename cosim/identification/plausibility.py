@@ -17,6 +17,10 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
   time column.
 - :func:`record_length`: fewer than :data:`LEAST_PERIODS` periods of the lowest line the
   current shows.
+- :func:`mode_record_length`: fewer than :data:`LEAST_MODE_PERIODS` periods of the
+  lowest mode the record shows (judged once the modes are read,
+  :func:`~arcosim.identification.log_decision.decide_log`; it does not rest on finding
+  the lines, which a short record of many close lines blurs).
 """
 
 from __future__ import annotations
@@ -40,6 +44,12 @@ INERTIA_HIGH = 1e3
 #: hold: the line's frequency is then resolved to a third of itself, and the fits' start
 #: transients (a few periods of the slowest motion) leave part of the record.
 LEAST_PERIODS = 3.0
+#: Least number of periods (a count) of the lowest mode a record should hold: its
+#: spectrum's resolution 2π/T is then at most a tenth of the mode, and the fit's start
+#: transients (a few periods of the slowest motion) leave most of the record. The 20 s
+#: logs of the benchmarks hold 36–45 periods of their lowest mode; 3 s of the README's
+#: excitation holds 5.3 of the three-mass chain's 11.2 rad/s.
+LEAST_MODE_PERIODS = 10.0
 
 
 def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
@@ -210,6 +220,43 @@ def record_length(time: np.ndarray, lowest: float | None) -> str | None:
         f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest excitation "
         f"line ({lowest:.3g} rad/s; fewer than {LEAST_PERIODS:g}): modes that low are "
         f"poorly resolved; record at least {LEAST_PERIODS * 2 * np.pi / lowest:.3g} s"
+    )
+
+
+def mode_record_length(time: np.ndarray, lowest_mode: float | None) -> str | None:
+    """The record's length against its lowest mode.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    lowest_mode : float or None
+        The lowest mode the record shows (rad/s); None: none.
+
+    Returns
+    -------
+    str or None
+        The problem and its fix, when the record holds fewer than
+        :data:`LEAST_MODE_PERIODS` periods of ``lowest_mode``; None otherwise.
+
+    Examples
+    --------
+    >>> mode_record_length(np.arange(3001) * 1e-3, 11.2)[:48]
+    'the record lasts 3 s, 5.3 periods of its lowest '
+    >>> mode_record_length(np.arange(20001) * 1e-3, 11.2) is None
+    True
+    """
+    if not lowest_mode or lowest_mode <= 0:
+        return None
+    duration = float(time[-1] - time[0])
+    periods = duration * lowest_mode / (2 * np.pi)
+    if periods >= LEAST_MODE_PERIODS:
+        return None
+    return (
+        f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest mode "
+        f"({lowest_mode:.3g} rad/s; fewer than {LEAST_MODE_PERIODS:g}): that mode and its "
+        "damping rest on few periods, their σ may not cover the error; record at least "
+        f"{LEAST_MODE_PERIODS * 2 * np.pi / lowest_mode:.3g} s"
     )
 
 

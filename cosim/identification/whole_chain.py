@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -67,6 +68,7 @@ from arcosim.identification.structure_choice import (
     load_check,
     scores,
 )
+from arcosim.identification.weak_modes import without_weak_modes
 
 #: Largest chain ``masses="auto"`` tries.
 MAX_AUTO_MASSES = 8
@@ -173,6 +175,9 @@ class ChainChoice:
         :func:`~arcosim.identification.modal_start.detect_modes`).
     singular_values : ndarray or None
         The subspace step's singular values, relative to the first (dimensionless).
+    leaner : ParameterFit or None
+        The fit without the weakly determined modes n keeps (those in its ``extra``,
+        :func:`~arcosim.identification.weak_modes.without_weak_modes`).
     """
 
     n: int
@@ -182,6 +187,7 @@ class ChainChoice:
     refused: dict[int, str] = field(default_factory=dict)
     seen: int | None = None
     singular_values: np.ndarray | None = None
+    leaner: ParameterFit | None = None
 
 
 @single_threaded
@@ -280,6 +286,7 @@ def identify_whole_chain(
     refused = {}
     if detected.weak:
         refused[n + 1] = missing_modes(detected, n + 1, record)
+    leaner = without_weak_modes(detected, n, encoder and partial(_fit_m, record, encoder, detected))
     return ChainChoice(
         n,
         result,
@@ -288,6 +295,7 @@ def identify_whole_chain(
         refused,
         detected.n,
         detected.singular_values,
+        leaner,
     )
 
 
@@ -331,6 +339,13 @@ def _prediction_error(
     if record is not None:
         result.rms_data = float(np.sqrt(np.mean(record.tau_hat**2)))
     return result
+
+
+def _fit_m(record: MotorRecord, encoder: EncoderRecord, detected: DetectedModes, m: int):
+    """The prediction-error fit of the m strongest modes (m = 0: the rigid drive)."""
+    if m == 0:
+        return rigid_fit(encoder, record)
+    return _prediction_error(record, encoder, _strongest(detected, m))
 
 
 def _same_modes(a: DetectedModes, b: DetectedModes, tolerance: float = 5e-3) -> bool:
