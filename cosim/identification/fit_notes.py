@@ -1,12 +1,14 @@
 """The sentences a whole-chain result carries (offline): what it rests on
 (:func:`assumptions`), why a record cannot support a chain (:func:`missing_modes`), and
-the one rule the fit refuses by and ``check`` judges by (:func:`refusal`).
+the one rule the fit refuses by and ``check`` judges by (:func:`refusal`), and the
+number of masses asked (:func:`masses_asked`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from arcosim.identification.errors import IdentificationError
 from arcosim.identification.modal_start import DetectedModes, chain_of
 from arcosim.identification.records import EncoderRecord, MotorRecord
 
@@ -89,3 +91,37 @@ def refusal(
             detected, None, record
         )
     return None
+
+
+def masses_asked(masses: int | str) -> int:
+    """The number of load masses a user asked for (``--masses``, not ``auto``).
+
+    Parameters
+    ----------
+    masses : int or str
+        A whole number ≥ 0 (0: a rigid drive).
+
+    Returns
+    -------
+    int
+        ``masses`` as an int.
+
+    Raises
+    ------
+    IdentificationError
+        When it is not a whole number ≥ 0 (the message names ``auto`` too).
+
+    Examples
+    --------
+    >>> masses_asked("2")
+    2
+    """
+    try:
+        n = int(masses)
+    except ValueError:
+        n = -1
+    if n < 0 or str(masses).strip() not in (str(n), "auto"):
+        raise IdentificationError(
+            f"--masses must be a whole number ≥ 0 (0: a rigid drive) or 'auto', got {masses!r}"
+        )
+    return n

@@ -36,6 +36,7 @@ from arcosim.identification.errors import IdentificationError
 from arcosim.identification.fit_notes import (
     T_CONFIRM,
     assumptions,
+    masses_asked,
     missing_modes,
     refusal,
 )
@@ -246,7 +247,7 @@ def identify_whole_chain(
     (2, 0.3)
     """
     auto = masses == "auto"
-    n_asked = None if auto else _masses(masses)
+    n_asked = None if auto else masses_asked(masses)
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
@@ -307,7 +308,7 @@ def first_reading(
     :func:`identify_whole_chain` starts from and ``check`` judges; raises
     IdentificationError for a bad ``masses`` or a record with no motion or too short."""
     auto = masses == "auto"
-    n_asked = None if auto else _masses(masses)
+    n_asked = None if auto else masses_asked(masses)
     check_excited(record)
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     detected = detect_modes(record, largest)
@@ -408,17 +409,17 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
 
     n = detected.n
     tried = {n: candidate(n)}
-    while n >= 1:
-        tried[n - 1] = candidate(n - 1)
-        pair = [c for c in (tried[n - 1], tried[n]) if c is not None]
-        if not pair or choose(pair).name != f"n={n - 1}":
-            break
+
+    def prefers(m: int, over: int) -> bool:  # the rule takes the chain of m masses
+        if m not in tried:
+            tried[m] = candidate(m)
+        pair = [c for c in (tried[m], tried[over]) if c is not None]
+        return bool(pair) and choose(pair).name == f"n={m}"
+
+    while n >= 1 and prefers(n - 1, n):
         n -= 1
-    if n >= 1 and 0 not in tried:  # a spurious chain between may stop the descent early
-        tried[0] = candidate(0)
-        pair = [c for c in (tried[0], tried[n]) if c is not None]
-        if pair and choose(pair).name == "n=0":
-            n = 0
+    if n >= 1 and prefers(0, n):  # a spurious chain between may stop the descent early
+        n = 0
     table = scores([c for c in tried.values() if c is not None])
     return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
 
@@ -443,15 +444,3 @@ def _mode_evidence(modes: Modes) -> dict:
         "damping_ratios": [float(z) for z in modes.damping],
         "singular_values": [float(x) for x in modes.singular_values[:20]],
     }
-
-
-def _masses(masses: int | str) -> int:
-    try:
-        n = int(masses)
-    except ValueError:
-        n = -1
-    if n < 0 or str(masses).strip() not in (str(n), "auto"):
-        raise IdentificationError(
-            f"--masses must be a whole number ≥ 0 (0: a rigid drive) or 'auto', got {masses!r}"
-        )
-    return n
