@@ -87,6 +87,8 @@ def venv_maker(root: Path) -> Callable[[str], str]:
         base = pythons().get(label)
         if base is None:
             pytest.skip(f"no CPython {label} on this machine")
+        if Path(base).resolve().is_relative_to(HIDDEN):
+            pytest.skip(f"CPython {label} is the one the FMUs were built with, hidden here")
         venv = root / f"fmpy-{label}"
         python = venv / "bin" / "python"
         if not (venv / ".ready").is_file():
