@@ -220,9 +220,20 @@ def test_no_python_found_fails_instantiation_cleanly(c_host, fmus, tmp_path) -> 
 def test_arcosim_libpython_chooses_the_python(
     c_host, fmus, reference, tmp_path, declared_outputs
 ) -> None:
-    chosen = sorted(glob.glob(str(Path.home() / ".pyenv/versions/3.12.*/lib/libpython3.12.so.1.0")))
+    chosen = [  # the first of these that is not the building CPython (hidden here)
+        found[-1]
+        for v in ("3.12", "3.13", "3.10")
+        if (
+            found := sorted(
+                glob.glob(str(Path.home() / f".pyenv/versions/{v}.*/lib/libpython{v}.so.1.0"))
+            )
+        )
+        and not Path(found[-1]).resolve().is_relative_to(HIDDEN)
+    ][:1]
     if not chosen:
-        pytest.skip("no pyenv CPython 3.12 with a shared libpython")
+        pytest.skip(
+            "no pyenv CPython 3.12, 3.13 or 3.10 with a shared libpython but the building one"
+        )
     out = run_c_host(c_host, fmus, tmp_path, {**bare_env(), "ARCOSIM_LIBPYTHON": chosen[-1]})
     libpythons = [t.split(" ", 1)[1] for t in out["tail"] if t.startswith("libpython ")]
     assert libpythons == [str(Path(chosen[-1]).resolve())]
