@@ -210,17 +210,27 @@ def record_length(time: np.ndarray, lowest: float | None) -> str | None:
     >>> record_length(np.arange(3001) * 1e-3, 3.0)[:32]
     'the record lasts 3 s, 1.4 period'
     """
-    if not lowest or lowest <= 0:
+    short = _periods_short(time, lowest, LEAST_PERIODS)
+    if short is None:
         return None
-    duration = float(time[-1] - time[0])
-    periods = duration * lowest / (2 * np.pi)
-    if periods >= LEAST_PERIODS:
-        return None
+    duration, periods = short
     return (
         f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest excitation "
         f"line ({lowest:.3g} rad/s; fewer than {LEAST_PERIODS:g}): modes that low are "
         f"poorly resolved; record at least {LEAST_PERIODS * 2 * np.pi / lowest:.3g} s"
     )
+
+
+def _periods_short(
+    time: np.ndarray, omega: float | None, least: float
+) -> tuple[float, float] | None:
+    """(record length in s, periods of ``omega`` rad/s in it) when fewer than ``least``
+    periods; None when ``omega`` is absent or the record is long enough."""
+    if not omega or omega <= 0:
+        return None
+    duration = float(time[-1] - time[0])
+    periods = duration * omega / (2 * np.pi)
+    return None if periods >= least else (duration, periods)
 
 
 def mode_record_length(time: np.ndarray, lowest_mode: float | None) -> str | None:
@@ -246,12 +256,10 @@ def mode_record_length(time: np.ndarray, lowest_mode: float | None) -> str | Non
     >>> mode_record_length(np.arange(20001) * 1e-3, 11.2) is None
     True
     """
-    if not lowest_mode or lowest_mode <= 0:
+    short = _periods_short(time, lowest_mode, LEAST_MODE_PERIODS)
+    if short is None:
         return None
-    duration = float(time[-1] - time[0])
-    periods = duration * lowest_mode / (2 * np.pi)
-    if periods >= LEAST_MODE_PERIODS:
-        return None
+    duration, periods = short
     return (
         f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest mode "
         f"({lowest_mode:.3g} rad/s; fewer than {LEAST_MODE_PERIODS:g}): that mode and its "
