@@ -31,6 +31,11 @@ from collections.abc import Callable, Sequence
 from arcosim.errors import ArcosimError
 
 
+def progress(text: str) -> None:
+    """Print one progress line of a benchmark's run (indented, flushed at once)."""
+    print(f"  … {text}", flush=True)
+
+
 def main(
     name: str, add_parser: Callable[[argparse._SubParsersAction], None], argv: Sequence[str]
 ) -> int:

@@ -62,6 +62,7 @@ from benchmarks import (
     excitation_accuracy,
     field_accuracy,
     load_accuracy,
+    progress,
 )
 from benchmarks.cases import ACTUATOR, CASES, G_DIST, Case, run_case, settings_for
 
@@ -471,7 +472,7 @@ def _execute(args: argparse.Namespace) -> int:
         args.seeds,
         args.b_seeds,
         args.quick,
-        progress=_progress,
+        progress=progress,
         load_torque_only=args.load_torque_only,
         beam_only=args.beam_only,
     )
@@ -479,10 +480,6 @@ def _execute(args: argparse.Namespace) -> int:
     md, js = result.get("files", ("accuracy.md", "accuracy.json"))
     print(f"wrote {args.out / md} and {args.out / js} ({result['seconds']:.0f} s)")
     return 0
-
-
-def _progress(text: str) -> None:
-    print(f"  … {text}", flush=True)
 
 
 if __name__ == "__main__":

@@ -54,6 +54,7 @@ from arcosim.experiments.motion_findings import (
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR
+from benchmarks import progress
 
 #: The chains: lowest modes 19.7, 17.1 and 13.4 rad/s (motor free), damped at 0.05–0.2 %.
 CHAINS = (
@@ -177,15 +178,11 @@ def _execute(args: argparse.Namespace) -> int:
     if args.seeds < 1:
         raise UserError(f"--seeds must be >= 1, got {args.seeds}")
     chains = CHAINS[:1] if args.quick else CHAINS
-    result = run(args.out, range(1, args.seeds + 1), chains, _progress)
+    result = run(args.out, range(1, args.seeds + 1), chains, progress)
     print(result["table"])
     print(f"wrote {args.out / 'control.md'} and {args.out / 'control.json'} "
           f"({result['seconds']:.0f} s)")  # fmt: skip
     return 0
-
-
-def _progress(text: str) -> None:
-    print(f"  … {text}", flush=True)
 
 
 if __name__ == "__main__":

@@ -58,7 +58,7 @@ from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR, I_NOISE_STD, STEP
 from arcosim.identification.drive import DriveIdentification, identify_drive
 from arcosim.logs import write_csv
-from benchmarks import control_accuracy
+from benchmarks import control_accuracy, progress
 from benchmarks.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
 
 #: The chain: control_accuracy's first (lowest mode 19.7 rad/s).
@@ -346,16 +346,12 @@ def _execute(args: argparse.Namespace) -> int:
         return 0
     if args.log:
         print(f"wrote {write_log(identification_log(args.fmus, 1), args.log)}")
-    result = run(args.fmus, args.out, range(1, args.seeds + 1), _progress)
+    result = run(args.fmus, args.out, range(1, args.seeds + 1), progress)
     for table in result["tables"].values():
         print(table)
     print(f"wrote {args.out / 'thirdparty.md'} and {args.out / 'thirdparty.json'} "
           f"({result['seconds']:.0f} s)")  # fmt: skip
     return 0
-
-
-def _progress(text: str) -> None:
-    print(f"  … {text}", flush=True)
 
 
 if __name__ == "__main__":
