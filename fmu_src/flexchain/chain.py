@@ -30,14 +30,7 @@ def spring_matrix(gains: Sequence[float]) -> Matrix:
     Matrix
         The Laplacian, shape ``(n + 1, n + 1)``, in the unit of ``gains``.
     """
-    n = len(gains)
-    m = zeros(n + 1, n + 1)
-    for i, g in enumerate(gains, start=1):
-        m[i - 1][i - 1] += g
-        m[i][i] += g
-        m[i - 1][i] -= g
-        m[i][i - 1] -= g
-    return m
+    return _laplacian(gains, [(i - 1, i) for i in range(1, len(gains) + 1)])
 
 
 def star_matrix(gains: Sequence[float]) -> Matrix:
@@ -60,13 +53,35 @@ def star_matrix(gains: Sequence[float]) -> Matrix:
     >>> star_matrix([1.0, 2.0])
     [[3.0, -1.0, -2.0], [-1.0, 1.0, 0.0], [-2.0, 0.0, 2.0]]
     """
-    n = len(gains)
-    m = zeros(n + 1, n + 1)
-    for i, g in enumerate(gains, start=1):
-        m[0][0] += g
-        m[i][i] += g
-        m[0][i] -= g
-        m[i][0] -= g
+    return _laplacian(gains, [(0, i) for i in range(1, len(gains) + 1)])
+
+
+def _laplacian(gains: Sequence[float], ends: Sequence[tuple[int, int]]) -> Matrix:
+    """The ``(n+1) × (n+1)`` Laplacian of n springs, spring j joining bodies ``ends[j]``.
+
+    Parameters
+    ----------
+    gains : Sequence[float]
+        One gain per spring, shape ``(n,)``, in any unit.
+    ends : Sequence[tuple[int, int]]
+        The two bodies (0 … n) each spring joins, shape ``(n, 2)``.
+
+    Returns
+    -------
+    Matrix
+        The Laplacian, shape ``(n + 1, n + 1)``, in the unit of ``gains``.
+
+    Examples
+    --------
+    >>> _laplacian([2.0], [(0, 1)])
+    [[2.0, -2.0], [-2.0, 2.0]]
+    """
+    m = zeros(len(gains) + 1, len(gains) + 1)
+    for g, (a, b) in zip(gains, ends):
+        m[a][a] += g
+        m[b][b] += g
+        m[a][b] -= g
+        m[b][a] -= g
     return m
 
 
