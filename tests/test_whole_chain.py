@@ -154,6 +154,16 @@ def test_the_printed_set_line_estimates_every_load_angle(build_fmus, tmp_path, c
         assert np.sqrt(np.mean(error**2) / np.mean(swing**2)) < 0.05, i
 
 
+def test_whole_chain_reads_n_from_the_record_unless_given(tmp_path, capsys) -> None:
+    """Without --masses the whole-chain fit searches n as `check` assumes; given, it fits n."""
+    log = tmp_path / "log.csv"
+    log.write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0.001,0,0,0\n0.002,0,0,0\n")
+    assert main(["identify", str(log), "--method", "whole-chain"]) == 2
+    assert "n = 0 … " in capsys.readouterr().err
+    assert main(["identify", str(log), "--method", "whole-chain", "--masses", "2"]) == 2
+    assert "n = 2 (" in capsys.readouterr().err
+
+
 def test_masses_auto_needs_the_whole_chain_method(build_fmus, tmp_path, capsys) -> None:
     log = tmp_path / "log.csv"
     log.write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0.001,0,0,0\n0.002,0,0,0\n")

@@ -34,9 +34,10 @@ Contract (scripts rely on it)::
   J_mo, k_to, dkt, dJm, g_dist, encoder_cpr; D_m and f_c when known, else they are
   fitted with the chain; with counts the fit is the prediction-error fit from the
   current to the encoder). ``--load constant|slow``: a load torque on the last mass is
-  part of the model (fitted, reported as ``tau_load``). ``--masses auto`` reads the
-  number of masses from the record. The report's ``assumptions`` say what the result
-  is conditional on (and any drive parameter left at the bench's default). ``--json``
+  part of the model (fitted, reported as ``tau_load``). ``--masses auto`` (the default
+  here, as ``check`` assumes) reads the number of masses from the record. The report's
+  ``assumptions`` say what the result is conditional on (and any drive parameter left at
+  the bench's default). ``--json``
   prints ``J[i]``, ``k[i]``, ``B[i]``, ``D_m``, ``f_c`` (the observer's own parameter
   names; the text output ends with the ``--set`` line, ``estimator=1`` included, that
   estimates every load angle with them), their standard errors under ``std``, the evidence
@@ -130,10 +131,9 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
     log_options(p, "observer parameter, repeatable")
     p.add_argument(
         "--masses",
-        default="3",
         metavar="N",
-        help="number of load masses (default 3); with --method whole-chain also 0 "
-        "(a rigid drive) and 'auto'",
+        help="number of load masses (default 3; with --method whole-chain default 'auto', "
+        "as check assumes); with --method whole-chain also 0 (a rigid drive) and 'auto'",
     )
     p.add_argument(
         "--mode", type=int, choices=(0, 1, 2), help="observer mode (default: the FMU's, 2)"
@@ -216,12 +216,12 @@ def _execute(args: argparse.Namespace) -> int:
     if args.method == "beam":
         return run_beam(args, log)
     if args.method == "whole-chain":
-        # whole-chain also fits the rigid drive, n = 0
-        masses = {"auto": "auto", "0": 0}.get(args.masses.strip()) if args.masses else None
-        return run_whole_chain(
-            args, log, masses if masses is not None else masses_option(args.masses)
-        )
-    n = int(chain.pop("masses")) if chain else masses_option(args.masses)
+        # whole-chain also fits the rigid drive, n = 0, and reads n from the record by
+        # default: the n `arcosim check` judges when it is not given
+        text = (args.masses or "auto").strip()
+        masses = {"auto": "auto", "0": 0}.get(text)
+        return run_whole_chain(args, log, masses if masses is not None else masses_option(text))
+    n = int(chain.pop("masses")) if chain else masses_option(args.masses or "3")
     args.set = chain_assignments(chain, args.set) + list(args.set)  # --set wins
     if args.method == "load-torque":
         return run_load_torque(args, log, n)
