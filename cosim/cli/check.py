@@ -62,7 +62,8 @@ arcosim check log.csv --scale i_a=0.001 --set k_to=0.0406 --json""",
         "--load",
         choices=("none", "constant", "slow"),
         default="none",
-        help="the load torque model identify will use (default none)",
+        help="the load torque model identify will be given (default: none given, which "
+        "check judges as none and identify chooses by its selection rule)",
     )
     p.add_argument("--json", action="store_true", help="print the report as one JSON object")
     p.set_defaults(execute=_execute)

@@ -33,9 +33,10 @@ Contract (scripts rely on it)::
   damping (``arcosim.identification.whole_chain``); only the actuator terms are known (``--set``:
   J_mo, k_to, dkt, dJm, g_dist, encoder_cpr; D_m and f_c when known, else they are
   fitted with the chain; with counts the fit is the prediction-error fit from the
-  current to the encoder). ``--load constant|slow``: a load torque on the last mass is
-  part of the model (fitted, reported as ``tau_load``). ``--masses auto`` (the default
-  here, as ``check`` assumes) reads the number of masses from the record. The report's
+  current to the encoder). ``--load none|constant|slow``: a load torque on the last mass
+  is part of the model (fitted, reported as ``tau_load``); not given, the selection rule
+  chooses it and says so (``selection.load``). ``--masses auto`` (the default here, as
+  ``check`` assumes) reads the number of masses from the record. The report's
   ``assumptions`` say what the result is conditional on (and any drive parameter left at
   the bench's default). ``--json``
   prints ``J[i]``, ``k[i]``, ``B[i]``, ``D_m``, ``f_c`` (the observer's own parameter
@@ -171,9 +172,9 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
     p.add_argument(
         "--load",
         choices=("none", "constant", "slow"),
-        default="none",
+        default=None,
         help="whole-chain: model a load torque on the last mass (constant, or constant "
-        "plus a slow drift), fitted and reported",
+        "plus a slow drift), fitted and reported; not given: chosen by the selection rule",
     )
     p.add_argument(
         "--start-k",

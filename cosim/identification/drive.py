@@ -154,7 +154,7 @@ def identify_drive(
     masses: int | str = "auto",
     D_m: float | None = None,
     f_c: float | None = None,
-    load: str = "none",
+    load: str | None = None,
     g_dist: float = G_DIST,
 ) -> DriveIdentification:
     """Every J_i, k_i, B_i of the load chain, and n, from a drive log.
@@ -188,9 +188,14 @@ def identify_drive(
     D_m, f_c : float, optional
         Motor viscous (N·m·s/rad) and Coulomb (N·m) friction, when known; fitted
         otherwise.
-    load : {"none", "constant", "slow"}
+    load : {None, "none", "constant", "slow"}
         A load torque on the last mass in the model: none, constant, or constant
-        plus a slow drift (fitted and reported).
+        plus a slow drift (fitted and reported). None (the default): chosen by the
+        selection rule among the three on the final fit
+        (:func:`~arcosim.identification.structure_choice.load_choice`), the chain
+        refitted with the one taken; the report's ``selection["load"]`` holds the
+        candidates and their scores. A load given is never overridden (``"none"``
+        given: the rule only warns).
     g_dist : float
         Bandwidth of the disturbance observer that computes τ̂_reac (rad/s).
 
@@ -224,7 +229,7 @@ def identify_drive(
     """
     if not (k_t > 0 and J_m > 0):
         raise IdentificationError(f"k_t and J_m must be > 0, got k_t = {k_t}, J_m = {J_m}")
-    if load not in LOADS:
+    if load is not None and load not in LOADS:
         raise IdentificationError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
     friction_given = D_m is not None and f_c is not None
     time, i_a, omega_m, theta_m = (
@@ -243,7 +248,7 @@ def identify_drive(
         masses=masses,
         D_m=D_m,
         f_c=f_c,
-        load=load,
+        load=load or "none",
     )
     plausibility = decision.plausibility
     if decision.problems:
@@ -251,7 +256,7 @@ def identify_drive(
         raise IdentificationError("; ".join(decision.warnings + decision.problems))
     record, encoder = decision.record, decision.encoder
     try:
-        choice = identify_whole_chain(record, masses, encoder)
+        choice = identify_whole_chain(record, masses, encoder, choose_load=load is None)
     except IdentificationError as error:
         if not plausibility:
             raise
@@ -259,7 +264,8 @@ def identify_drive(
     fit = choice.fit
     parameters = fit.as_dict()
     above = None
-    if load == "none":  # a modelled load's torque is in the τ̂ residual, not in the noise
+    # a modelled load's torque (given or chosen by the rule) is in the τ̂ residual, not the noise
+    if fit.extra.get("load", "none") == "none":
         chain = split(fit.values, choice.n)
         rigid = parameters.get(RIGID_LOAD, 0.0)
         floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid)
@@ -272,7 +278,7 @@ def identify_drive(
         masses=choice.n,
         parameters=parameters,
         std={k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})},
-        assumptions=dict(fit.extra["assumptions"]),
+        assumptions=_load_said(dict(fit.extra["assumptions"]), load),
         warnings=decision.warnings + list(fit.extra["warnings"]) + ([above] if above else []),
         choice=choice,
         record=record,
@@ -280,3 +286,18 @@ def identify_drive(
         if friction_given
         else {k: parameters.get(k, 0.0) for k in ("D_m", "f_c")},  # left out: 0
     )
+
+
+def _load_said(assumptions: dict[str, str], load: str | None) -> dict[str, str]:
+    """``assumptions`` with the load's saying whether the user gave it or the rule chose it.
+
+    Examples
+    --------
+    >>> _load_said({"load": "no load torque modelled"}, None)["load"]
+    'no load torque modelled, chosen by the selection rule (--load not given)'
+    """
+    if load is None and "load" in assumptions:
+        assumptions["load"] += ", chosen by the selection rule (--load not given)"
+    elif "load" in assumptions:
+        assumptions["load"] += f" (--load {load} given)"
+    return assumptions

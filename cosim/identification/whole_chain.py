@@ -66,7 +66,7 @@ from arcosim.identification.structure_choice import (
     candidate_of,
     choose,
     friction_form,
-    load_check,
+    load_choice,
     scores,
 )
 from arcosim.identification.weak_modes import without_weak_modes
@@ -193,7 +193,10 @@ class ChainChoice:
 
 @single_threaded
 def identify_whole_chain(
-    record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
+    record: MotorRecord,
+    masses: int | str,
+    encoder: EncoderRecord | None = None,
+    choose_load: bool = True,
 ) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
@@ -220,6 +223,9 @@ def identify_whole_chain(
         J_total − J_m with the friction), or ``"auto"`` (0 included).
     encoder : EncoderRecord, optional
         The same log's current → encoder record (:func:`~arcosim.encoder_record`).
+    choose_load : bool
+        With ``encoder.load`` none: the load torque (none, constant, slow) chosen by the
+        rule and the chain refitted with it; False: none kept, the rule only warns.
 
     Returns
     -------
@@ -254,8 +260,7 @@ def identify_whole_chain(
     record, encoder, detected = first_reading(record, masses, encoder)
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
-        # the fit's friction is far better than the start's: read the modes once more
-        # with it, and fit again if they changed
+        # re-read the modes with the fit's friction (far better than the start's)
         D_m, f_c = result.extra["D_m"], result.extra["f_c"]
         cleaned = without_friction(raw, encoder, D_m, f_c)
         again = detect_modes(cleaned, largest)
@@ -267,9 +272,9 @@ def identify_whole_chain(
     selection: dict = {"rule": RULE, "masses": {str(m): v for m, v in criterion.items()}}
     if encoder is not None:
         result, selection["friction"] = friction_form(record, encoder, n, result, CONFIRM_SECONDS)
-        selection["load"], load_warning = load_check(encoder, n, result, CONFIRM_SECONDS)
-        if load_warning:
-            result.extra.setdefault("structure_warnings", []).append(load_warning)
+        result, encoder, selection["load"] = load_choice(
+            record, encoder, n, result, CONFIRM_SECONDS, choose_load
+        )
     result.extra["selection"] = selection
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
@@ -284,9 +289,7 @@ def identify_whole_chain(
         ]
         + result.extra.get("structure_warnings", []),
     )
-    refused = {}
-    if detected.weak:
-        refused[n + 1] = missing_modes(detected, n + 1, record)
+    refused = {n + 1: missing_modes(detected, n + 1, record)} if detected.weak else {}
     leaner = without_weak_modes(detected, n, encoder and partial(_fit_m, record, encoder, detected))
     return ChainChoice(
         n,
