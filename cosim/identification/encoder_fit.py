@@ -41,7 +41,11 @@ from scipy import optimize
 
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.kalman import Drive, Kalman, discrete_drive, innovations
-from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
+from arcosim.identification.newey_west import (
+    decorrelation_lag,
+    newey_west_covariance,
+    significance_lag,
+)
 from arcosim.identification.output_error import ParameterFit, predict
 from arcosim.identification.records import EncoderRecord, MotorRecord, mean_sign
 
@@ -203,7 +207,9 @@ def refine(
     sign first from the record's velocity, then stuck-aware from the Kalman smoother's
     states with the first pass's drive (:func:`stuck_aware_sign`).
 
-    Standard errors: Newey–West on the innovations' score (they are nearly white).
+    Standard errors: Newey–West on the innovations' score, its bandwidth
+    :func:`~arcosim.identification.newey_west.significance_lag` (the innovations are
+    nearly white, not white: a small correlation persists over dozens of lags).
 
     Parameters
     ----------
@@ -246,8 +252,9 @@ def refine(
         values, residual, jac, runs = _least_squares(record, values, n)
         drive, more = unpack(values, n, record), more + runs
     drive = unpack(values, n, record)
-    lag = decorrelation_lag(residual, 1)
-    std = np.sqrt(np.clip(np.diag(newey_west_covariance(jac, residual, lag)), 0.0, None))
+    lag = decorrelation_lag(residual, 1)  # the BIC's effective sample count
+    std_lag = significance_lag(residual, lag)  # σ: until the correlation is noise
+    std = np.sqrt(np.clip(np.diag(newey_west_covariance(jac, residual, std_lag)), 0.0, None))
     extra = {
         **start.extra,
         "bounds": at_bound(parameter_names(n, record), values, std, first),
@@ -255,6 +262,7 @@ def refine(
         "start_fit": start.as_dict(),
         "innovation_variance": float(np.mean(residual**2)),
         "innovation_count": len(residual),
+        "std_lag": std_lag,
         "torque_std": record.torque_std,
         "friction": "given" if record.friction_given else "fitted",
         "friction_form": "given" if record.friction_given else record.friction_form,
