@@ -12,8 +12,8 @@ step) and says what was played, for the log's check and the fits' decisions
   sidelobes its leakage leaves; each line's frequency then refined by a least-squares
   fit of a sine at off-grid frequencies (:func:`refine_lines`), and a line kept only if
   its fitted amplitude passes the same prominence over the noise and the linear
-  detrend's remnant (:func:`prominent_lines`: that remnant, a ramp, reads as a weak
-  line one to two bins above 0);
+  detrend's remnant (:mod:`arcosim.identification.line_prominence`: that remnant, a
+  ramp, reads as a weak line one to two bins above 0);
 - **periodic** (a square-wave or stepped reference, position-loop steps): lines that all
   sit on whole multiples of one fundamental whose first harmonics are present, counted
   as the harmonics of that fundamental
@@ -37,6 +37,7 @@ from arcosim.identification.harmonics import (
     harmonic_fundamental,
     on_harmonics,
 )
+from arcosim.identification.line_prominence import noise_amplitude, prominent_lines
 
 #: A line stands this many times above the periodogram's median (its noise or
 #: broadband level) and above the leakage envelope of the stronger lines.
@@ -234,99 +235,10 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     q = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
     y = sp_signal.resample_poly(x, 1, q) if q > 1 else x
     lines, amplitudes, _ = refine_lines(y, q * h, coarse)
-    prominent = prominent_lines(y, q * h, lines, least_amplitude(power, n))
+    noise = noise_amplitude(_floor(power), n)
+    prominent = prominent_lines(y, q * h, lines, noise, LINE_PROMINENCE)
     order = np.argsort(lines[prominent])
     return lines[prominent][order], amplitudes[prominent][order], share
-
-
-def least_amplitude(power: np.ndarray, n: int) -> float:
-    """The amplitude (the signal's unit) whose Hann periodogram peak, (a·Σw/2)², is the
-    periodogram's median ``power`` (its noise or broadband level), the record ``n``
-    samples long: the noise level in a line's unit.
-
-    Parameters
-    ----------
-    power : ndarray
-        The Hann-windowed periodogram, shape ``(n//2 + 1,)``.
-    n : int
-        Samples in the record (a count).
-
-    Returns
-    -------
-    float
-        The amplitude (the signal's unit).
-
-    Examples
-    --------
-    >>> noise = np.random.default_rng(0).standard_normal(20000)
-    >>> power = np.abs(np.fft.rfft(noise * np.hanning(20000))) ** 2
-    >>> round(float(least_amplitude(power, 20000)), 4)   # unit white noise, 20000 samples
-    0.0142
-    """
-    return 2.0 * np.sqrt(_floor(power)) / np.sum(np.hanning(n))
-
-
-def prominent_lines(x: np.ndarray, h: float, lines: np.ndarray, noise: float) -> np.ndarray:
-    """Which refined lines pass the periodogram's test again, on their fitted amplitudes:
-    :data:`LINE_PROMINENCE` times (in power) above the noise level and the detrend's
-    remnant.
-
-    Removing a multi-sine's linear trend also removes its lines' projection on a
-    constant and a ramp, and leaves that projection, sign turned, in the signal: a ramp,
-    whose Hann spectrum peaks one to two bins above 0, where the periodogram then finds
-    a "line" (0.48 rad/s in a 20 s record of lines from 3 rad/s, amplitude 1 % of
-    theirs). The remnant each line sees is known once the lines are fitted: the
-    projection of all the other fitted lines on the constant and the ramp. A line whose
-    fitted amplitude a stands under √:data:`LINE_PROMINENCE` times (a_noise² + a_rem²)^½,
-    a_rem that remnant's amplitude at its frequency, is not told from them (the same
-    rule as the leakage of the stronger lines on the periodogram, :func:`_peaks`).
-
-    Parameters
-    ----------
-    x : ndarray
-        The signal the lines were fitted on (trend removed), shape ``(N,)``.
-    h : float
-        Its sample step (s).
-    lines : ndarray
-        The refined lines (rad/s), shape ``(L,)``.
-    noise : float
-        The noise level in a line's amplitude (the signal's unit,
-        :func:`least_amplitude`).
-
-    Returns
-    -------
-    ndarray
-        Boolean, shape ``(L,)``: the lines that count.
-
-    Examples
-    --------
-    A linear detrend of a multi-sine from 3 rad/s leaves a ramp that the periodogram
-    reads as a line near 0.5 rad/s; it does not pass:
-
-    >>> t = np.arange(20000) * 1e-3
-    >>> lines = np.geomspace(3.0, 150.0, 40)
-    >>> x = np.sin(np.outer(t, lines) + np.arange(40.0)).sum(axis=1) * 0.075
-    >>> x = x - np.polyval(np.polyfit(t, x, 1), t)
-    >>> found = refine_lines(x, 1e-3, np.concatenate([[0.48], lines]))[0]
-    >>> prominent_lines(x, 1e-3, found, 7e-5)[:3]
-    array([False,  True,  True])
-    """
-    t = np.arange(len(x)) * h
-    t = t - t.mean()
-    phase = np.outer(t, lines)
-    cos, sin = np.cos(phase), np.sin(phase)
-    c, s = _fit(x, t, lines)
-    trend = np.column_stack([np.ones_like(t), t / max(float(np.abs(t).max()), 1e-300)])
-    basis = np.linalg.qr(trend)[0]
-    # each line's projection on the constant and the ramp, as its two coefficients
-    each = basis.T @ (cos * c + sin * s)
-    keep = np.zeros(len(lines), dtype=bool)
-    for i in range(len(lines)):
-        remnant = basis @ (each.sum(axis=1) - each[:, i])
-        pair = np.column_stack([cos[:, i], sin[:, i]])
-        a_rem = float(np.hypot(*np.linalg.lstsq(pair, remnant, rcond=None)[0]))
-        keep[i] = np.hypot(c[i], s[i]) ** 2 >= LINE_PROMINENCE * (noise**2 + a_rem**2)
-    return keep
 
 
 #: The lines' refinement decimates the signal to this many times their top frequency's
