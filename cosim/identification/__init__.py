@@ -15,6 +15,8 @@ Modes
 spectrum          -- what the excitation is: lines (leakage-aware), harmonics of one
                      period, or broadband with its band (excitation_spectrum)
 harmonics         -- lines that are harmonics of one fundamental (a periodic reference)
+line_prominence   -- which found lines are lines: the prominence again on their fitted
+                     amplitudes, over the noise and the detrend's remnant
 band              -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band)
 subspace          -- PO-MOESP subspace identification, one input and one output
 modal_start       -- the record's modes (stabilization diagram, residues) and the

@@ -20,9 +20,11 @@ from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.encoder_fit import RIGID_LOAD
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_decision import decide_log
+from arcosim.identification.motor_friction import without_friction
 from arcosim.identification.noise_floor import (
     floor_warning,
     noise_floor,
+    tau_residual,
     weak_mode_floor_warning,
 )
 from arcosim.identification.records import LOADS, MotorRecord
@@ -269,11 +271,18 @@ def identify_drive(
         chain = split(fit.values, choice.n)
         rigid = parameters.get(RIGID_LOAD, 0.0)
         floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid)
-        above = floor_warning(fit.rms_residual, floor, sigma_i)
+        motor = record
+        if not friction_given and encoder is not None:
+            friction = (parameters.get("D_m", 0.0), parameters.get("f_c", 0.0))
+            motor = without_friction(record, encoder, *friction)
+        rms = tau_residual(motor, i_a, k_t, chain, rigid)
+        above = floor_warning(rms, floor, sigma_i)
         if above is None and choice.leaner is not None:
             # a weak mode kept may take up what a wrong k_t or J_m leaves: the fit without
             dropped = choice.leaner.extra["dropped_weak_modes_rad_s"]
-            above = weak_mode_floor_warning(dropped, choice.leaner.rms_residual, floor, sigma_i)
+            leaner = split(choice.leaner.values, choice.n - len(dropped))
+            rms = tau_residual(motor, i_a, k_t, leaner)
+            above = weak_mode_floor_warning(dropped, rms, floor, sigma_i)
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,

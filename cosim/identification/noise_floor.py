@@ -20,10 +20,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from scipy import signal
 
+from arcosim.fmu.flexchain.defaults import VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.output_error import predict, rigid_predict
-from arcosim.identification.records import motor_record
+from arcosim.identification.output_error import predict, rigid_predict, through_g
+from arcosim.identification.records import MotorRecord, motor_record
 
 #: A residual this many times the noise floor (dimensionless) warns. Noise alone gives
 #: about 1×; on good logs of the independent simulator (seed 0) the friction model's
@@ -117,8 +119,96 @@ def noise_floor(
     omega = np.concatenate([[0.0], np.diff(theta)]) / float(np.mean(np.diff(time)))
     record = motor_record(time, current, omega, theta, Actuator(J_m, k_t), g_dist)
     model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
-    residual = model - record.tau_hat
+    residual = model - record.tau_hat + smoothing_error(record, current, k_t, model)
     return float(np.sqrt(np.mean(residual**2))), sigma_i
+
+
+def smoothing_error(
+    record: MotorRecord, i_a: np.ndarray, k_t: float, model: np.ndarray
+) -> np.ndarray:
+    """The τ̂ error the observer's velocity smoothing leaves, to be added to the residual
+    ``model − record.tau_hat``: (1 − F)[G[k_t·i_a] − model].
+
+    Offline the motor's velocity is the angle's derivative smoothed at
+    ``VELOCITY_SMOOTHING``·g_dist (F, zero phase;
+    :func:`~arcosim.identification.records.motor_record`), so τ̂ = G[k_t·i − J_m·F[α] −
+    friction] carries G[(1 − F)·J_m·α] besides the reaction torque: nothing of the
+    chain, and no noise, but the motor's own acceleration where F cuts it. A
+    multi-sine below the band barely reaches F's cut (1 − F is 2 % at 150 rad/s with
+    g_dist = 100 rad/s); a PRBS or noise to 1100 rad/s does, and it was 80 % of the
+    residual's power on a PRBS log, 24 × the floor although the fit was right. Since
+    J_m·α = k_t·i − τ_reac − friction, G[J_m·α] is G[k_t·i] less the model's τ̂
+    (the friction's part, F's cut above the band, left out).
+
+    Parameters
+    ----------
+    record : MotorRecord
+        The record the residual is taken on (its step, g_dist and velocity source).
+    i_a : ndarray
+        The current that built it (A), shape ``(N,)``.
+    k_t : float
+        Torque constant (N·m/A).
+    model : ndarray
+        The model's τ̂ on the record (N·m), shape ``(N,)``.
+
+    Returns
+    -------
+    ndarray
+        The term (N·m), shape ``(N,)``; zeros when the record's velocity was logged,
+        not smoothed.
+
+    Examples
+    --------
+    A drive torque far above F's cut (2000 rad/s at 400) passes into τ̂ through G
+    only: the term is that, 100/2000 of it.
+
+    >>> from arcosim.identification.records import MotorRecord
+    >>> t = np.arange(20000) * 1e-4
+    >>> record = MotorRecord(1e-4, np.zeros(20000), np.zeros(20000), 100.0, "smoothed")
+    >>> term = smoothing_error(record, np.sin(2000 * t), 1.0, np.zeros(20000))
+    >>> round(float(np.abs(term[5000:15000]).max()), 3)
+    0.05
+    """
+    h, g = record.h, record.g_dist
+    cutoff, nyquist = VELOCITY_SMOOTHING * g, np.pi / h
+    if record.velocity_source == "measured" or cutoff >= nyquist or len(model) <= 12:
+        return np.zeros(len(model))
+    b, a = signal.butter(2, cutoff / nyquist)
+    x = through_g(k_t * np.asarray(i_a, dtype=float), g, h) - model
+    return x - signal.filtfilt(b, a, x)
+
+
+def tau_residual(
+    record: MotorRecord,
+    i_a: np.ndarray,
+    k_t: float,
+    chain: tuple[Sequence[float], Sequence[float], Sequence[float]],
+    J_load: float = 0.0,
+) -> float:
+    """The fit's RMS τ̂ residual (N·m) as the floor is taken: the model's τ̂ less the
+    record's, the velocity smoothing's error (:func:`smoothing_error`) taken out.
+
+    Parameters
+    ----------
+    record : MotorRecord
+        The log's record, its friction (given or fitted) taken out of τ̂.
+    i_a : ndarray
+        The logged current (A), shape ``(N,)``.
+    k_t : float
+        Torque constant (N·m/A).
+    chain : tuple of three sequences of float
+        The fitted J_i (kg·m²), k_i (N·m/rad), B_i (N·m·s/rad); empty for n = 0.
+    J_load : float
+        A rigid drive's load inertia (kg·m²), used when ``chain`` is empty.
+
+    Returns
+    -------
+    float
+        The RMS residual (N·m).
+    """
+    model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
+    residual = model - record.tau_hat + smoothing_error(record, i_a, k_t, model)
+    return float(np.sqrt(np.mean(residual**2)))
 
 
 def floor_warning(rms_residual: float, floor: float, sigma_i: float) -> str | None:

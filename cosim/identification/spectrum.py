@@ -10,7 +10,10 @@ step) and says what was played, for the log's check and the fits' decisions
   *and* above the leakage of every stronger line (the Hann window's sidelobe envelope,
   :func:`leakage_envelope`), so an off-grid line counts once and not as the dozen
   sidelobes its leakage leaves; each line's frequency then refined by a least-squares
-  fit of a sine at off-grid frequencies (:func:`refine_lines`);
+  fit of a sine at off-grid frequencies (:func:`refine_lines`), and a line kept only if
+  its fitted amplitude passes the same prominence over the noise and the linear
+  detrend's remnant (:mod:`arcosim.identification.line_prominence`: that remnant, a
+  ramp, reads as a weak line one to two bins above 0);
 - **periodic** (a square-wave or stepped reference, position-loop steps): lines that all
   sit on whole multiples of one fundamental whose first harmonics are present, counted
   as the harmonics of that fundamental
@@ -34,6 +37,7 @@ from arcosim.identification.harmonics import (
     harmonic_fundamental,
     on_harmonics,
 )
+from arcosim.identification.line_prominence import noise_amplitude, prominent_lines
 
 #: A line stands this many times above the periodogram's median (its noise or
 #: broadband level) and above the leakage envelope of the stronger lines.
@@ -231,8 +235,10 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     q = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
     y = sp_signal.resample_poly(x, 1, q) if q > 1 else x
     lines, amplitudes, _ = refine_lines(y, q * h, coarse)
-    order = np.argsort(lines)
-    return lines[order], amplitudes[order], share
+    noise = noise_amplitude(_floor(power), n)
+    prominent = prominent_lines(y, q * h, lines, noise, LINE_PROMINENCE)
+    order = np.argsort(lines[prominent])
+    return lines[prominent][order], amplitudes[prominent][order], share
 
 
 #: The lines' refinement decimates the signal to this many times their top frequency's
