@@ -25,7 +25,8 @@ motor the bench's (J_m, k_t, D_m = 2e-5 N·m·s/rad, no Coulomb friction).
 The FMU is not in the repository: ``--fmus DIR`` names the folder that holds
 ``edrive_mass.fmu``; absent, the benchmark says where to get it and exits 0.
 
-Run: ``python -m benchmarks.thirdparty_chain --fmus DIR [--seeds N] [--out DIR]``.
+Run: ``python -m benchmarks.thirdparty_chain --fmus DIR [--seeds N] [--out DIR]
+[--identification-only]``.
 """
 
 from __future__ import annotations
@@ -220,11 +221,12 @@ def _off(value: float, true: float) -> float:
     return 0.0 if value == true else math.inf
 
 
-def score_seed(folder: Path, seed: int, corners: bool) -> dict[str, object]:
-    """One seed: the identification's errors and every model's moves, scored."""
+def score_seed(folder: Path, seed: int, corners: bool, control: bool = True) -> dict[str, object]:
+    """One seed: the identification's errors and (``control``) every model's moves,
+    scored."""
     result = identify(folder, seed)
     found = {"identification": identification_errors(result)}
-    if result.masses != CHAIN.n:
+    if result.masses != CHAIN.n or not control:
         return found
     params = design_parameters(result, False)
 
@@ -250,8 +252,15 @@ def score_seed(folder: Path, seed: int, corners: bool) -> dict[str, object]:
     return found
 
 
-def run(folder: Path, out: Path, seeds: range, progress: Callable[[str], None]) -> dict:
-    """Coupling, then every seed; the tables and the results (written into ``out``)."""
+def run(
+    folder: Path,
+    out: Path,
+    seeds: range,
+    progress: Callable[[str], None],
+    control: bool = True,
+) -> dict:
+    """Coupling, then every seed (``control``: the moves too, else the identification
+    only); the tables and the results (written into ``out``)."""
     started = time.perf_counter()
     out.mkdir(parents=True, exist_ok=True)
     progress("coupling against MotorChainPlant")
@@ -261,19 +270,23 @@ def run(folder: Path, out: Path, seeds: range, progress: Callable[[str], None]) 
     per_seed: dict[str, dict] = {}
     for seed in seeds:
         progress(f"seed {seed}")
-        per_seed[str(seed)] = score_seed(folder, seed, corners=seed == seeds[0])
+        per_seed[str(seed)] = score_seed(folder, seed, seed == seeds[0], control)
         partial = {"coupling": check, "own_plant": own, "seeds": per_seed}
         (out / "thirdparty.json").write_text(json.dumps(partial, indent=1, default=str), "utf-8")
     lowest = check["modes"][0]
     controlled = {s: r["models"] for s, r in per_seed.items() if "models" in r}
-    control = {f"third-party FMU chain, {CHAIN.name}": {"lowest_mode": lowest,
-                                                        "seeds": controlled}}  # fmt: skip
+    moves = {f"third-party FMU chain, {CHAIN.name}": {"lowest_mode": lowest,
+                                                      "seeds": controlled}}  # fmt: skip
     tables = {
         "coupling": coupling_table(check),
         "identification": identification_table(per_seed)
         + f"\nThe same chain on MotorChainPlant, seed {seeds[0]}:\n\n"
         + identification_table({"own": {"identification": own}}),
-        "control": control_accuracy.markdown(control) if controlled else "(no seed found n = 2)\n",
+        "control": control_accuracy.markdown(moves)
+        if controlled
+        else "(moves skipped: --identification-only)\n"
+        if not control
+        else "(no seed found n = 2)\n",
     }
     summary = {"coupling": check, "own_plant": own, "seeds": per_seed,
                "seconds": time.perf_counter() - started}  # fmt: skip
@@ -335,6 +348,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the tables")
     p.add_argument("--log", type=Path, help="also write the first seed's identification log "
                    "(CSV) for `arcosim identify`")  # fmt: skip
+    p.add_argument("--identification-only", action="store_true",
+                   help="skip the moves: the coupling and the identification (about 5 s "
+                   "a seed)")  # fmt: skip
     p.set_defaults(execute=_execute)
 
 
@@ -346,7 +362,8 @@ def _execute(args: argparse.Namespace) -> int:
         return 0
     if args.log:
         print(f"wrote {write_log(identification_log(args.fmus, 1), args.log)}")
-    result = run(args.fmus, args.out, range(1, args.seeds + 1), progress)
+    seeds = range(1, args.seeds + 1)
+    result = run(args.fmus, args.out, seeds, progress, not args.identification_only)
     for table in result["tables"].values():
         print(table)
     print(f"wrote {args.out / 'thirdparty.md'} and {args.out / 'thirdparty.json'} "

@@ -59,3 +59,18 @@ def test_benchmark_skips_naming_the_source_when_the_fmu_is_absent(tmp_path, caps
     assert main("thirdparty", thirdparty_chain.add_parser, ["--fmus", str(tmp_path)]) == 0
     said = capsys.readouterr().out
     assert "skip" in said and FMU_FILE in said and "OMSimulator" in said
+
+
+@pytest.mark.slow
+@pytest.mark.system
+@pytest.mark.data(ENV)
+def test_identification_only_fits_without_moving(folder):
+    """``score_seed(..., control=False)``: the third-party chain identified (n right,
+    J_i, k_i within the issue's 0.5 %), no move run."""
+    found = thirdparty_chain.score_seed(folder, 1, corners=False, control=False)
+    assert "models" not in found
+    ident = found["identification"]
+    assert ident["masses"] == thirdparty_chain.CHAIN.n
+    for name, p in ident["parameters"].items():
+        if name[0] in "Jk":
+            assert abs(p["error_percent"]) < 0.5, (name, p)
