@@ -201,7 +201,11 @@ def smoothed_sign(record: EncoderRecord, drive: Drive, rounds: int) -> EncoderRe
 
 
 def refine(
-    record: EncoderRecord, motor: MotorRecord | None, start: ParameterFit, n: int
+    record: EncoderRecord,
+    motor: MotorRecord | None,
+    start: ParameterFit,
+    n: int,
+    more_rounds: int = 0,
 ) -> ParameterFit:
     """Prediction-error fit of the drive from ``start``, in two passes: the friction's
     sign first from the record's velocity, then stuck-aware from the Kalman smoother's
@@ -222,6 +226,9 @@ def refine(
         (N·m·s/rad).
     n : int
         Number of load masses (a count).
+    more_rounds : int
+        Smoothings of the friction's sign beyond the usual (a count; see
+        :func:`smoothed_sign`), to measure how far the sign moves the friction.
 
     Returns
     -------
@@ -245,7 +252,7 @@ def refine(
     drive = unpack(values, n, record)
     more = 0
     for _ in range(RIGID_PASSES if n == 0 else 1):
-        signed = smoothed_sign(record, drive, SIGN_ITERATIONS if n == 0 else 1)
+        signed = smoothed_sign(record, drive, (SIGN_ITERATIONS if n == 0 else 1) + more_rounds)
         if signed is None:  # the last pass's drive is no chain to smooth with
             break
         record = signed
