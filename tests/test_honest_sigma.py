@@ -15,7 +15,7 @@ from arcosim.identification.newey_west import (
     significance_lag,
 )
 from arcosim.identification.output_error import ParameterFit
-from arcosim.identification.structure_choice import with_form_shift
+from arcosim.identification.structure_choice import carry_over, with_form_shift
 
 
 def _regression(seed: int) -> tuple[np.ndarray, np.ndarray, float]:
@@ -80,3 +80,15 @@ def test_a_left_out_term_widens_sigma_by_its_shift_on_the_opening() -> None:
     alone = _fit({"B[1]": 9.79e-5, "f_c": 2.046e-3})
     with_form_shift(alone, stuck)  # the whole record's pair alone: no widening
     assert alone.std_dict()["B[1]"] < 1.1e-7
+
+
+def test_the_sign_shift_survives_a_load_refit() -> None:
+    """The friction sign's widening (square wave, seed 17: one more smoothing moved f_c
+    by 2.1σ) is carried onto the fit refitted with a load torque."""
+    result = _fit({"D_m": 2.0e-5, "f_c": 2.0198e-3}, std=9.3e-6)
+    result.extra["sign_shift"] = {"f_c": -1.98e-5}
+    final = _fit({"D_m": 2.0e-5, "f_c": 2.0198e-3, "tau_load": 1e-4}, std=9.3e-6)
+    carry_over(final, result, 3)
+    assert abs(2.0198e-3 - 2e-3) <= 2 * final.std_dict()["f_c"]  # the truth covered
+    assert final.extra["sign_shift"] == {"f_c": -1.98e-5}
+    assert "form_shift" not in final.extra

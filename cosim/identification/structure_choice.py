@@ -414,12 +414,15 @@ def load_choice(
 def carry_over(final: ParameterFit, result: ParameterFit, n: int) -> None:
     """What ``result``'s structure choices left on it, onto ``final`` (the same chain
     refitted with a load torque): the bounds of the terms it leaves out, the friction
-    form's widening of the σ (:func:`with_form_shift`), its warnings; a rigid fit's
+    form's and the friction sign's widening of the σ (:func:`with_form_shift`,
+    :func:`with_sign_shift`), its warnings; a rigid fit's
     residuals (n = 0: no τ̂ to predict)."""
     if n == 0:
         final.rms_residual, final.rms_data = result.rms_residual, result.rms_data
     left_out = {k: v for k, v in result.extra.get("bounds", {}).items() if k not in final.names}
     final.extra["bounds"] = final.extra.get("bounds", {}) | left_out
-    if "form_shift" in result.extra:
-        widen(final, result.extra["form_shift"])
+    for key in ("form_shift", "sign_shift"):  # :func:`with_sign_shift`'s too
+        if key in result.extra:
+            widen(final, result.extra[key])
+            final.extra[key] = final.extra.pop("form_shift")
     final.extra["structure_warnings"] = list(result.extra.get("structure_warnings", []))
