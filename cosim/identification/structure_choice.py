@@ -294,8 +294,7 @@ def with_sign_shift(
     except (IdentificationError, ValueError, np.linalg.LinAlgError):
         return result
     moved = again.as_dict()
-    widen(result, {name: moved[name] - values[name] for name in ("D_m", "f_c")})
-    result.extra["sign_shift"] = result.extra.pop("form_shift")
+    widen(result, {name: moved[name] - values[name] for name in ("D_m", "f_c")}, "sign_shift")
     return result
 
 
@@ -329,11 +328,12 @@ def with_form_shift(
     widen(final, shift)
 
 
-def widen(fit: ParameterFit, shift: dict[str, float]) -> None:
+def widen(fit: ParameterFit, shift: dict[str, float], key: str = "form_shift") -> None:
     """Each σ of ``fit`` widened by its parameter's ``shift`` (``σ² + shift²``, each
-    parameter's units), kept in ``extra["form_shift"]``."""
+    parameter's units), kept in ``extra[key]`` (``"form_shift"``: a left-out friction
+    term's, ``"sign_shift"``: the friction sign's)."""
     fit.std = np.array([np.hypot(s, shift.get(name, 0.0)) for name, s in zip(fit.names, fit.std)])
-    fit.extra["form_shift"] = shift
+    fit.extra[key] = shift
 
 
 def with_load(encoder: EncoderRecord, load: str, drift: float) -> EncoderRecord:
@@ -423,6 +423,5 @@ def carry_over(final: ParameterFit, result: ParameterFit, n: int) -> None:
     final.extra["bounds"] = final.extra.get("bounds", {}) | left_out
     for key in ("form_shift", "sign_shift"):  # :func:`with_sign_shift`'s too
         if key in result.extra:
-            widen(final, result.extra[key])
-            final.extra[key] = final.extra.pop("form_shift")
+            widen(final, result.extra[key], key)
     final.extra["structure_warnings"] = list(result.extra.get("structure_warnings", []))
