@@ -20,6 +20,7 @@ from arcosim.identification.modal_recursion import linear_recursion, output_recu
 from arcosim.identification.records import encoder_record, mean_sign
 from arcosim.identification.whole_chain import split
 from benchmarks import field_sim
+from tests.field_runs import identify_log
 
 LINES = np.geomspace(3.0, 150.0, 40)
 THREE = dict(J=(3e-4, 5e-4, 4e-4), k=(0.25, 0.4, 0.15), B=(1.2e-5, 1.5e-5, 6e-6))
@@ -34,19 +35,7 @@ def drive(**kw) -> field_sim.Drive:
 
 
 def fit(d: field_sim.Drive, log: field_sim.Log, friction_given=True, load="none", masses="auto"):
-    friction = {"D_m": d.D_m, "f_c": d.f_c} if friction_given else {}
-    return identify_drive(
-        log.time,
-        log.i_a,
-        log.omega_m,
-        log.theta_m,
-        k_t=d.k_t,
-        J_m=d.J_m,
-        encoder_cpr=d.counts,
-        masses=masses,
-        load=load,
-        **friction,
-    ).choice
+    return identify_log(d, log, friction_given, masses=masses, load=load).choice
 
 
 def assert_chain(choice, d: field_sim.Drive, rtol: float) -> None:

@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arcosim.identification.drive import identify_drive
 from arcosim.identification.output_error import ParameterFit
 from arcosim.identification.structure_choice import LOAD_MARGIN, choose, load_candidate
 from benchmarks.field_accuracy import ROWS
+from tests.field_runs import identify_log
 
 
 def _fit(names: list[str], rms: float) -> ParameterFit:
@@ -45,25 +45,10 @@ def slow_load_log():
     return row.drive, row.log(1, 10.0)
 
 
-def _identify(d, log, **kw):
-    return identify_drive(
-        log.time,
-        log.i_a,
-        log.omega_m,
-        log.theta_m,
-        k_t=d.k_t,
-        J_m=d.J_m,
-        encoder_cpr=d.counts,
-        D_m=d.D_m,
-        f_c=d.f_c,
-        **kw,
-    )
-
-
 @pytest.mark.slow
 def test_an_unmodelled_slow_load_is_chosen_fitted_and_said(slow_load_log) -> None:
     d, log = slow_load_log
-    result = _identify(d, log)  # --load not given
+    result = identify_log(d, log)  # --load not given
     selection = result.report()["selection"]["load"]
     assert selection["chosen"] == "slow", selection
     assert set(selection["candidates"]) == {"none", "constant", "slow"}
@@ -83,7 +68,7 @@ def test_an_unmodelled_slow_load_is_chosen_fitted_and_said(slow_load_log) -> Non
 @pytest.mark.slow
 def test_a_load_the_user_gives_as_none_is_kept_and_only_warned(slow_load_log) -> None:
     d, log = slow_load_log
-    result = _identify(d, log, load="none")
+    result = identify_log(d, log, load="none")
     assert "tau_load" not in result.parameters
     assert result.report()["selection"]["load"]["given"] == "none"
     assert any("--load slow" in w for w in result.warnings), result.warnings

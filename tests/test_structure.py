@@ -12,6 +12,7 @@ from arcosim.fmu.flexchain import defaults
 from arcosim.identification.drive import identify_drive
 from arcosim.identification.errors import IdentificationError
 from benchmarks import field_sim
+from tests.field_runs import identify_log
 
 LINES = np.geomspace(3.0, 150.0, 40)
 #: A ball-screw axis: the table's inertia rigidly on the motor, no mode in the band.
@@ -26,18 +27,7 @@ def rigid(**kw) -> field_sim.Drive:
 
 
 def identify(d: field_sim.Drive, log: field_sim.Log, friction_given=False, **kw):
-    friction = {"D_m": d.D_m, "f_c": d.f_c} if friction_given else {}
-    return identify_drive(
-        log.time,
-        log.i_a,
-        log.omega_m,
-        log.theta_m,
-        k_t=d.k_t,
-        J_m=defaults.J_M,
-        encoder_cpr=d.counts,
-        **friction,
-        **kw,
-    )
+    return identify_log(d, log, friction_given, J_m=defaults.J_M, **kw)
 
 
 @pytest.fixture(scope="module")
