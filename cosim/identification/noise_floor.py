@@ -20,10 +20,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import signal
 
 from arcosim.fmu.flexchain.defaults import VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.low_pass import low_passed
 from arcosim.identification.output_error import predict, rigid_predict, through_g
 from arcosim.identification.records import MotorRecord, motor_record
 
@@ -169,13 +169,11 @@ def smoothing_error(
     >>> round(float(np.abs(term[5000:15000]).max()), 3)
     0.05
     """
-    h, g = record.h, record.g_dist
-    cutoff, nyquist = VELOCITY_SMOOTHING * g, np.pi / h
-    if record.velocity_source == "measured" or cutoff >= nyquist or len(model) <= 12:
+    if record.velocity_source == "measured":
         return np.zeros(len(model))
-    b, a = signal.butter(2, cutoff / nyquist)
+    h, g = record.h, record.g_dist
     x = through_g(k_t * np.asarray(i_a, dtype=float), g, h) - model
-    return x - signal.filtfilt(b, a, x)
+    return x - low_passed(x, h, VELOCITY_SMOOTHING * g)
 
 
 def tau_residual(

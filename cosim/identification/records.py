@@ -25,6 +25,7 @@ from scipy import signal
 from arcosim.fmu.flexchain.defaults import G_DIST, VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.low_pass import low_passed
 
 
 @dataclass(frozen=True)
@@ -194,12 +195,7 @@ def smooth_velocity(theta_m: np.ndarray, h: float, cutoff: float) -> np.ndarray:
     """Derivative (rad/s, shape ``(N,)``) of the angle ``theta_m`` (rad, shape ``(N,)``,
     step ``h`` in s) low-passed at ``cutoff`` (rad/s) forward and backward (2nd-order
     Butterworth each way: no lag, 4th-order roll-off)."""
-    theta = np.asarray(theta_m, dtype=float)
-    nyquist = np.pi / h
-    if cutoff < nyquist and len(theta) > 12:
-        b, a = signal.butter(2, cutoff / nyquist)
-        theta = signal.filtfilt(b, a, theta)
-    return np.gradient(theta, h)
+    return np.gradient(low_passed(np.asarray(theta_m, dtype=float), h, cutoff), h)
 
 
 def motor_opening(record: MotorRecord, seconds: float) -> MotorRecord:
