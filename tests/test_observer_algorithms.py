@@ -128,6 +128,22 @@ def test_dob_pairing_recovers_a_constant_load_exactly() -> None:
         assert dob.d_hat == pytest.approx(tau * (1 - math.exp(-g * k * h)), rel=1e-9)
 
 
+def test_a_known_heading_is_taken_as_sliding_where_the_encoder_reads_no_count() -> None:
+    """A motor crossing less than a count per step reads ω = 0 on most steps, which the
+    DOB alone takes for a stuck motor; with its heading given it removes f_c · heading
+    (kinetic friction) from the drive torque, as on a step where the encoder moved."""
+    f_c, kt, J, h = 2e-3, 0.04, 2e-5, 1e-3
+    alone = ReactionObserver(Actuator(J, kt, f_c=f_c), 100.0, 0.0, 0.0)
+    told = ReactionObserver(Actuator(J, kt, f_c=f_c), 100.0, 0.0, 0.0)
+    i = 0.03  # A: a drive torque (1.2 mN·m) within the friction band
+    alone.step(h, i, 0.0, 0.0)
+    told.step(h, i, 0.0, 0.0, heading=1.0)
+    assert alone.sticking and not told.sticking
+    assert told.friction_sign == 1.0
+    assert told.torque == pytest.approx(kt * i - f_c, rel=1e-12)
+    assert alone.torque == 0.0  # the band's value nearest the previous one
+
+
 def test_recursion_first_stage_is_the_static_deflection() -> None:
     """B = 0 and a constant torque: θ̂_1 = G[θ_m] − τ/k exactly."""
     rec = ChainRecursion([1e-3], [0.5], [0.0], g_dist=100.0, g_lpf=100.0, theta0=0.0)

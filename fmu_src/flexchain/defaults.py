@@ -97,6 +97,12 @@ MOTOR_FRICTION_BANDWIDTH = 20.0
 #: the observer's 1e-4 the bench's two-mass loop held a 37 mrad limit cycle when the
 #: model's J were 10 % high and its k 10 % low; at 1e-3 it settled (1e-2: unstable).
 CONTROL_TORQUE_NOISE_STD = 1e-3
+#: The reference model's motor speed (rad/s) above which the controller tells its DOB the
+#: motor's heading (the reference's): at a move's speeds the motor crosses less than a
+#: count per step, and the DOB alone took it as stuck and left the estimator uncorrected
+#: (five-mass chain: 1.74 × the full-state bound's settling time, 0.98 × with it; 0.05,
+#: 0.3 and 1 rad/s were also tried on `arcosim bench control`'s chains).
+CONTROL_MOVING_SPEED = 0.6
 
 
 # -- the observer on a flexible link (star of modes, ReactionTorqueObserver; issue 28) ----

@@ -146,7 +146,7 @@ class ReactionObserver:
         self._h = 0.0  # step size the filter coefficient below was computed for
         self._a = 1.0  # e^{−g h}
 
-    def step(self, h: float, i_a: float, omega: float, theta: float) -> None:
+    def step(self, h: float, i_a: float, omega: float, theta: float, heading: float = 0.0) -> None:
         """Take the sample (i_a, ω, θ) that ends a step.
 
         Parameters
@@ -159,6 +159,11 @@ class ReactionObserver:
             Motor velocity at the sample (rad/s).
         theta : float
             Motor angle at the sample (rad).
+        heading : float
+            The motor's direction over the step when the caller knows it (−1 or +1):
+            the motor is then taken as sliding that way throughout, with kinetic
+            friction, even where the encoder read no new count (a motor slower than a
+            count per step reads ω = 0); 0 (default): from the samples.
         """
         if h != self._h:
             self._h = h
@@ -176,8 +181,10 @@ class ReactionObserver:
             friction_sign = -1.0
         else:
             friction_sign = mean_sign(w0, omega)
+        if heading != 0.0:
+            friction_sign = heading
         self.friction_sign = friction_sign
-        self.sticking = sticking = omega == 0.0 or w0 == 0.0
+        self.sticking = sticking = heading == 0.0 and (omega == 0.0 or w0 == 0.0)
         if sticking:
             torque = drive - clamp(drive - self.torque, self._f_c)
         else:

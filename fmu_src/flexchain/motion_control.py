@@ -250,7 +250,7 @@ class MotionController:
         t0 = self.theta0
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
-        dob.step(h, i_a, omega_m, theta_m)
+        dob.step(h, i_a, omega_m, theta_m, self._reference_heading())
         th_m = theta_m + self.offset - t0
         self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
         d_m = self.motor.s[0]
@@ -264,6 +264,14 @@ class MotionController:
         L = self.design.control_mass
         self.theta_hat_ctrl = est.theta[L - 1]
         return self._command(h, theta_ref, x, est.tau_load, d_m)
+
+    def _reference_heading(self) -> float:
+        """The reference model's motor heading at this sample (−1, 0 or +1): its sign
+        while the reference's motor speed exceeds ``defaults.CONTROL_MOVING_SPEED``."""
+        v = self.reference[self.design.n + 1]
+        if abs(v) <= defaults.CONTROL_MOVING_SPEED:
+            return 0.0
+        return 1.0 if v > 0.0 else -1.0
 
     def step_full_state(
         self,
