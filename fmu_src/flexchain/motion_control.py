@@ -7,7 +7,9 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   L (:class:`~arcosim.fmu.flexchain.observer.Observer`, mode 2, estimator 1, the same
   code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``)
   gives every load angle and velocity and the torque d̂ on mass L; the motor's angle
-  and velocity enter as measured; a motor observer (:class:`MotorObserver`) gives the
+  enters as measured (the middle of its count), its velocity as the backward difference
+  of the encoder's last crossed edge (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`:
+  0 for a dither across one edge), in the feedback and the DOB alike; a motor observer (:class:`MotorObserver`) gives the
   friction d̂_m the friction model misses, from the current and the encoder, with the
   first spring pulling towards the estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
@@ -42,6 +44,7 @@ from . import defaults
 from .codes import Estimator, Mode
 from .control_design import ControllerDesign, design_controller
 from .dob import Actuator, ReactionObserver, clamp
+from .encoder_edge import CrossedEdge
 from .filters import lowpass_pole
 from .load_observer import LoadTorqueObserver
 from .motor_observer import MotorObserver
@@ -216,6 +219,7 @@ class MotionController:
         self.observer = Observer(settings, theta_m0, 0.0)
         self.offset = settings.angle_offset()
         self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
+        self.crossed = CrossedEdge(theta_m0, self.offset)
         # the origin of the relative states: where the estimates start (the encoder's
         # angle at the middle of its count), so the reference starts on them
         self.theta0 = theta_m0 + self.offset
@@ -238,7 +242,9 @@ class MotionController:
         i_a : float
             Current that acted over the step ending at t_k (A).
         omega_m, theta_m : float
-            Measured motor velocity (rad/s) and angle (rad) at t_k.
+            Measured motor velocity (rad/s) and angle (rad) at t_k. With an encoder
+            (``encoder_cpr`` > 0) the velocity is not used: the controller takes the
+            motor's from the encoder's last crossed edge.
 
         Returns
         -------
@@ -250,7 +256,13 @@ class MotionController:
         t0 = self.theta0
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
-        dob.step(h, i_a, omega_m, theta_m, self._reference_heading())
+        # with an encoder: the velocity of the last crossed edge, not of the count (a
+        # dither across one edge is no motion; encoder_edge), the DOB's too
+        crossed = self.crossed.step(h, theta_m)
+        motion = theta_m
+        if self.offset > 0.0:
+            omega_m, motion = crossed, self.crossed.edge - self.offset
+        dob.step(h, i_a, omega_m, motion, self._reference_heading())
         th_m = theta_m + self.offset - t0
         self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
         d_m = self.motor.s[0]

@@ -1,0 +1,48 @@
+"""The encoder's last crossed edge (``CrossedEdge``) against hand-worked sequences."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from arcosim.fmu.flexchain.encoder_edge import CrossedEdge
+
+COUNT = 2 * math.pi / 2000  # one count of a 2000-count encoder (rad)
+H = 1e-3
+
+
+def _velocities(readings: list[float], half: float = COUNT / 2) -> list[float]:
+    edge = CrossedEdge(readings[0], half)
+    return [edge.step(H, r) for r in readings[1:]]
+
+
+def test_a_dither_across_one_edge_is_no_motion() -> None:
+    """Counts 5, 6, 5, 6, 5: the motor crosses the edge at 6 counts back and forth; after
+    the first crossing (half a count from the first count's middle) it reads 0."""
+    v = _velocities([c * COUNT for c in (5, 6, 5, 6, 5, 5)])
+    assert v[0] == pytest.approx(0.5 * COUNT / H, rel=1e-12)
+    assert v[1:] == [0.0] * 4
+
+
+def test_motion_in_one_direction_is_the_backward_difference() -> None:
+    """A motor moving on (one or several counts a step) reads what the plain backward
+    difference of the counts reads, once it has left its first count."""
+    counts = np.array([0, 1, 3, 4, 4, 6, 9, 9, 10])
+    v = _velocities(list(counts * COUNT))
+    assert v[1:] == pytest.approx(list(np.diff(counts)[1:] * COUNT / H), rel=1e-12)
+
+
+def test_a_reversal_moves_the_edge_by_the_counts_past_it() -> None:
+    """Up to count 8, then down to 6: the edges crossed are 8 (rising into count 8), then
+    8 again (falling into count 7, its upper edge) and 7 (falling into count 6)."""
+    v = _velocities([c * COUNT for c in (6, 7, 8, 7, 6)])
+    assert v[1:] == pytest.approx([COUNT / H, 0.0, -COUNT / H], rel=1e-12)
+
+
+def test_an_exact_angle_gives_the_backward_difference() -> None:
+    """With no counts (half a count of 0) the edge is the angle itself."""
+    angles = [0.0, 0.3e-3, 0.1e-3, 0.25e-3]
+    v = _velocities(angles, half=0.0)
+    assert v == pytest.approx(list(np.diff(angles) / H), rel=1e-12)
