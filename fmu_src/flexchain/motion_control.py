@@ -8,10 +8,11 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``)
   gives every load angle and velocity and the torque d̂ on mass L; the motor's angle
   enters as measured (the middle of its count), its velocity as the backward difference
-  of the encoder's last crossed edge (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`:
-  0 for a dither across one edge), in the feedback and the DOB alike; a motor observer (:class:`MotorObserver`) gives the
-  friction d̂_m the friction model misses, from the current and the encoder, with the
-  first spring pulling towards the estimated mass 1;
+  of the encoder's last crossed edge
+  (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a dither across one
+  edge), in the feedback and the DOB alike; a motor observer (:class:`MotorObserver`)
+  gives the friction d̂_m the friction model misses, from the current and the encoder,
+  with the first spring pulling towards the estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
   (:func:`shaped_step`, zero velocity, acceleration and jerk at both ends, lasting
   ``move_time``) whose sum is the target path s(t); a reference model, the design model
