@@ -129,6 +129,17 @@ def test_the_bench_holds_the_motor_within_one_count() -> None:
 
 
 @pytest.mark.slow
+def test_a_frictionless_drive_holds_the_motor_within_one_count() -> None:
+    """Without Coulomb friction (f_c = 0) the plain backward difference's kick at an edge
+    is the motor's damping there and holds it on the edge: one count (the last crossed
+    edge's velocity, used where friction is cancelled, left it hunting across its count:
+    two counts, three with one step of delay)."""
+    plant = dict(BENCH_2, f_c=0.0)
+    for delay in (0, 1):
+        _check_move(closed_loop(plant, delay=delay), counts=1)
+
+
+@pytest.mark.slow
 def test_a_five_mass_move_settles_sensorless() -> None:
     """The five-mass chain's target lies inside a count, and the motor, free of friction
     inside it, hunts across the count's two edges: three counts (0.83 mrad rms left)."""

@@ -7,8 +7,8 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   L (:class:`~arcosim.fmu.flexchain.observer.Observer`, mode 2, estimator 1, the same
   code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``)
   gives every load angle and velocity and the torque d̂ on mass L; the motor's angle
-  enters as measured (the middle of its count), its velocity as the backward difference
-  of the encoder's last crossed edge
+  enters as measured (the middle of its count), its velocity, where Coulomb friction is
+  cancelled, as the backward difference of the encoder's last crossed edge
   (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a dither across one
   edge), in the feedback and the DOB alike; a motor observer (:class:`MotorObserver`)
   gives the friction d̂_m the friction model misses, from the current and the encoder,
@@ -244,8 +244,9 @@ class MotionController:
             Current that acted over the step ending at t_k (A).
         omega_m, theta_m : float
             Measured motor velocity (rad/s) and angle (rad) at t_k. With an encoder
-            (``encoder_cpr`` > 0) the velocity is not used: the controller takes the
-            motor's from the encoder's last crossed edge.
+            (``encoder_cpr`` > 0) and Coulomb friction (``f_c`` > 0) the velocity is
+            not used: the controller takes the motor's from the encoder's last crossed
+            edge.
 
         Returns
         -------
@@ -257,11 +258,14 @@ class MotionController:
         t0 = self.theta0
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
-        # with an encoder: the velocity of the last crossed edge, not of the count (a
-        # dither across one edge is no motion; encoder_edge), the DOB's too
+        # with an encoder and the friction cancelled: the velocity of the last crossed
+        # edge, not of the count (a dither across one edge is no motion; encoder_edge),
+        # the DOB's too. Without friction the plain difference's kick at an edge is the
+        # motor's only damping there: it holds the motor on the edge, where the crossed
+        # edge leaves it hunting across its count (docs/control.md)
         crossed = self.crossed.step(h, theta_m)
         motion = theta_m
-        if self.offset > 0.0:
+        if self.offset > 0.0 and self.design.f_c > 0.0:
             omega_m, motion = crossed, self.crossed.edge - self.offset
         dob.step(h, i_a, omega_m, motion, self._reference_heading())
         th_m = theta_m + self.offset - t0
