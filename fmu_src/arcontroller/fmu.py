@@ -44,7 +44,12 @@ class ActionReactionController(FmuSlave):
                 "Target of the controlled mass; a change starts a shaped point-to-point move",
             ),
             inp("i_a", 0.0, "A", "Measured motor current: the mean over the step ending at t_k"),
-            inp("omega_m", 0.0, "rad/s", "Measured motor velocity at t_k"),
+            inp(
+                "omega_m",
+                0.0,
+                "rad/s",
+                "Measured motor velocity at t_k (unused with encoder_cpr > 0 and f_c > 0)",
+            ),
             inp("theta_m", 0.0, "rad", "Measured motor angle at t_k"),
             par("J_mo", defaults.J_M, "kg.m2", "Motor inertia (nominal)"),
             par("k_to", defaults.K_T, "N.m/A", "Torque constant (nominal)"),
