@@ -44,7 +44,7 @@ from collections.abc import Sequence
 from . import defaults
 from .codes import Estimator, Mode
 from .control_design import ControllerDesign, design_controller
-from .dob import Actuator, ReactionObserver, clamp
+from .dob import Actuator, ReactionObserver, clamp, sign
 from .encoder_edge import CrossedEdge
 from .filters import lowpass_pole
 from .load_observer import LoadTorqueObserver
@@ -220,7 +220,11 @@ class MotionController:
         self.observer = Observer(settings, theta_m0, 0.0)
         self.offset = settings.angle_offset()
         self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
-        self.crossed = CrossedEdge(theta_m0, self.offset)
+        # the crossed edge's velocity only with an encoder and the friction cancelled:
+        # without friction the plain difference's kick at an edge is the motor's only
+        # damping there and holds it on the edge (docs/control.md)
+        use_edge = self.offset > 0.0 and d.f_c > 0.0
+        self.crossed = CrossedEdge(theta_m0, self.offset) if use_edge else None
         # the origin of the relative states: where the estimates start (the encoder's
         # angle at the middle of its count), so the reference starts on them
         self.theta0 = theta_m0 + self.offset
@@ -258,15 +262,12 @@ class MotionController:
         t0 = self.theta0
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
-        # with an encoder and the friction cancelled: the velocity of the last crossed
-        # edge, not of the count (a dither across one edge is no motion; encoder_edge),
-        # the DOB's too. Without friction the plain difference's kick at an edge is the
-        # motor's only damping there: it holds the motor on the edge, where the crossed
-        # edge leaves it hunting across its count (docs/control.md)
-        crossed = self.crossed.step(h, theta_m)
+        # the velocity of the last crossed edge, not of the count (a dither across one
+        # edge is no motion; encoder_edge), the DOB's too, where reset chose it
         motion = theta_m
-        if self.offset > 0.0 and self.design.f_c > 0.0:
-            omega_m, motion = crossed, self.crossed.edge - self.offset
+        if self.crossed is not None:
+            omega_m = self.crossed.step(h, theta_m)
+            motion = self.crossed.edge - self.offset
         dob.step(h, i_a, omega_m, motion, self._reference_heading())
         th_m = theta_m + self.offset - t0
         self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
@@ -286,9 +287,7 @@ class MotionController:
         """The reference model's motor heading at this sample (−1, 0 or +1): its sign
         while the reference's motor speed exceeds ``defaults.CONTROL_MOVING_SPEED``."""
         v = self.reference[self.design.n + 1]
-        if abs(v) <= defaults.CONTROL_MOVING_SPEED:
-            return 0.0
-        return 1.0 if v > 0.0 else -1.0
+        return float(sign(v)) if abs(v) > defaults.CONTROL_MOVING_SPEED else 0.0
 
     def step_full_state(
         self,
