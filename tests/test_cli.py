@@ -72,9 +72,15 @@ def test_build_writes_into_the_folder_named(tmp_path: Path) -> None:
 def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path) -> None:
     """The paper's three experiments and the three beyond them, end to end (about 90 s)."""
     build_fmus(3)  # into the session cache, where reproduce finds them current
-    result = arcosim("reproduce", "--out", "report", "--no-progress", cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
     out = tmp_path / "report"
+    out.mkdir()
+    # an earlier --all-csv run's file: --force rewrites the report but not this one, so it
+    # is named as left over, and kept (never a lost file)
+    (out / "whole_chain.csv").write_text("time\n0\n")
+    result = arcosim("reproduce", "--out", "report", "--no-progress", "--force", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "not rewritten by this run: whole_chain.csv" in result.stderr, result.stderr
+    assert (out / "whole_chain.csv").read_text() == "time\n0\n"
     for name in (
         "fig4_reaction_torque.png",
         "fig5_flexible_response.png",
@@ -90,7 +96,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         assert (out / name).stat().st_size > 100_000, name
         header = (out / name).open(encoding="utf-8").readline().strip()
         assert header == "time,i_a,omega_m,theta_m", (name, header)
-    for name in ("rigid_seed2.csv", "whole_chain.csv", "load_identified_chain.csv"):
+    for name in ("rigid_seed2.csv", "load_identified_chain.csv"):
         assert not (out / name).exists(), name
     assert sum(p.stat().st_size for p in out.iterdir()) < 10_000_000  # measured 6.6 MB
     units = json.loads((out / "flexible.units.json").read_text())  # every CSV's units

@@ -4,8 +4,9 @@ experiments and four beyond them (:mod:`arcosim.experiments.reproduce`).
 Writes ``report.md``, the runs as CSV (one per maneuver, its log; ``--all-csv``: every
 run, every signal) and the PNG figures into ``--out`` (default ``reports/``), and prints
 the tables. Refuses to start when one of those files exists there, unless ``--force``
-(``make demo`` passes it). Realistic sensors (2000-count encoder, 5 mA current noise)
-unless ``--ideal``.
+(``make demo`` passes it); with it, the report's files this run does not write (an
+earlier ``--all-csv`` run's) are kept and named in a warning. Realistic sensors
+(2000-count encoder, 5 mA current noise) unless ``--ideal``.
 """
 
 from __future__ import annotations
@@ -52,7 +53,8 @@ figures (PNG) and the runs as CSV into --out. By default one run per maneuver (s
 rigid_seed1, flexible, identification, load_true_chain, flexible_link), each its
 log only (time, i_a, omega_m, theta_m: what arcosim identify reads; about 7 MB in
 all); --all-csv writes every run with every recorded signal (about 100 MB). Refuses a
-folder that already holds the report's files unless --force. Realistic sensors
+folder that already holds the report's files unless --force (then an earlier
+--all-csv run's files it does not rewrite are kept, and named). Realistic sensors
 (2000-count encoder, 5 mA current noise) unless --ideal. Takes a minute or two.""",
         examples="""
 arcosim reproduce --out reports

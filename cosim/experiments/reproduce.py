@@ -30,6 +30,7 @@
 from __future__ import annotations
 
 import functools
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -147,6 +148,12 @@ def reproduce(
         When ``out`` is not a folder that can be written, or one of :data:`OUTPUTS`
         exists in it and not ``force`` (checked before any run); every file is written
         atomically.
+
+    Warns
+    -----
+    UserWarning
+        When ``out`` still holds files of :data:`OUTPUTS` this run did not write (an
+        earlier ``all_csv`` run's, under ``force``): named, and kept (:func:`left_over`).
     """
     from tqdm import tqdm
 
@@ -182,7 +189,39 @@ def reproduce(
         results.files.append(figure)
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
+    stale = left_over(out, results.files)
+    if stale:
+        warnings.warn(
+            f"{out} holds files of an earlier run, not rewritten by this run: "
+            f"{', '.join(stale)} (delete them, or run with --all-csv to rewrite them)",
+            stacklevel=2,
+        )
     return results
+
+
+def left_over(out: Path, written: list[Path]) -> list[str]:
+    """The report's files (:data:`OUTPUTS`) in ``out`` that a run did not write: an
+    earlier run's, such as its ``--all-csv`` runs, kept as they are.
+
+    Parameters
+    ----------
+    out : Path
+        The report's folder.
+    written : list of Path
+        The files the run wrote.
+
+    Returns
+    -------
+    list of str
+        Their names, in the order of :data:`OUTPUTS`.
+
+    Examples
+    --------
+    >>> left_over(Path("nowhere"), [])
+    []
+    """
+    mine = {path.name for path in written}
+    return [name for name in OUTPUTS if name not in mine and (out / name).exists()]
 
 
 def _total_steps() -> int:
