@@ -224,3 +224,37 @@ def test_check_tells_a_good_log_from_a_poor_one() -> None:
         assert report.ok, text
     except IdentificationError:
         assert not report.ok, text
+
+
+@pytest.mark.slow
+def test_identify_drive_reads_the_modes_once(monkeypatch) -> None:
+    """``check``'s reading of the modes (the friction estimated and taken out first) is
+    the one the fit starts from, not made again: the same chain, one reading."""
+    import arcosim.identification.drive as drive_module
+    import arcosim.identification.log_decision as log_decision
+    import arcosim.identification.whole_chain as whole_chain
+
+    d = drive()
+    log = field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(args[1])
+        return whole_chain.first_reading.__wrapped__(*args, **kwargs)
+
+    counted.__wrapped__ = whole_chain.first_reading
+    monkeypatch.setattr(log_decision, "first_reading", counted)
+    monkeypatch.setattr(whole_chain, "first_reading", counted)
+    result = identify_log(d, log, friction_given=False)
+    assert calls == ["auto"]
+    monkeypatch.undo()
+
+    def forgetful(*args, **kwargs):  # the decision without its reading: the fit reads again
+        decision = decide_log(*args, **kwargs)
+        decision.reading = None
+        return decision
+
+    decide_log = log_decision.decide_log
+    monkeypatch.setattr(drive_module, "decide_log", forgetful)
+    again = identify_log(d, log, friction_given=False)
+    np.testing.assert_array_equal(result.choice.fit.values, again.choice.fit.values)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
+from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import RIGID_LOAD
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.log_decision import decide_log
@@ -144,6 +145,7 @@ class DriveIdentification:
         return out
 
 
+@single_threaded
 def identify_drive(
     time: Sequence[float] | np.ndarray,
     i_a: Sequence[float] | np.ndarray,
@@ -258,7 +260,9 @@ def identify_drive(
         raise IdentificationError("; ".join(decision.warnings + decision.problems))
     record, encoder = decision.record, decision.encoder
     try:
-        choice = identify_whole_chain(record, masses, encoder, choose_load=load is None)
+        choice = identify_whole_chain(
+            record, masses, encoder, choose_load=load is None, reading=decision.reading
+        )
     except IdentificationError as error:
         if not plausibility:
             raise

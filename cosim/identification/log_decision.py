@@ -96,6 +96,10 @@ class LogDecision:
         The reaction-torque record built for the reading (the friction given, if any).
     encoder : EncoderRecord or None
         The current → encoder record built for it (None without encoder counts).
+    reading : tuple or None
+        What :func:`~arcosim.identification.whole_chain.first_reading` returned for them
+        (the records then fitted and the modes), for the fit to start from; None when
+        the modes could not be read.
     """
 
     problems: list[str] = field(default_factory=list)
@@ -110,6 +114,7 @@ class LogDecision:
     detected: DetectedModes | None = None
     record: MotorRecord | None = None
     encoder: EncoderRecord | None = None
+    reading: tuple[MotorRecord, EncoderRecord | None, DetectedModes] | None = None
 
     @property
     def ok(self) -> bool:
@@ -301,10 +306,12 @@ def _modes(
                 "without encoder counts (encoder_cpr = 0) the fit needs the motor friction "
                 "(D_m and f_c) and no load torque model"
             )
-        record, _, detected = first_reading(decision.record, masses, decision.encoder)
+        reading = first_reading(decision.record, masses, decision.encoder)
     except IdentificationError as error:
         decision.problems.append(str(error))
         return
+    decision.reading = reading
+    record, _, detected = reading
     decision.detected = detected
     why = refusal(detected, masses, record, decision.encoder is not None)
     if why:

@@ -197,6 +197,8 @@ def identify_whole_chain(
     masses: int | str,
     encoder: EncoderRecord | None = None,
     choose_load: bool = True,
+    *,
+    reading: tuple[MotorRecord, EncoderRecord | None, DetectedModes] | None = None,
 ) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
@@ -226,6 +228,10 @@ def identify_whole_chain(
     choose_load : bool
         With ``encoder.load`` none: the load torque (none, constant, slow) chosen by the
         rule and the chain refitted with it; False: none kept, the rule only warns.
+    reading : tuple, optional
+        What :func:`first_reading` returned for these ``record``, ``masses`` and
+        ``encoder``, when the caller has it (:func:`arcosim.identify_drive` takes
+        ``check``'s): the modes are then not read again.
 
     Returns
     -------
@@ -257,7 +263,7 @@ def identify_whole_chain(
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
-    record, encoder, detected = first_reading(record, masses, encoder)
+    record, encoder, detected = reading or first_reading(record, masses, encoder)
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
         # re-read the modes with the fit's friction (far better than the start's)
