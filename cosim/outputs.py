@@ -24,6 +24,7 @@ import io
 import os
 import stat
 import tempfile
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
@@ -204,6 +205,45 @@ def refuse_existing(folder: Path, names: Iterable[str], option: str = "--out") -
             f"{option} {folder}: {existing[0]}{more} exist(s) already; add --force to "
             "replace them, or choose another folder"
         )
+
+
+def warn_left_over(
+    folder: Path, names: Iterable[str], written: Iterable[Path], fix: str = "delete them"
+) -> list[str]:
+    """Warn of the files among ``names`` in ``folder`` that a run did not write (an
+    earlier run's, such as ``reproduce --all-csv``'s runs): kept as they are, but named,
+    so nobody takes them for this run's.
+
+    Parameters
+    ----------
+    folder : Path
+        The run's output folder.
+    names : iterable of str
+        The files the command may write there.
+    written : iterable of Path
+        The files this run wrote.
+    fix : str
+        What the user can do about them, as the warning says it.
+
+    Returns
+    -------
+    list of str
+        The names warned of, in the order of ``names``.
+
+    Examples
+    --------
+    >>> warn_left_over(Path("nowhere"), ["report.md"], [])
+    []
+    """
+    mine = {path.name for path in written}
+    stale = [name for name in names if name not in mine and (folder / name).exists()]
+    if stale:
+        warnings.warn(
+            f"{folder} holds files of an earlier run, not rewritten by this run: "
+            f"{', '.join(stale)} ({fix})",
+            stacklevel=3,
+        )
+    return stale
 
 
 def _publish(temporary: Path, target: Path, force: bool) -> None:

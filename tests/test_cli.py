@@ -79,7 +79,8 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     (out / "whole_chain.csv").write_text("time\n0\n")
     result = arcosim("reproduce", "--out", "report", "--no-progress", "--force", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "not rewritten by this run: whole_chain.csv" in result.stderr, result.stderr
+    named = "not rewritten by this run: whole_chain.csv (delete them, or rewrite them with"
+    assert named in result.stderr, result.stderr
     assert (out / "whole_chain.csv").read_text() == "time\n0\n"
     for name in (
         "fig4_reaction_torque.png",

@@ -23,14 +23,12 @@
    shaping, the sensorless controller and its full-state upper bound, a load-torque
    step and model errors (:mod:`arcosim.experiments.motion_experiment`) → Fig. 10.
 
-:func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder;
-``arcosim reproduce`` is the command line.
+:func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder.
 """
 
 from __future__ import annotations
 
 import functools
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -80,7 +78,7 @@ from arcosim.identification.offline_observer import estimate_states
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.logs import write_csv
-from arcosim.outputs import check_output_folder, refuse_existing, write_text
+from arcosim.outputs import check_output_folder, refuse_existing, warn_left_over, write_text
 
 #: The runs written by default, each its log only (``all_csv``: every run, every signal).
 DEFAULT_CSV = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
@@ -130,7 +128,8 @@ def reproduce(
     fmu_dir : Path, optional
         Folder of the FMUs, built there if missing or stale (default: the per-user cache).
     force : bool
-        Whether the files of :data:`OUTPUTS` may be replaced.
+        Whether the files of :data:`OUTPUTS` may be replaced (those the run does not
+        write are kept, and named in a warning: :func:`~arcosim.outputs.warn_left_over`).
     all_csv : bool
         Whether to write every run with every signal rather than :data:`DEFAULT_CSV`,
         each with the log's columns only.
@@ -148,12 +147,6 @@ def reproduce(
         When ``out`` is not a folder that can be written, or one of :data:`OUTPUTS`
         exists in it and not ``force`` (checked before any run); every file is written
         atomically.
-
-    Warns
-    -----
-    UserWarning
-        When ``out`` still holds files of :data:`OUTPUTS` this run did not write (an
-        earlier ``all_csv`` run's, under ``force``): named, and kept (:func:`left_over`).
     """
     from tqdm import tqdm
 
@@ -189,39 +182,8 @@ def reproduce(
         results.files.append(figure)
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
-    stale = left_over(out, results.files)
-    if stale:
-        warnings.warn(
-            f"{out} holds files of an earlier run, not rewritten by this run: "
-            f"{', '.join(stale)} (delete them, or run with --all-csv to rewrite them)",
-            stacklevel=2,
-        )
+    warn_left_over(out, OUTPUTS, results.files, "delete them, or rewrite them with --all-csv")
     return results
-
-
-def left_over(out: Path, written: list[Path]) -> list[str]:
-    """The report's files (:data:`OUTPUTS`) in ``out`` that a run did not write: an
-    earlier run's, such as its ``--all-csv`` runs, kept as they are.
-
-    Parameters
-    ----------
-    out : Path
-        The report's folder.
-    written : list of Path
-        The files the run wrote.
-
-    Returns
-    -------
-    list of str
-        Their names, in the order of :data:`OUTPUTS`.
-
-    Examples
-    --------
-    >>> left_over(Path("nowhere"), [])
-    []
-    """
-    mine = {path.name for path in written}
-    return [name for name in OUTPUTS if name not in mine and (out / name).exists()]
 
 
 def _total_steps() -> int:

@@ -197,18 +197,16 @@ def identify_whole_chain(
     masses: int | str,
     encoder: EncoderRecord | None = None,
     choose_load: bool = True,
-    *,
     reading: tuple[MotorRecord, EncoderRecord | None, DetectedModes] | None = None,
 ) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
     The record's modes come from a stabilization diagram of the subspace step
     (:func:`~arcosim.identification.modal_start.detect_modes`): a mode counts when it
-    comes back at several model orders and its residue stands above its standard
-    error; ``auto`` takes n = the number that count, confirmed by the data's
-    information criterion one weak mode at a time. An n the record cannot support is
-    refused, naming the modes it shows, the ones too weakly excited, and what would
-    fix the record. :func:`arcosim.identify_drive` runs this from a log.
+    comes back at several model orders and its residue stands above its standard error;
+    ``auto`` takes n = their number, confirmed by the information criterion one weak
+    mode at a time. An n the record cannot support is refused, naming the modes it
+    shows, the weak ones and what would fix the record (:func:`arcosim.identify_drive`).
 
     With ``encoder`` (the same log's current and encoder counts) the chain is fitted by
     the prediction-error fit from the current to the encoder
@@ -229,9 +227,8 @@ def identify_whole_chain(
         With ``encoder.load`` none: the load torque (none, constant, slow) chosen by the
         rule and the chain refitted with it; False: none kept, the rule only warns.
     reading : tuple, optional
-        What :func:`first_reading` returned for these ``record``, ``masses`` and
-        ``encoder``, when the caller has it (:func:`arcosim.identify_drive` takes
-        ``check``'s): the modes are then not read again.
+        :func:`first_reading`'s result for these arguments, when the caller has it
+        (:func:`arcosim.identify_drive` passes ``check``'s): the modes are not read again.
 
     Returns
     -------
@@ -243,8 +240,7 @@ def identify_whole_chain(
     ------
     IdentificationError
         When ``masses`` is neither a whole number ≥ 0 nor ``"auto"``, or the record
-        cannot support the chain asked for (it shows fewer modes than asked; n = 0, the
-        rigid drive, needs the encoder record).
+        cannot support the chain asked for (fewer modes than asked; n = 0 needs encoder).
 
     Examples
     --------
@@ -312,10 +308,9 @@ def identify_whole_chain(
 def first_reading(
     record: MotorRecord, masses: int | str, encoder: EncoderRecord | None = None
 ) -> tuple[MotorRecord, EncoderRecord | None, DetectedModes]:
-    """The modes as the fit first reads them (a friction not given estimated from them
-    and taken out of τ̂ first), and the records then fitted: what
-    :func:`identify_whole_chain` starts from and ``check`` judges; raises
-    IdentificationError for a bad ``masses`` or a record with no motion or too short."""
+    """The modes as the fit first reads them (a friction not given estimated from them and
+    taken out of τ̂ first) and the records then fitted, which ``check`` judges and the fit
+    starts from; raises IdentificationError for a bad ``masses``, no motion or too short."""
     auto = masses == "auto"
     n_asked = None if auto else masses_asked(masses)
     check_excited(record)
