@@ -21,16 +21,9 @@ from ctypes import c_double
 import numpy as np
 
 from arcosim.errors import UserError
+from arcosim.host import stepping
 from arcosim.host.instance import FmuInstance
-from arcosim.host.master import (
-    MEASURED,
-    Recording,
-    _check,
-    _check_arguments,
-    _plant_inputs,
-    _recorder,
-    _signals,
-)
+from arcosim.host.master import MEASURED, Recording
 
 ORDERINGS = ("sequential", "parallel")
 #: The controller's outputs a run records.
@@ -100,23 +93,23 @@ def control_loop(
     """
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
-    _check_arguments("gauss-seidel", h, 1)
+    stepping.check_step(h, 1)
     targets = [float(x) for x in theta_ref]
     steps = len(targets)
-    extra = _plant_inputs(plant, plant_inputs or {}, steps)
+    extra = stepping.plant_inputs(plant, plant_inputs or {}, steps)
     plant.initialize(plant_parameters, t0)
     measured = plant.real_port(MEASURED)
     sensors = controller.real_port(["theta_ref", *MEASURED])
-    _check(measured.get(), plant, "reading the sensors", t0)
+    stepping.check_status(measured.get(), plant, "reading the sensors", t0)
     sensors.values[0] = targets[0] if targets else 0.0
     sensors.values[1:] = list(measured.values)
-    _check(sensors.send(sensors.values), controller, "taking the sensors", t0)
+    stepping.check_status(sensors.send(sensors.values), controller, "taking the sensors", t0)
     controller.initialize(controller_parameters, t0)
     command = controller.real_port(["i_ref"])
     drive = plant.real_port(["i_ref", *extra])
     read_plant, read_controller = (
-        _recorder(plant, record_plant),
-        _recorder(controller, CONTROLLER_OUTPUTS),
+        stepping.recorder(plant, record_plant),
+        stepping.recorder(controller, CONTROLLER_OUTPUTS),
     )
     plant_log = np.empty((steps + 1, len(record_plant)))
     controller_log = np.empty((steps + 1, len(CONTROLLER_OUTPUTS)))
@@ -128,30 +121,30 @@ def control_loop(
     held = 0.0  # the command the plant holds over the next step
     for k in range(steps):
         t_c.value = t = t0 + k * h
-        _check(measured.get(), plant, "reading the sensors", t)
+        stepping.check_status(measured.get(), plant, "reading the sensors", t)
         sensors.values[0] = targets[k]
         sensors.values[1:] = list(measured.values)
-        _check(sensors.send(sensors.values), controller, "taking the sensors", t)
+        stepping.check_status(sensors.send(sensors.values), controller, "taking the sensors", t)
         if ordering == "parallel":  # the plant steps on the command read before this step
             drive.values[0] = held
         if ctrl_step(ctrl_c, t_c, h_c, 1) > 1:
-            _check(2, controller, "stepping", t)
-        _check(command.get(), controller, "reading i_ref", t)
+            stepping.check_status(2, controller, "stepping", t)
+        stepping.check_status(command.get(), controller, "reading i_ref", t)
         controller_log[k] = read_controller()
         if ordering == "sequential":
             drive.values[0] = command.values[0]
         if rows is not None:
             drive.values[1:] = list(rows[k])
-        _check(drive.send(drive.values), plant, "taking i_ref", t)
+        stepping.check_status(drive.send(drive.values), plant, "taking i_ref", t)
         if plant_step(plant_c, t_c, h_c, 1) > 1:
-            _check(2, plant, "stepping", t)
+            stepping.check_status(2, plant, "stepping", t)
         held = command.values[0]
         plant_log[k + 1] = read_plant()
     controller_log[steps] = controller_log[steps - 1] if steps else 0.0
     plant.time = controller.time = t0 + steps * h
     recording = Recording(time=t0 + np.arange(steps + 1) * h)
-    recording.signals.update(_signals("plant", record_plant, plant_log))
-    recording.signals.update(_signals("controller", CONTROLLER_OUTPUTS, controller_log))
+    recording.signals.update(stepping.signals("plant", record_plant, plant_log))
+    recording.signals.update(stepping.signals("controller", CONTROLLER_OUTPUTS, controller_log))
     recording.units.update({f"plant.{name}": plant.unit(name) for name in record_plant})
     recording.units.update(
         {f"controller.{name}": controller.unit(name) for name in CONTROLLER_OUTPUTS}

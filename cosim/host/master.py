@@ -23,6 +23,7 @@ import numpy as np
 
 from arcosim.errors import UserError
 from arcosim.fmu.fmukit.checks import SMALLEST_STEP
+from arcosim.host import stepping
 from arcosim.host.instance import FmuInstance
 
 MEASURED = ("i_a", "omega_m", "theta_m")
@@ -141,16 +142,21 @@ def cosimulate(
     _check_arguments(ordering, h, record_every)
     currents = [float(x) for x in i_ref]
     steps = len(currents)
-    extra = _plant_inputs(plant, plant_inputs or {}, steps)
+    extra = stepping.plant_inputs(plant, plant_inputs or {}, steps)
     plant.initialize(plant_parameters, t0)
     measured = plant.real_port(MEASURED)
     observer_in = observer.real_port(MEASURED)
-    _check(measured.get() | observer_in.send(measured.values), plant, "reading the sensors", t0)
+    stepping.check_status(
+        measured.get() | observer_in.send(measured.values), plant, "reading the sensors", t0
+    )
     observer.initialize(observer_parameters, t0)
-    recorded = record_points(steps, record_every)
+    recorded = stepping.record_points(steps, record_every)
     plant_log = np.empty((len(recorded), len(record_plant)))
     observer_log = np.empty((len(recorded), len(record_observer)))
-    read_plant, read_observer = _recorder(plant, record_plant), _recorder(observer, record_observer)
+    read_plant, read_observer = (
+        stepping.recorder(plant, record_plant),
+        stepping.recorder(observer, record_observer),
+    )
     plant_log[0], observer_log[0] = read_plant(), read_observer()
     # The hot loop: bare ctypes calls with ctypes arguments made once, no allocation.
     i_port = plant.real_port(["i_ref", *extra])
@@ -173,13 +179,13 @@ def cosimulate(
             )
             > 1
         ):
-            _check(2, plant, "passing the sensors on", t)
+            stepping.check_status(2, plant, "passing the sensors on", t)
         if rows is None:
             i_value[0] = currents[k]
         else:
             i_value[:] = rows[k]
         if set_i(plant_c, i_vr, one, i_value) > 1 or plant_step(plant_c, t_c, h_c, 1) > 1:
-            _check(2, plant, "stepping", t)
+            stepping.check_status(2, plant, "stepping", t)
         if (
             gauss_seidel
             and (
@@ -188,9 +194,9 @@ def cosimulate(
             )
             > 1
         ):
-            _check(2, plant, "passing the sensors on", t)
+            stepping.check_status(2, plant, "passing the sensors on", t)
         if observer_step(observer_c, t_c, h_c, 1) > 1:
-            _check(2, observer, "stepping", t)
+            stepping.check_status(2, observer, "stepping", t)
         if k + 1 == next_record:
             plant_log[row], observer_log[row] = read_plant(), read_observer()
             row += 1
@@ -201,77 +207,16 @@ def cosimulate(
         progress(steps % 1000)
     plant.time = observer.time = t0 + steps * h
     recording = Recording(time=t0 + np.array(recorded) * h)
-    recording.signals.update(_signals("plant", record_plant, plant_log))
-    recording.signals.update(_signals("observer", record_observer, observer_log))
+    recording.signals.update(stepping.signals("plant", record_plant, plant_log))
+    recording.signals.update(stepping.signals("observer", record_observer, observer_log))
     recording.units.update({f"plant.{name}": plant.unit(name) for name in record_plant})
     recording.units.update({f"observer.{name}": observer.unit(name) for name in record_observer})
     return recording
 
 
 def _check_arguments(ordering: str, h: float, record_every: int) -> None:
-    """Refuse an unknown ordering, a step ``h`` (s) that is not finite and > 0, and a
-    ``record_every`` below 1."""
+    """Refuse an unknown ordering, then what :func:`~arcosim.host.stepping.check_step`
+    refuses."""
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
-    if not (h > 0.0 and np.isfinite(h)):
-        raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
-    if record_every < 1:
-        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
-
-
-def _plant_inputs(
-    plant: FmuInstance, inputs: Mapping[str, Sequence[float]], steps: int
-) -> dict[str, list[float]]:
-    """The plant's other Real inputs as floats, one per step; refuse a name that is not
-    such an input, or a length that is not ``steps``."""
-    extra = {name: [float(x) for x in values] for name, values in inputs.items()}
-    for name, values in extra.items():
-        var = plant.variables.get(name)
-        if name == "i_ref" or var is None or var.causality != "input" or var.type != "Real":
-            raise UserError(f"plant input {name!r}: not a Real input of the plant besides i_ref")
-        if len(values) != steps:
-            raise UserError(f"plant input {name!r}: {len(values)} values for {steps} steps")
-    return extra
-
-
-def record_points(steps: int, record_every: int) -> list[int]:
-    """The steps after which a run of ``steps`` steps records: 0 (the initial values),
-    every ``record_every``-th, and always the last.
-
-    Examples
-    --------
-    >>> record_points(10, 4)
-    [0, 4, 8, 10]
-    """
-    recorded = [0, *range(record_every, steps + 1, record_every)]
-    if recorded[-1] != steps:
-        recorded.append(steps)
-    return recorded
-
-
-def _signals(prefix: str, names: Sequence[str], log: np.ndarray) -> dict[str, np.ndarray]:
-    """The columns of ``log`` (shape ``(R, len(names))``) as ``"prefix.name"`` signals."""
-    return {f"{prefix}.{name}": log[:, j] for j, name in enumerate(names)}
-
-
-def _recorder(fmu: FmuInstance, names: Sequence[str]) -> Callable[[], Sequence[float]]:
-    """Reads ``names`` as floats: one preallocated get when all are Real."""
-    if not names:
-        return lambda: ()
-    if all(fmu.variables[n].type == "Real" for n in names if n in fmu.variables):
-        port = fmu.real_port(names)
-
-        def read() -> np.ndarray:
-            _check(port.get(), fmu, "reading outputs", fmu.time)
-            return port.array
-
-        return read
-    return fmu.reader(names)
-
-
-def _check(status: int, fmu: FmuInstance, doing: str, t: float) -> None:
-    """Raise :class:`UserError` with the FMU's last log lines if ``status`` > warning."""
-    if status > 1:
-        log = "\n  ".join(fmu.messages[-5:])
-        refused = "refused the step" if doing == "stepping" else f"failed {doing}"
-        raise UserError(f"{fmu.path.name} {refused} at t = {float(t):.10g} s:\n  {log}")
+    stepping.check_step(h, record_every)
