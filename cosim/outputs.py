@@ -207,9 +207,7 @@ def refuse_existing(folder: Path, names: Iterable[str], option: str = "--out") -
         )
 
 
-def warn_left_over(
-    folder: Path, names: Iterable[str], written: Iterable[Path], fix: str = "delete them"
-) -> list[str]:
+def warn_left_over(folder: Path, names: Iterable[str], written: Iterable[Path]) -> list[str]:
     """Warn of the files among ``names`` in ``folder`` that a run did not write (an
     earlier run's, such as ``reproduce --all-csv``'s runs): kept as they are, but named,
     so nobody takes them for this run's.
@@ -222,8 +220,6 @@ def warn_left_over(
         The files the command may write there.
     written : iterable of Path
         The files this run wrote.
-    fix : str
-        What the user can do about them, as the warning says it.
 
     Returns
     -------
@@ -240,7 +236,7 @@ def warn_left_over(
     if stale:
         warnings.warn(
             f"{folder} holds files of an earlier run, not rewritten by this run: "
-            f"{', '.join(stale)} ({fix})",
+            f"{', '.join(stale)} (delete them, or run again with the options that wrote them)",
             stacklevel=3,
         )
     return stale

@@ -77,9 +77,10 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     # an earlier --all-csv run's file: --force rewrites the report but not this one, so it
     # is named as left over, and kept (never a lost file)
     (out / "whole_chain.csv").write_text("time\n0\n")
+    (out / "whole_chain.units.json").write_text('{"time": "s"}')
     result = arcosim("reproduce", "--out", "report", "--no-progress", "--force", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    named = "not rewritten by this run: whole_chain.csv (delete them, or rewrite them with"
+    named = "not rewritten by this run: whole_chain.csv, whole_chain.units.json (delete them"
     assert named in result.stderr, result.stderr
     assert (out / "whole_chain.csv").read_text() == "time\n0\n"
     for name in (

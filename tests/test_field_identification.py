@@ -230,6 +230,8 @@ def test_check_tells_a_good_log_from_a_poor_one() -> None:
 def test_identify_drive_reads_the_modes_once(monkeypatch) -> None:
     """``check``'s reading of the modes (the friction estimated and taken out first) is
     the one the fit starts from, not made again: the same chain, one reading."""
+    from threadpoolctl import threadpool_info
+
     import arcosim.identification.drive as drive_module
     import arcosim.identification.log_decision as log_decision
     import arcosim.identification.whole_chain as whole_chain
@@ -237,12 +239,15 @@ def test_identify_drive_reads_the_modes_once(monkeypatch) -> None:
     d = drive()
     log = field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))
     calls = []
+    original = whole_chain.first_reading
 
     def counted(*args, **kwargs):
         calls.append(args[1])
-        return whole_chain.first_reading.__wrapped__(*args, **kwargs)
+        # the whole call on one BLAS thread: check's reading is the one the fit made
+        blas = [p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"]
+        assert all(n == 1 for n in blas), blas
+        return original(*args, **kwargs)
 
-    counted.__wrapped__ = whole_chain.first_reading
     monkeypatch.setattr(log_decision, "first_reading", counted)
     monkeypatch.setattr(whole_chain, "first_reading", counted)
     result = identify_log(d, log, friction_given=False)

@@ -77,32 +77,23 @@ from arcosim.host.master import Recording
 from arcosim.identification.offline_observer import estimate_states
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
-from arcosim.logs import write_csv
+from arcosim.logs import units_path, write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, warn_left_over, write_text
 
 #: The runs written by default, each its log only (``all_csv``: every run, every signal).
 DEFAULT_CSV = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
 DEFAULT_CSV += ("load_true_chain.csv", "flexible_link.csv")
+#: The figures, Fig. 4 … Fig. 10.
+PAPER_FIGURES = ("fig4_reaction_torque.png", "fig5_flexible_response.png")
+PAPER_FIGURES += ("fig6_state_estimates.png", "fig7_whole_chain.png", "fig8_load_torque.png")
+PAPER_FIGURES += ("fig9_flexible_link.png", MOTION_FIGURE)
 
+#: Every run :func:`reproduce` may write as CSV (``all_csv``), each with its units sidecar.
+RUNS = ("selfid.csv", *(f"rigid_seed{seed}.csv" for seed in SEEDS), "flexible.csv")
+RUNS += ("identification.csv", "whole_chain.csv", "load_true_chain.csv")
+RUNS += ("load_identified_chain.csv", "flexible_link.csv")
 #: The files :func:`reproduce` writes into its folder.
-OUTPUTS = (
-    "selfid.csv",
-    *(f"rigid_seed{seed}.csv" for seed in SEEDS),
-    "flexible.csv",
-    "identification.csv",
-    "whole_chain.csv",
-    "load_true_chain.csv",
-    "load_identified_chain.csv",
-    "flexible_link.csv",
-    "fig4_reaction_torque.png",
-    "fig5_flexible_response.png",
-    "fig6_state_estimates.png",
-    "fig7_whole_chain.png",
-    "fig8_load_torque.png",
-    "fig9_flexible_link.png",
-    MOTION_FIGURE,
-    "report.md",
-)
+OUTPUTS = (*RUNS, *(units_path(run).name for run in RUNS), *PAPER_FIGURES, "report.md")
 
 
 def reproduce(
@@ -182,7 +173,7 @@ def reproduce(
         results.files.append(figure)
         report = report_markdown(results, ideal, k_mean, b_mean)
         results.files.append(write_text(out / "report.md", report, force=True))
-    warn_left_over(out, OUTPUTS, results.files, "delete them, or rewrite them with --all-csv")
+    warn_left_over(out, OUTPUTS, results.files)
     return results
 
 
@@ -237,7 +228,7 @@ class _Bench:
                 tool_names=self.tool_names,
                 force=True,
             )
-            self.results.files.append(path)
+            self.results.files += [path, units_path(path)]
 
     @functools.cached_property
     def encoder_cpr(self) -> int:

@@ -93,7 +93,7 @@ def control_loop(
     """
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
-    stepping.check_step(h, 1)
+    stepping.check_step(h)
     targets = [float(x) for x in theta_ref]
     steps = len(targets)
     extra = stepping.plant_inputs(plant, plant_inputs or {}, steps)

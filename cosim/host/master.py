@@ -215,8 +215,10 @@ def cosimulate(
 
 
 def _check_arguments(ordering: str, h: float, record_every: int) -> None:
-    """Refuse an unknown ordering, then what :func:`~arcosim.host.stepping.check_step`
-    refuses."""
+    """Refuse an unknown ordering, a step ``h`` (s) that is not finite and > 0
+    (:func:`~arcosim.host.stepping.check_step`), and a ``record_every`` below 1."""
     if ordering not in ORDERINGS:
         raise UserError(f"ordering {ordering!r}: use one of {', '.join(ORDERINGS)}")
-    stepping.check_step(h, record_every)
+    stepping.check_step(h)
+    if record_every < 1:
+        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")

@@ -13,12 +13,10 @@ from arcosim.errors import UserError
 from arcosim.host.instance import FmuInstance
 
 
-def check_step(h: float, record_every: int) -> None:
-    """Refuse a step ``h`` (s) that is not finite and > 0, and a ``record_every`` below 1."""
+def check_step(h: float) -> None:
+    """Refuse a step ``h`` (s) that is not finite and > 0."""
     if not (h > 0.0 and np.isfinite(h)):
         raise UserError(f"step size {float(h)!r} s: it must be a finite number > 0")
-    if record_every < 1:
-        raise UserError(f"record_every = {record_every}: record at least every step (>= 1)")
 
 
 def plant_inputs(

@@ -96,7 +96,7 @@ class LogDecision:
         The reaction-torque record built for the reading (the friction given, if any).
     encoder : EncoderRecord or None
         The current → encoder record built for it (None without encoder counts).
-    reading : tuple or None
+    reading : tuple of (MotorRecord, EncoderRecord or None, DetectedModes) or None
         What :func:`~arcosim.identification.whole_chain.first_reading` returned for them
         (the records then fitted and the modes), for the fit to start from; None when
         the modes could not be read.

@@ -145,9 +145,8 @@ def fit_chain(record: MotorRecord, n: int, modes: Modes | None = None) -> Parame
 def information_criterion(
     result: ParameterFit, record: MotorRecord, lag: int | None = None
 ) -> float:
-    """BIC (dimensionless) of ``result`` on ``record`` with the effective sample count
-    N / lag (lag: the Newey–West bandwidth in samples, ``result``'s own unless given;
-    compare fits with one lag)."""
+    """BIC (dimensionless) of ``result`` on ``record`` over N / lag effective samples (lag:
+    the Newey–West bandwidth, samples; ``result``'s unless given: compare at one lag)."""
     count = len(record.theta_m)
     effective = max(count / max(lag or result.lag, 1), 2.0)
     rss = result.rms_residual**2
@@ -197,6 +196,7 @@ def identify_whole_chain(
     masses: int | str,
     encoder: EncoderRecord | None = None,
     choose_load: bool = True,
+    *,
     reading: tuple[MotorRecord, EncoderRecord | None, DetectedModes] | None = None,
 ) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
@@ -226,9 +226,9 @@ def identify_whole_chain(
     choose_load : bool
         With ``encoder.load`` none: the load torque (none, constant, slow) chosen by the
         rule and the chain refitted with it; False: none kept, the rule only warns.
-    reading : tuple, optional
-        :func:`first_reading`'s result for these arguments, when the caller has it
-        (:func:`arcosim.identify_drive` passes ``check``'s): the modes are not read again.
+    reading : tuple of (MotorRecord, EncoderRecord or None, DetectedModes), optional
+        ``first_reading(record, masses, encoder)`` with these very arguments (not
+        checked), when the caller has it (``identify_drive`` passes ``check``'s).
 
     Returns
     -------
@@ -259,7 +259,9 @@ def identify_whole_chain(
     largest = max(MAX_AUTO_MASSES, n_asked or 0)
     unknown = encoder is not None and not encoder.friction_given
     raw = record
-    record, encoder, detected = reading or first_reading(record, masses, encoder)
+    if reading is None:
+        reading = first_reading(record, masses, encoder)
+    record, encoder, detected = reading
     n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
     if unknown:
         # re-read the modes with the fit's friction (far better than the start's)
@@ -355,9 +357,7 @@ def _fit_m(record: MotorRecord, encoder: EncoderRecord, detected: DetectedModes,
 
 def _same_modes(a: DetectedModes, b: DetectedModes, tolerance: float = 5e-3) -> bool:
     """Two mode readings agree: as many modes, each within ``tolerance`` (relative)."""
-    if a.n != b.n:
-        return False
-    return bool(np.all(np.abs(a.frequency - b.frequency) <= tolerance * b.frequency))
+    return a.n == b.n and bool(np.all(abs(a.frequency - b.frequency) <= tolerance * b.frequency))
 
 
 def _choose_and_fit(
