@@ -228,7 +228,11 @@ class _Bench:
                 tool_names=self.tool_names,
                 force=True,
             )
-            self.results.files += [path, units_path(path)]
+            self.wrote_csv(path)
+
+    def wrote_csv(self, path: Path) -> None:
+        """Count the CSV ``path`` and its units sidecar among the files written."""
+        self.results.files += [path, units_path(path)]
 
     @functools.cached_property
     def encoder_cpr(self) -> int:
@@ -378,7 +382,7 @@ def _flexible_link(bench: _Bench) -> tuple[LinkRun, dict[str, np.ndarray]]:
         tool_names=bench.tool_names,
         force=True,
     )
-    bench.results.files.append(path)
+    bench.wrote_csv(path)
     return run, findings.estimates
 
 
