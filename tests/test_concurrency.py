@@ -89,6 +89,35 @@ def test_a_second_sweep_into_a_locked_folder_is_refused_naming_the_first(
     assert not (out / "results.csv").exists()
 
 
+def test_a_refusal_names_a_holder_that_has_just_taken_the_lock(tmp_path: Path) -> None:
+    """A sweep that takes the lock writes who it is a moment later; one refused in that
+    moment waits for the line instead of naming "one that is starting" (the two fresh
+    sweeps below met that window on a loaded CI machine)."""
+    import fcntl
+    import threading
+
+    from arcosim.errors import UserError
+    from arcosim.sweeps.runner import LOCK_FILE, lock_sweep
+
+    out = tmp_path / "out"
+    out.mkdir()
+    with open(out / LOCK_FILE, "a+", encoding="utf-8") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)  # taken, nothing written yet
+
+        def introduce() -> None:
+            held.write("pid 1 on bench, started 2026-12-02T17:50:00+00:00: arcosim sweep\n")
+            held.flush()
+
+        timer = threading.Timer(0.2, introduce)
+        timer.start()
+        try:
+            refused = pytest.raises(UserError, match=r"another sweep is writing there \(pid 1 on")
+            with refused, lock_sweep(out):
+                pass
+        finally:
+            timer.join()
+
+
 @pytest.mark.system
 @pytest.mark.slow
 def test_two_sweeps_into_one_folder_run_every_run_once(build_fmus, tmp_path: Path) -> None:

@@ -34,6 +34,7 @@ import time
 import traceback
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import IO
 
 from arcosim.build.builder import ensure_built, fmu_variables
 from arcosim.build.recipes import OBSERVER, PLANT
@@ -49,6 +50,8 @@ __all__ = ["draw_runs", "load_spec", "lock_sweep", "read_results", "run_one", "s
 
 #: The lock file of a sweep folder; while locked it says who holds it.
 LOCK_FILE = ".arcosim-sweep.lock"
+#: How long a refused sweep waits for the lock's holder to write who it is (s).
+HOLDER_WAIT = 1.0
 #: The files a sweep writes into its folder (besides the PNG plots).
 RESULTS, SUMMARY = "results.csv", "summary.md"
 
@@ -75,8 +78,7 @@ def lock_sweep(out: Path) -> Iterator[None]:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            handle.seek(0)
-            holder = " ".join(handle.read().split())[:300] or "one that is starting"
+            holder = _holder(handle)
             raise UserError(
                 f"--out {out}: another sweep is writing there ({holder}); wait for it to "
                 "finish or choose another --out"
@@ -95,6 +97,19 @@ def lock_sweep(out: Path) -> Iterator[None]:
             handle.seek(0)
             handle.truncate()
             fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _holder(handle: IO[str]) -> str:
+    """Who holds the lock, as the holder wrote it in the lock file. A holder writes its
+    line a moment after taking the lock, so an empty file is read again for up to
+    :data:`HOLDER_WAIT` s before the holder is named "one that is starting"."""
+    deadline = time.monotonic() + HOLDER_WAIT
+    while True:
+        handle.seek(0)
+        holder = " ".join(handle.read().split())[:300]
+        if holder or time.monotonic() > deadline:
+            return holder or "one that is starting"
+        time.sleep(0.01)
 
 
 def run_one(
