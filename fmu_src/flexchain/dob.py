@@ -175,14 +175,14 @@ class ReactionObserver:
         velocity = (theta - self.theta) / h
         self.d_hat = a * self.d_hat + b * (self._k_to * i_a - self._J_mo * accel)
         self.drive = drive = self._kt * i_a - self._jm * accel - self._D * velocity
-        if w0 > 0.0 and omega > 0.0:  # moving one way throughout: the common case, inline
+        if heading != 0.0:  # the caller knows the direction
+            friction_sign = heading
+        elif w0 > 0.0 and omega > 0.0:  # moving one way throughout: the common case, inline
             friction_sign = 1.0
         elif w0 < 0.0 and omega < 0.0:
             friction_sign = -1.0
         else:
             friction_sign = mean_sign(w0, omega)
-        if heading != 0.0:
-            friction_sign = heading
         self.friction_sign = friction_sign
         self.sticking = sticking = heading == 0.0 and (omega == 0.0 or w0 == 0.0)
         if sticking:
