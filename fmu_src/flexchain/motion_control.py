@@ -383,7 +383,7 @@ def heading(design: ControllerDesign, x: Sequence[float], i: float, h: float) ->
     w_m = x[n1]
     tau_1 = design.k[0] * (x[0] - x[1]) + design.B[0] * (w_m - x[n1 + 1])
     mean = w_m + 0.5 * h * (design.k_t * i - tau_1 - design.D_m * w_m) / design.J_m
-    return 1.0 if mean > 0.0 else (-1.0 if mean < 0.0 else 0.0)
+    return float(sign(mean))
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:
