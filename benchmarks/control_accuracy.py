@@ -18,6 +18,9 @@ A seed passes a criterion when the sensorless move settles the last mass within 
 the upper bound's time (same design) and holds no motor limit cycle over one count
 (:func:`arcosim.experiments.motion_findings.done_when`). Prints the pass counts per chain
 and model; writes ``control.md`` and ``control.json`` into ``--out``.
+
+``--encoder-cpr`` sets the encoder of the plant, of the identification's log and of the
+controller's design alike (default 2000); the limit cycle is counted in its counts.
 """
 
 from __future__ import annotations
@@ -67,11 +70,18 @@ MODELS = ("identified", "random errors", "J +10 %, k −10 %", "J −10 %, k +10
 CRITERIA = ("settles", "residual", "near_bound", "no_limit_cycle")
 
 
-def score_seed(chain: MotionChain, folder: Path, seed: int, corners: bool) -> dict[str, dict]:
+def score_seed(
+    chain: MotionChain, folder: Path, seed: int, corners: bool, encoder_cpr: int = ENCODER_CPR
+) -> dict[str, dict]:
     """One seed on one chain: every model's sensorless and upper-bound moves, and the
-    criteria; the corners only when ``corners``."""
-    params = design_parameters(identify_chain(folder, chain, False, seed), False)
-    runs = Runs(folder, chain, False, seed=seed)
+    criteria; the corners only when ``corners``; an encoder of ``encoder_cpr`` counts."""
+    result = identify_chain(folder, chain, False, seed, encoder_cpr)
+    params = design_parameters(result, False, encoder_cpr)
+    runs = Runs(folder, chain, False, seed=seed, encoder_cpr=encoder_cpr)
+
+    def _score(run) -> MoveScore:
+        return score_move(run, DISTANCE, DISTANCE, encoder_cpr)
+
     cascade = _score(runs.run(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX)))
     errors = model_errors(chain.n, (seed,))
     models = {"identified": (np.ones(chain.n), np.ones(chain.n))}
@@ -90,14 +100,15 @@ def score_seed(chain: MotionChain, folder: Path, seed: int, corners: bool) -> di
     return out
 
 
-def _score(run) -> MoveScore:
-    return score_move(run, DISTANCE, DISTANCE, ENCODER_CPR)
-
-
 def run(
-    out: Path, seeds: Sequence[int], chains: Sequence[MotionChain], progress: Callable[[str], None]
+    out: Path,
+    seeds: Sequence[int],
+    chains: Sequence[MotionChain],
+    progress: Callable[[str], None],
+    encoder_cpr: int = ENCODER_CPR,
 ) -> dict[str, object]:
-    """Every chain over ``seeds``; the table, the per-seed results, the time (s)."""
+    """Every chain over ``seeds`` with an encoder of ``encoder_cpr`` counts; the table,
+    the per-seed results, the time (s)."""
     started = time.perf_counter()
     results: dict[str, dict] = {}
     for chain in chains:
@@ -106,10 +117,16 @@ def run(
         per_seed = {}
         for seed in seeds:
             progress(f"{chain.name}: seed {seed}")
-            per_seed[str(seed)] = score_seed(chain, folder, seed, corners=seed == seeds[0])
+            per_seed[str(seed)] = score_seed(
+                chain, folder, seed, corners=seed == seeds[0], encoder_cpr=encoder_cpr
+            )
         results[chain.name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
-    text = markdown(results)
-    summary = {"results": results, "seconds": time.perf_counter() - started}
+    text = f"Encoder: {encoder_cpr} counts per revolution.\n\n" + markdown(results)
+    summary = {
+        "encoder_cpr": encoder_cpr,
+        "results": results,
+        "seconds": time.perf_counter() - started,
+    }
     out.mkdir(parents=True, exist_ok=True)
     (out / "control.md").write_text(text, encoding="utf-8")
     (out / "control.json").write_text(json.dumps(summary, indent=1, default=str), "utf-8")
@@ -127,6 +144,7 @@ HEADER = [
     "±1 % settling: median, worst (s)",
     "bound's median (s)",
     "worst residual (mrad)",
+    "worst limit cycle (counts)",
 ]
 
 
@@ -142,6 +160,7 @@ def markdown(results: dict[str, dict]) -> str:
             settle = [s["sensorless"]["settle_1"] for s in seeds]
             bound = [s["upper_bound"]["settle_1"] for s in seeds]
             residual = max(s["sensorless"]["residual"] for s in seeds)
+            cycle = max(s["sensorless"]["limit_cycle"] for s in seeds)
             rows.append(
                 [
                     f"{chain} ({found['lowest_mode']:.1f} rad/s)",
@@ -151,6 +170,7 @@ def markdown(results: dict[str, dict]) -> str:
                     f"{_s(float(np.median(settle)))}, {_s(max(settle))}",
                     _s(float(np.median(bound))),
                     f"{1e3 * residual:.2f}",
+                    f"{cycle:g}",
                 ]
             )
     return markdown_table(HEADER, rows) + "\n"
@@ -171,14 +191,27 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--seeds", type=int, default=20, help="plant seeds per chain (default 20)")
     p.add_argument("--quick", action="store_true", help="the first chain only")
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
+    p.add_argument(
+        "--encoder-cpr",
+        type=int,
+        default=ENCODER_CPR,
+        help=f"the encoder's counts per revolution, of the plant and of the controller's "
+        f"design (default {ENCODER_CPR})",
+    )
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
     if args.seeds < 1:
         raise UserError(f"--seeds must be >= 1, got {args.seeds}")
+    if args.encoder_cpr < 1:
+        raise UserError(
+            f"--encoder-cpr must be >= 1 count per revolution, got {args.encoder_cpr} "
+            f"(the limit cycle is counted in the encoder's counts; default {ENCODER_CPR})"
+        )
     chains = CHAINS[:1] if args.quick else CHAINS
-    result = run(args.out, range(1, args.seeds + 1), chains, progress)
+    seeds = range(1, args.seeds + 1)
+    result = run(args.out, seeds, chains, progress, args.encoder_cpr)
     print(result["table"])
     print(f"wrote {args.out / 'control.md'} and {args.out / 'control.json'} "
           f"({result['seconds']:.0f} s)")  # fmt: skip

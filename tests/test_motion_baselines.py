@@ -266,3 +266,27 @@ def test_experiment_on_the_bench_has_the_four_rows(fmus) -> None:
     cascade, shaped = found.moves[CONTROLLERS[0]], found.moves[CONTROLLERS[1]]
     assert cascade.settle_1 == math.inf and cascade.residual > 5e-3
     assert shaped.residual < cascade.residual / 3
+
+
+def test_runs_give_the_plant_the_encoder_asked_for(fmus) -> None:
+    """``Runs(..., encoder_cpr=N)`` puts an encoder of N counts on the plant (every reading
+    a whole count of 2π/N), not the bench's 2000 (a 0.1 A push: the motor turns)."""
+    from arcosim.experiments.motion_experiment import CHAINS, Runs
+    from arcosim.experiments.motion_findings import DURATION
+
+    push = OpenLoop(np.full(round(DURATION / defaults.STEP), 0.1))
+    run = Runs(fmus, CHAINS[0], False, encoder_cpr=20000).run(push)
+    counts = run.theta_m / (2 * math.pi / 20000)
+    assert np.allclose(counts, np.round(counts), atol=1e-6) and np.ptp(counts) > 100
+    coarse = run.theta_m / (2 * math.pi / 2000)
+    assert not np.allclose(coarse, np.round(coarse), atol=1e-6)
+
+
+def test_bench_control_refuses_an_encoder_without_counts(capsys) -> None:
+    """``arcosim bench control --encoder-cpr 0``: one line naming the option and the fix."""
+    from arcosim.cli import main
+
+    assert main(["bench", "control", "--encoder-cpr", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--encoder-cpr must be >= 1" in err and "default 2000" in err
+    assert len(err.splitlines()) == 1

@@ -85,19 +85,23 @@ CHAINS = (
 )
 
 
-def plant_settings(chain: MotionChain, ideal: bool, seed: int = SEED) -> dict[str, float]:
-    """The plant FMU's start values: the chain, the noise seed, the sensors."""
-    sensors = {"encoder_cpr": 0, "i_noise_std": 0.0} if ideal else {}
+def plant_settings(
+    chain: MotionChain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
+) -> dict[str, float]:
+    """The plant FMU's start values: the chain, the noise seed, the sensors (an encoder
+    of ``encoder_cpr`` counts per revolution and 5 mA current noise, none if ``ideal``)."""
+    sensors = {"encoder_cpr": 0, "i_noise_std": 0.0} if ideal else {"encoder_cpr": encoder_cpr}
     return {**chain.plant_values(), "seed": seed, **sensors}
 
 
 def identify_chain(
-    folder: Path, chain: MotionChain, ideal: bool, seed: int = SEED
+    folder: Path, chain: MotionChain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
 ) -> DriveIdentification:
     """The chain as :func:`arcosim.identify_drive` finds it in a log of the plant.
 
     The log: the ``identification`` multi-sine (40 lines 3–150 rad/s, 3 A, 20 s) on the
-    plant FMU of ``folder``; known: k_t and J_m (and, with ideal sensors, the friction).
+    plant FMU of ``folder`` with an encoder of ``encoder_cpr`` counts (exact if
+    ``ideal``); known: k_t and J_m (and, with ideal sensors, the friction).
 
     Raises
     ------
@@ -107,23 +111,26 @@ def identify_chain(
     t = np.arange(round(IDENTIFICATION_DURATION / STEP)) * STEP
     log = run_closed_loop(
         folder, chain.n, OpenLoop(identification_current(t)), 0.0, IDENTIFICATION_DURATION,
-        plant=plant_settings(chain, ideal, seed),
+        plant=plant_settings(chain, ideal, seed, encoder_cpr),
     )  # fmt: skip
     friction = {"D_m": defaults.D_M, "f_c": defaults.F_C} if ideal else {}
     return identify_drive(
         log.time, log.i_a, log.omega_m, log.theta_m, k_t=defaults.K_T, J_m=defaults.J_M,
-        encoder_cpr=0 if ideal else ENCODER_CPR, masses=chain.n, **friction,
+        encoder_cpr=0 if ideal else encoder_cpr, masses=chain.n, **friction,
     )  # fmt: skip
 
 
-def design_parameters(result: DriveIdentification, ideal: bool) -> dict[str, float]:
-    """The controller's parameters (the observer FMU's names) from an identification."""
+def design_parameters(
+    result: DriveIdentification, ideal: bool, encoder_cpr: int = ENCODER_CPR
+) -> dict[str, float]:
+    """The controller's parameters (the observer FMU's names) from an identification, for
+    an encoder of ``encoder_cpr`` counts (exact if ``ideal``)."""
     chain = {k: v for k, v in result.observer_parameters().items() if k != "estimator"}
     return {
         "J_mo": defaults.J_M,
         "k_to": defaults.K_T,
         **chain,
-        "encoder_cpr": 0 if ideal else ENCODER_CPR,
+        "encoder_cpr": 0 if ideal else encoder_cpr,
         "g_dist": G_DIST,
     }
 
@@ -189,7 +196,8 @@ def motion_steps() -> int:
 
 class Runs:
     """The runs of one chain: its plant's FMUs, sensors and the load step, and what to
-    call with the steps done after each run."""
+    call with the steps done after each run; the plant's encoder has ``encoder_cpr``
+    counts (exact if ``ideal``), and limit cycles are counted in them either way."""
 
     def __init__(
         self,
@@ -198,17 +206,18 @@ class Runs:
         ideal: bool,
         progress: Callable[[int], object] = lambda _steps: None,
         seed: int = SEED,
+        encoder_cpr: int = ENCODER_CPR,
     ) -> None:
         self.folder, self.chain, self.ideal, self.progress = folder, chain, ideal, progress
         self.seed = seed
-        self.cpr = ENCODER_CPR  # the limit cycle in counts of the bench's encoder, ideal or not
+        self.cpr = encoder_cpr
 
     def run(self, controller: object, full_state: bool = False, load: bool = False) -> LoopRun:
         """A 1 rad move from rest; with ``load``, the load-torque step during the hold."""
         step = LoadStep(self.chain.n, LOAD_TIME, LOAD_TORQUE) if load else None
         run = run_closed_loop(
             self.folder, self.chain.n, controller, DISTANCE, DURATION,
-            plant=plant_settings(self.chain, self.ideal, self.seed), load=step,
+            plant=plant_settings(self.chain, self.ideal, self.seed, self.cpr), load=step,
             full_state=full_state,
         )  # fmt: skip
         self.progress(len(run.i_ref))
