@@ -276,17 +276,41 @@ def test_runs_give_the_plant_the_encoder_asked_for(fmus) -> None:
 
     push = OpenLoop(np.full(round(DURATION / defaults.STEP), 0.1))
     run = Runs(fmus, CHAINS[0], False, encoder_cpr=20000).run(push)
-    counts = run.theta_m / (2 * math.pi / 20000)
+    counts = run.theta_m / (2 * math.pi / 20000)  # whole fine counts, as a 2000 would be too
     assert np.allclose(counts, np.round(counts), atol=1e-6) and np.ptp(counts) > 100
     coarse = run.theta_m / (2 * math.pi / 2000)
     assert not np.allclose(coarse, np.round(coarse), atol=1e-6)
 
 
-def test_bench_control_refuses_an_encoder_without_counts(capsys) -> None:
-    """``arcosim bench control --encoder-cpr 0``: one line naming the option and the fix."""
+@pytest.mark.parametrize("cpr", ["0", str(2**31)])
+def test_bench_control_refuses_an_encoder_it_cannot_run(capsys, cpr: str) -> None:
+    """``arcosim bench control --encoder-cpr 0`` (exact) or one past the plant's 32-bit
+    integer: one line naming the option, the range and the default."""
     from arcosim.cli import main
 
-    assert main(["bench", "control", "--encoder-cpr", "0"]) == 2
+    assert main(["bench", "control", "--encoder-cpr", cpr]) == 2
     err = capsys.readouterr().err.strip()
-    assert "--encoder-cpr must be >= 1" in err and "default 2000" in err
+    assert "--encoder-cpr must be 1 … 2147483647" in err and "default 2000" in err
     assert len(err.splitlines()) == 1
+
+
+def test_a_bench_seed_identifies_designs_and_scores_with_its_encoder(monkeypatch) -> None:
+    """``score_seed(..., encoder_cpr=N)`` hands N to the identification's log, the design
+    and the runs (stopped there)."""
+    from benchmarks import control_accuracy as bench
+
+    seen = {}
+
+    class StoppedError(Exception):
+        pass
+
+    def runs(folder, chain, ideal, seed, encoder_cpr):
+        seen["runs"] = encoder_cpr
+        raise StoppedError
+
+    monkeypatch.setattr(bench, "identify_chain", lambda *a: seen.setdefault("log", a[4]))
+    monkeypatch.setattr(bench, "design_parameters", lambda r, i, c: seen.setdefault("design", c))
+    monkeypatch.setattr(bench, "Runs", runs)
+    with pytest.raises(StoppedError):
+        bench.score_seed(bench.CHAINS[0], None, 1, False, encoder_cpr=8192)
+    assert seen == {"log": 8192, "design": 8192, "runs": 8192}
