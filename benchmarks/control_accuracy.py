@@ -57,6 +57,7 @@ from arcosim.experiments.motion_findings import (
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR
+from arcosim.host.overrides import INT_MAX
 from benchmarks import progress
 
 #: The chains: lowest modes 19.7, 17.1 and 13.4 rad/s (motor free), damped at 0.05–0.2 %.
@@ -68,8 +69,6 @@ CHAINS = (
 #: The models per seed, in the table's order.
 MODELS = ("identified", "random errors", "J +10 %, k −10 %", "J −10 %, k +10 %")
 CRITERIA = ("settles", "residual", "near_bound", "no_limit_cycle")
-#: The largest encoder the plant FMU holds (its ``encoder_cpr`` is a 32-bit integer).
-MAX_ENCODER_CPR = 2**31 - 1
 
 
 def score_seed(
@@ -207,9 +206,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def _execute(args: argparse.Namespace) -> int:
     if args.seeds < 1:
         raise UserError(f"--seeds must be >= 1, got {args.seeds}")
-    if not 1 <= args.encoder_cpr <= MAX_ENCODER_CPR:
+    if not 1 <= args.encoder_cpr <= INT_MAX:  # the plant's encoder_cpr: an FMI Integer
         raise UserError(
-            f"--encoder-cpr must be 1 … {MAX_ENCODER_CPR} counts per revolution, got "
+            f"--encoder-cpr must be 1 … {INT_MAX} counts per revolution, got "
             f"{args.encoder_cpr} (an exact encoder is not benchmarked; default {ENCODER_CPR})"
         )
     chains = CHAINS[:1] if args.quick else CHAINS
