@@ -36,6 +36,7 @@ import numpy as np
 
 from arcosim.build.builder import ensure_built
 from arcosim.errors import UserError
+from arcosim.experiments.closed_loop import LoopRun
 from arcosim.experiments.motion_baselines import CascadeController, cascade_gains, chain_modes
 from arcosim.experiments.motion_experiment import (
     MotionChain,
@@ -81,7 +82,7 @@ def score_seed(
     runs = Runs(folder, chain, False, seed=seed, encoder_cpr=encoder_cpr)
 
     def _score(run) -> MoveScore:
-        return score_move(run, DISTANCE, DISTANCE, encoder_cpr)
+        return score(run, encoder_cpr)
 
     cascade = _score(runs.run(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX)))
     errors = model_errors(chain.n, (seed,))
@@ -99,6 +100,11 @@ def score_seed(
             "criteria": done_when(moving, cascade, upper),
         }
     return out
+
+
+def score(run: LoopRun, encoder_cpr: int = ENCODER_CPR) -> MoveScore:
+    """A 1 rad move's scores, the limit cycle in counts of an ``encoder_cpr`` encoder."""
+    return score_move(run, DISTANCE, DISTANCE, encoder_cpr)
 
 
 def run(

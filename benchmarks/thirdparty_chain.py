@@ -233,7 +233,7 @@ def score_seed(folder: Path, seed: int, corners: bool, control: bool = True) -> 
     def move(controller: object, full_state: bool = False):
         with open_plant(folder, seed) as plant:
             run = run_loop(plant, controller, DISTANCE, DURATION, full_state)
-        return control_accuracy._score(run)
+        return control_accuracy.score(run)
 
     cascade = move(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX))
     models = {"identified": (np.ones(CHAIN.n), np.ones(CHAIN.n))}

@@ -74,3 +74,32 @@ def test_identification_only_fits_without_moving(folder):
     for name, p in ident["parameters"].items():
         if name[0] in "Jk":
             assert abs(p["error_percent"]) < 0.5, (name, p)
+
+
+def test_a_seed_scores_its_moves_as_the_control_benchmark_does(monkeypatch) -> None:
+    """``score_seed``'s moves go through :func:`benchmarks.control_accuracy.score` (the
+    third-party FMU not needed: the identification and the plant are stood in for, the
+    motor and the last mass resting on target, so every criterion holds)."""
+    from contextlib import nullcontext
+    from types import SimpleNamespace
+
+    from arcosim.experiments.closed_loop import LoopRun
+
+    n = thirdparty_chain.CHAIN.n
+    time = np.arange(6001) * 1e-3
+    rest = LoopRun(time=time, theta=np.ones((n + 1, time.size)), theta_m=np.ones(time.size),
+                   omega_m=np.zeros(time.size), i_a=np.zeros(time.size),
+                   i_ref=np.zeros(time.size - 1))  # fmt: skip
+    fake = SimpleNamespace(masses=n)
+    monkeypatch.setattr(thirdparty_chain, "identify", lambda folder, seed: fake)
+    monkeypatch.setattr(thirdparty_chain, "identification_errors", lambda result: {})
+    monkeypatch.setattr(thirdparty_chain, "design_parameters", lambda result, ideal: {})
+    monkeypatch.setattr(thirdparty_chain, "scaled", lambda params, fJ, fk: params)
+    monkeypatch.setattr(thirdparty_chain, "cascade_gains", lambda params: None)
+    monkeypatch.setattr(thirdparty_chain, "CascadeController", lambda *a: None)
+    monkeypatch.setattr(thirdparty_chain, "sensorless", lambda params: None)
+    monkeypatch.setattr(thirdparty_chain, "open_plant", lambda folder, seed: nullcontext())
+    monkeypatch.setattr(thirdparty_chain, "run_loop", lambda *a: rest)
+    found = thirdparty_chain.score_seed(Path("."), 1, corners=False)
+    criteria = found["models"]["identified"]["criteria"]
+    assert criteria == dict.fromkeys(("settles", "residual", "near_bound", "no_limit_cycle"), True)
