@@ -70,3 +70,24 @@ def test_arcosim_ssp_command(build_fmus, tmp_path, capsys) -> None:
     )
     assert "50 steps" in capsys.readouterr().out
     assert out.read_text().splitlines()[0].startswith("time,source.i_ref")
+
+
+def test_a_refused_step_names_the_component_and_its_log(build_fmus, monkeypatch) -> None:
+    """As the other hosts say it (``stepping.check_status``): the component, its FMU, the
+    time and the FMU's last log lines as text, not a Python list."""
+    from arcosim.host.instance import FmuInstance
+
+    step = FmuInstance.do_step
+
+    def refusing(self, t: float, h: float) -> int:
+        if "Observer" in self.path.name and t >= 0.005:
+            self.messages.append("observer: [fmi2Error] the step went wrong")
+            return 3  # fmi2Error
+        return step(self, t, h)
+
+    monkeypatch.setattr(FmuInstance, "do_step", refusing)
+    with pytest.raises(UserError) as error:
+        run_ssp(build_fmus(3) / "ActionReaction.ssp", "bench", stop=0.02)
+    said = str(error.value)
+    assert said.startswith("observer (") and "refused the step at t = 0.005 s" in said
+    assert "the step went wrong" in said and "['" not in said

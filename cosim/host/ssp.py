@@ -25,6 +25,7 @@ from arcosim.errors import UserError
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.instance import FmuInstance
 from arcosim.host.master import MAX_STEPS, Recording
+from arcosim.host.stepping import check_status
 
 
 @dataclass
@@ -249,10 +250,7 @@ def _run_steps(
         for read, write in links:
             write(read())
         for name, fmu in instances.items():
-            if fmu.do_step(t, h) > 1:
-                raise UserError(
-                    f"{name} refused the step at t = {float(t):.10g} s: {fmu.messages[-1:]}"
-                )
+            check_status(fmu.do_step(t, h), fmu, "stepping", t, name)
         for name, read in readers.items():
             logs[name][k + 1] = read()
     return outputs, logs

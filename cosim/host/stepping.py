@@ -69,9 +69,15 @@ def recorder(fmu: FmuInstance, names: Sequence[str]) -> Callable[[], Sequence[fl
     return fmu.reader(names)
 
 
-def check_status(status: int, fmu: FmuInstance, doing: str, t: float) -> None:
-    """Raise :class:`UserError` with the FMU's last log lines if ``status`` > warning."""
+def check_status(
+    status: int, fmu: FmuInstance, doing: str, t: float, component: str | None = None
+) -> None:
+    """Raise :class:`UserError` with the FMU's last log lines if ``status`` > warning.
+
+    The message names the FMU's file, after ``component`` (a system's name for it) when
+    given."""
     if status > 1:
         log = "\n  ".join(fmu.messages[-5:])
         refused = "refused the step" if doing == "stepping" else f"failed {doing}"
-        raise UserError(f"{fmu.path.name} {refused} at t = {float(t):.10g} s:\n  {log}")
+        who = fmu.path.name if component is None else f"{component} ({fmu.path.name})"
+        raise UserError(f"{who} {refused} at t = {float(t):.10g} s:\n  {log}")
