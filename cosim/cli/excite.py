@@ -17,6 +17,7 @@ import json
 from pathlib import Path
 
 from arcosim.cli.options import add_command, force_option, number, step_option, whole_number
+from arcosim.host.overrides import INT_MAX
 from arcosim.identification.excitation_design import DURATION, LINES, design_excitation
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
@@ -64,7 +65,7 @@ arcosim excite --band 3 150 --current-limit 3 --out excitation.csv \\
         type=number(0.0, low_open=True, unit="A.s/rad"),
         help="the speed loop's proportional gain (A.s/rad), for --kind speed",
     )
-    p.add_argument("--seed", type=whole_number(0, 2**31 - 1), default=1, help="phases")
+    p.add_argument("--seed", type=whole_number(0, INT_MAX), default=1, help="phases")
     for name, unit, what in (
         ("--k-t", "N.m/A", "torque constant"),
         ("--f-c", "N.m", "Coulomb friction"),
@@ -72,7 +73,7 @@ arcosim excite --band 3 150 --current-limit 3 --out excitation.csv \\
         ("--g-dist", "rad/s", "disturbance observer bandwidth"),
     ):
         p.add_argument(name, type=number(0.0, low_open=True, unit=unit), help=f"{what} ({unit})")
-    p.add_argument("--encoder-cpr", type=whole_number(1, 2**31 - 1), help="encoder counts/rev")
+    p.add_argument("--encoder-cpr", type=whole_number(1, INT_MAX), help="encoder counts/rev")
     p.add_argument("--out", type=Path, required=True, help="CSV file to write")
     force_option(p)
     p.add_argument("--json", action="store_true", help="print the design as one JSON object")
