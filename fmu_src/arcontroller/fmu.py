@@ -86,10 +86,23 @@ class ActionReactionController(FmuSlave):
                 "s",
                 "Duration of a shaped move; 0 = set by bandwidth (exactly one of the two > 0)",
             ),
+            par(
+                "hold_dither",
+                defaults.HOLD_DITHER,
+                "1",
+                "Dither at rest, in encoder counts peak to peak of the motor (0 = off): a "
+                "square current at about 125 Hz from half a move time after a move, so that "
+                "the encoder tells where the motor sits inside its count",
+            ),
             out("i_ref", "A", "Current command to hold over the step that starts at t_k"),
             out("theta_hat_ctrl", "rad", "Estimated angle of the controlled mass at t_k"),
             out("i_ff", "A", "Feedforward part of i_ref (the reference model's current)"),
-            out("i_fb", "A", "Feedback part of i_ref, before the limit (friction included)"),
+            out(
+                "i_fb",
+                "A",
+                "Feedback part of i_ref, before the limit (friction and the hold's dither "
+                "included)",
+            ),
         ]
 
     def check_parameters(self) -> list[str]:
@@ -98,7 +111,15 @@ class ActionReactionController(FmuSlave):
         problems = range_problems(
             v,
             positive=["J_mo", "k_to", "g_dist", "i_max", *indexed("J", n), *indexed("k", n)],
-            non_negative=["D_m", "f_c", "encoder_cpr", "bandwidth", "move_time", *indexed("B", n)],
+            non_negative=[
+                "D_m",
+                "f_c",
+                "encoder_cpr",
+                "bandwidth",
+                "move_time",
+                "hold_dither",
+                *indexed("B", n),
+            ],
         )
         if not 1 <= v("control_mass") <= n:
             problems.append(
@@ -132,6 +153,7 @@ class ActionReactionController(FmuSlave):
             move_time=v("move_time"),
             bandwidth=v("bandwidth"),
             i_max=v("i_max"),
+            hold_dither=v("hold_dither"),
         )
         self.controller = MotionController(design)
         self.controller.reset(v("theta_m"))

@@ -65,6 +65,9 @@ class ControllerDesign:
         ω_c (rad/s).
     i_max : float
         Current limit (A).
+    hold_dither : float
+        The hold's dither (encoder counts peak to peak; 0 = off;
+        :mod:`~arcosim.fmu.flexchain.hold_dither`).
     F : Matrix
         State transition over ``h``, shape ``(2n + 2, 2n + 2)``.
     g : list of float
@@ -96,6 +99,7 @@ class ControllerDesign:
     move_time: float
     bandwidth: float
     i_max: float
+    hold_dither: float
     F: Matrix
     g: list[float]
     K: list[float]
@@ -104,6 +108,26 @@ class ControllerDesign:
     def n(self) -> int:
         """Number of load masses."""
         return len(self.J)
+
+    @property
+    def dither_steps(self) -> int:
+        """The hold's dither period P in steps of h: ``defaults.HOLD_DITHER_PERIOD`` as a
+        multiple of four steps, at least four."""
+        return 4 * max(1, round(defaults.HOLD_DITHER_PERIOD / (4.0 * self.h)))
+
+    @property
+    def dither_current(self) -> float:
+        """Amplitude A (A) of the hold's square current, 0 when off or without an encoder.
+
+        The free motor moves ``A k_t (P h)² / (16 J_m)`` peak to peak under ``±A`` over
+        P steps of h (:attr:`dither_steps`); A makes that ``hold_dither`` counts
+        (:mod:`~arcosim.fmu.flexchain.hold_dither`).
+        """
+        if self.hold_dither <= 0.0 or self.encoder_cpr <= 0:
+            return 0.0
+        period = self.dither_steps * self.h
+        count = 2.0 * math.pi / self.encoder_cpr
+        return 16.0 * self.hold_dither * count * self.J_m / (self.k_t * period * period)
 
     @property
     def inertia(self) -> float:
@@ -311,6 +335,7 @@ def design_controller(
     move_time: float = defaults.MOVE_TIME,
     bandwidth: float = defaults.BANDWIDTH,
     i_max: float = defaults.I_MAX,
+    hold_dither: float = defaults.HOLD_DITHER,
 ) -> ControllerDesign:
     """The controller for a chain and the user's goals.
 
@@ -331,6 +356,9 @@ def design_controller(
         ω_c (rad/s) of the feedback, or 0 when ``move_time`` is given.
     i_max : float
         Current limit (A), > 0.
+    hold_dither : float
+        The dither at rest (encoder counts peak to peak, ≥ 0; 0 = off); used only with an
+        encoder (``encoder_cpr`` > 0).
 
     Returns
     -------
@@ -355,13 +383,15 @@ def design_controller(
     n = len(J)
     L = n if control_mass is None else int(control_mass)
     _check_chain(params, J, k, B, L, h, i_max)
+    if not (math.isfinite(hold_dither) and hold_dither >= 0.0):
+        raise ValueError(f"parameter hold_dither = {hold_dither!r} counts must be ≥ 0 (0 = off)")
     J_m, k_t, D_m = float(params["J_mo"]), float(params["k_to"]), float(params["D_m"])
     A, b = plant_matrices(J_m, k_t, D_m, J, k, B)
     F, g = hold_discretize(A, b, h)
     grow = math.exp(DECAY_RATIO * wc * h)
     Q = cost_weights(J_m, k_t, J, k, L, wc)
     K = regulator_gain(linalg.scaled(F, grow), [grow * x for x in g], Q, 1.0)
-    return ControllerDesign(
+    design = ControllerDesign(
         h=h,
         J_m=J_m,
         k_t=k_t,
@@ -376,10 +406,17 @@ def design_controller(
         move_time=T,
         bandwidth=wc,
         i_max=i_max,
+        hold_dither=float(hold_dither),
         F=F,
         g=g,
         K=K,
     )
+    if not design.dither_current <= 0.5 * i_max:
+        raise ValueError(
+            f"parameter hold_dither = {hold_dither!r} counts needs ±{design.dither_current:.3g} A "
+            f"at rest, more than half of i_max = {i_max!r} A: lower hold_dither (0 = off)"
+        )
+    return design
 
 
 def _check_chain(

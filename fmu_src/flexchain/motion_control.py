@@ -47,6 +47,7 @@ from .control_design import ControllerDesign, design_controller
 from .dob import Actuator, ReactionObserver, clamp, sign
 from .encoder_edge import CrossedEdge
 from .filters import lowpass_pole
+from .hold_dither import HoldDither
 from .load_observer import LoadTorqueObserver
 from .motor_observer import MotorObserver
 from .observer import Observer, ObserverSettings
@@ -234,6 +235,8 @@ class MotionController:
         self.theta_hat_ctrl = self.theta0
         self.i_ff = self.i_fb = self.i_ref = 0.0
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
+        self.dither: HoldDither | None = None  # while the hold's dither runs
+        self._moved = 0.0  # when the target path last moved (s)
 
     def step(self, h: float, theta_ref: float, i_a: float, omega_m: float, theta_m: float) -> float:
         """Take the sample at t_k and return the current to hold over the next step.
@@ -270,9 +273,15 @@ class MotionController:
             motion = self.crossed.edge - self.offset
         dob.step(h, i_a, omega_m, motion, self._reference_heading())
         th_m = theta_m + self.offset - t0
-        self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
-        d_m = self.motor.s[0]
-        drive = theta_m + obs.offset
+        dither = self.dither
+        if dither is None:
+            self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
+            d_m = self.motor.s[0]
+        else:  # at rest: the motor below a count, from the reading less the dither's path
+            th_m, omega_m = dither.measure(h, i_a, th_m)
+            self.motor.step(h, dither.steady, dither.reading, theta_1, omega_1, 0.0)
+            d_m = 0.0
+        drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
         if dob.sticking:
             settle_sticking(dob, est, h, drive)
         est.step(h, dob.tau_reac_hat, drive)
@@ -281,7 +290,31 @@ class MotionController:
         x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]
         L = self.design.control_mass
         self.theta_hat_ctrl = est.theta[L - 1]
-        return self._command(h, theta_ref, x, est.tau_load, d_m)
+        self._command(h, theta_ref, x, est.tau_load, d_m)
+        return self._hold(h, x)
+
+    def _hold(self, h: float, x: Sequence[float]) -> float:
+        """Start, run or stop the hold's dither for the next step; return ``i_ref`` (A).
+
+        It runs from ``defaults.HOLD_DITHER_AFTER`` move times after the target path
+        stops until the next move, where the design has one (``dither_current`` > 0).
+        """
+        design = self._design_for(h)
+        if self.path.moves:
+            self._moved = self.t
+        rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
+        if not (rest and design.dither_current > 0.0):
+            self.dither = None
+            return self.i_ref
+        if self.dither is None or self.dither.design.h != h:
+            self.dither = HoldDither(design)
+            self.dither.start(x[0], x[design.n + 1])
+        current, friction = self.dither.command(h)
+        # the friction cancelled along the dither's velocity, which the motor follows
+        self.i_fb += current + (friction - self.friction) / design.k_t
+        self.friction = friction
+        self.i_ref = clamp(self.i_ff + self.i_fb, design.i_max)
+        return self.i_ref
 
     def _reference_heading(self) -> float:
         """The reference model's motor heading at this sample (−1, 0 or +1): its sign
@@ -338,7 +371,12 @@ class MotionController:
                 params.update({f"{name}[{i + 1}]": v for i, v in enumerate(values)})
             params.update(g_dist=d.g_dist, encoder_cpr=d.encoder_cpr)
             found = design_controller(
-                params, h=h, control_mass=d.control_mass, move_time=d.move_time, i_max=d.i_max
+                params,
+                h=h,
+                control_mass=d.control_mass,
+                move_time=d.move_time,
+                i_max=d.i_max,
+                hold_dither=d.hold_dither,
             )
             self._designs[h] = found
         return found

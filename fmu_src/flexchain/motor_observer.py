@@ -72,14 +72,19 @@ class MotorObserver:
         The motor's terms and the first spring.
     bandwidth : float
         ω_o (rad/s).
+    spring : bool
+        True (default): the model above. False: the motor alone (``k_1 = B_1 = 0``), the
+        spring's torque taken into d_m, whose pole then sits at ω_o too: what the hold's
+        dither needs (:mod:`~arcosim.fmu.flexchain.hold_dither`), no load parameter in it.
     """
 
     _transient = ("_models",)  # derived from the settings; rebuilt after an FMU state restore
 
-    def __init__(self, design: ControllerDesign, bandwidth: float) -> None:
+    def __init__(self, design: ControllerDesign, bandwidth: float, spring: bool = True) -> None:
         self.design = design
         self.bandwidth = bandwidth
-        self.friction_bandwidth = defaults.MOTOR_FRICTION_BANDWIDTH
+        self.spring = spring
+        self.friction_bandwidth = defaults.MOTOR_FRICTION_BANDWIDTH if spring else bandwidth
         self.s = [0.0, 0.0, 0.0]
         self._models: dict[float, tuple[Matrix, Matrix, list[float]]] = {}
 
@@ -88,7 +93,8 @@ class MotorObserver:
         found = self._models.get(h)
         if found is None:
             d = self.design
-            k1, B1, Jm = d.k[0], d.B[0], d.J_m
+            k1, B1 = (d.k[0], d.B[0]) if self.spring else (0.0, 0.0)
+            Jm = d.J_m
             A = [
                 [0.0, 0.0, 0.0],
                 [-1.0 / Jm, -(d.D_m + B1) / Jm, -k1 / Jm],
