@@ -45,6 +45,26 @@ def test_move_time_and_bandwidth_exactly_one_or_fmi2error(fmus, goals: dict) -> 
     assert any(m.startswith("error") for m in fmu.messages)
 
 
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"hold_dither": -0.5}, r"parameter hold_dither = -0.5 must be >= 0"),
+        (
+            {"hold_dither": 0.9, "i_max": 0.5},
+            r"hold_dither = 0.9 counts needs ±0.364 A at rest, more than half of i_max = 0.5 A",
+        ),
+    ],
+    ids=["negative", "more than half of i_max"],
+)
+def test_a_dither_it_cannot_run_is_fmi2error_naming_it(fmus, settings: dict, message) -> None:
+    with (
+        FmuInstance(fmus / "ActionReactionController.fmu", "controller") as fmu,
+        pytest.raises(UserError, match=message),
+    ):
+        fmu.initialize(settings)
+    assert any(m.startswith("error") for m in fmu.messages)
+
+
 def _run(fmus, ordering: str, stop: float, plant: dict | None = None):
     """A 1 rad move of the bench's last mass, controller and plant FMUs in fmpy."""
     steps = round(stop / H)

@@ -9,7 +9,11 @@ periodic path of peak-to-peak ``A k_t (P h)² / (16 J_m)``; the amplitude is cho
 ``defaults.HOLD_DITHER`` counts. The reading less that path has a quantization error
 that changes from sample to sample (subtractive dither), and an observer of the motor
 alone (:class:`~arcosim.fmu.flexchain.motor_observer.MotorObserver` without its spring)
-averages it into the motor's angle and velocity below a count.
+averages it into the motor's angle below a count, for the state feedback and the
+estimator's input. Its velocity is not used: it carries the dither's periodic error (about
+0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s) and, fed back, made the
+five-mass chain diverge with its model's J 10 % high and k 10 % low; at 1000 rad/s it
+diverged with one step of delay, at 2000 no run held one count (docs/development.md).
 
 Friction is cancelled along the dither's velocity, which the motor follows; what the
 slow motion meets then is a viscous friction of about ``2 f_c / v_peak`` per rad/s, the
@@ -23,7 +27,7 @@ import math
 
 from . import defaults
 from .control_design import ControllerDesign
-from .dob import sign
+from .dob import mean_sign, sign
 from .motor_observer import MotorObserver
 
 
@@ -73,7 +77,7 @@ class HoldDither:
         """Start the dither with the motor at ``theta`` (rad, relative) and ``omega`` (rad/s)."""
         self.k = 0
         self.path = 0.0  # the dither's motion at the next sample (rad)
-        self.velocity = 0.0  # … and its velocity (rad/s)
+        self.velocity = self.before = 0.0  # … its velocity there and at the last (rad/s)
         self.current = self.friction = 0.0  # what acts over the step to the next sample
         self.observer.s = [0.0, omega, theta]
 
@@ -94,9 +98,14 @@ class HoldDither:
         tuple of float
             The observer's angle and velocity, the dither's path taken out. Also kept:
             ``reading`` (rad), the reading less the path, and ``steady`` (A), the
-            current less the dither's and the friction cancellation's.
+            current less the dither's and less the Coulomb friction that acted (f_c
+            times the mean sign of the dither's velocity plus the observer's slow one).
         """
-        self.steady = i_a - self.current - self.friction / self.design.k_t
+        d = self.design
+        # the friction that acted: along the dither's velocity plus the slow motion's
+        slow = self.observer.s[1]
+        friction = d.f_c * mean_sign(self.before + slow, self.velocity + slow)
+        self.steady = i_a - self.current - friction / d.k_t
         self.reading = theta - (self.path - self.mean)
         self.observer.step(h, self.steady, self.reading, 0.0, 0.0, 0.0)
         return self.observer.s[2], self.observer.s[1]
@@ -115,7 +124,7 @@ class HoldDither:
         velocity = self.velocity + accel * h
         self.friction = d.f_c * sign(self.velocity + velocity)
         self.path += (self.velocity + 0.5 * accel * h) * h
-        self.velocity = velocity
+        self.before, self.velocity = self.velocity, velocity
         self.current = current
         self.k += 1
         return current, self.friction
