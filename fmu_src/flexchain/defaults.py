@@ -107,10 +107,10 @@ CONTROL_MOVING_SPEED = 0.6
 #: current that moves the motor over this much of a count, so that the encoder's reading,
 #: less the dither's known path, tells where the motor is inside its count
 #: (:mod:`~arcosim.fmu.flexchain.hold_dither`); 0 = off. On `arcosim bench control`'s
-#: chains (seeds 1–3, 36 runs) it took the runs holding the motor within one count from 7
-#: to 18, those within the residual criterion from 31 to 35 and those meeting all four
-#: criteria from 3 to 10; 0.5, 0.6, 0.8 and 0.9 did as well or one run worse there, but
-#: 0.9 held the bench two-mass chain over two counts (docs/development.md).
+#: chains at 20 seeds it took the runs meeting all four criteria from 18 to 34 of 126 and
+#: those holding the motor within one count from 21 to 42. The amplitude was chosen with
+#: the dither observer's velocity fed back as well: 0.5–0.8 did alike on seeds 1–3, 0.9
+#: held the tests' bench two-mass chain over two counts (docs/development.md).
 HOLD_DITHER = 0.7
 #: Its period (s): 125 Hz, far above the chains' modes; taken as a whole number of control
 #: steps, a multiple of four and at least four (8 steps at 1 ms).
@@ -118,7 +118,8 @@ HOLD_DITHER_PERIOD = 8e-3
 #: When it starts: this share of the move time after the reference comes to rest.
 HOLD_DITHER_AFTER = 0.5
 #: Bandwidth of the motor-alone observer that averages the de-dithered reading (rad/s):
-#: at 150 two chains diverged at the J +10 %, k −10 % corner (docs/development.md).
+#: at 150, with its velocity and the DOB fed from it too, two chains diverged at the J
+#: +10 %, k −10 % corner (docs/development.md).
 HOLD_OBSERVER_BANDWIDTH = 300.0
 
 
