@@ -64,7 +64,7 @@ def test_the_dither_tells_where_the_motor_sits_inside_its_count(shift: float) ->
             current, _ = dither.command(H)
             true = place + dither.path - dither.mean
             reading = math.floor(true / COUNT + 1e-9) * COUNT
-            angle, _ = dither.measure(H, current, reading + COUNT / 2)
+            angle = dither.measure(H, current, reading + COUNT / 2)
             estimates.append(angle)
         worst = max(worst, abs(np.mean(estimates[-8:]) - place))
         plain = math.floor(place / COUNT + 1e-9) * COUNT + COUNT / 2

@@ -32,7 +32,7 @@ from .motor_observer import MotorObserver
 
 
 class HoldDither:
-    """The dither's current, its path and the motor's angle and velocity below a count.
+    """The dither's current, its path and the motor's angle below a count.
 
     Parameters
     ----------
@@ -81,8 +81,8 @@ class HoldDither:
         self.current = self.friction = 0.0  # what acts over the step to the next sample
         self.observer.s = [0.0, omega, theta]
 
-    def measure(self, h: float, i_a: float, theta: float) -> tuple[float, float]:
-        """The motor's angle (rad, relative) and velocity (rad/s) at this sample.
+    def measure(self, h: float, i_a: float, theta: float) -> float:
+        """The motor's angle at this sample (rad, relative).
 
         Parameters
         ----------
@@ -95,11 +95,12 @@ class HoldDither:
 
         Returns
         -------
-        tuple of float
-            The observer's angle and velocity, the dither's path taken out. Also kept:
-            ``reading`` (rad), the reading less the path, and ``steady`` (A), the
-            current less the dither's and less the Coulomb friction that acted (f_c
-            times the mean sign of the dither's velocity plus the observer's slow one).
+        float
+            The observer's angle, the dither's path taken out (its velocity, not used by
+            the controller, is ``observer.s[1]``). Also kept: ``reading`` (rad), the
+            reading less the path, and ``steady`` (A), the current less the dither's and
+            less the Coulomb friction that acted (f_c times the mean sign of the dither's
+            velocity plus the observer's slow one).
         """
         d = self.design
         # the friction that acted: along the dither's velocity plus the slow motion's
@@ -108,7 +109,7 @@ class HoldDither:
         self.steady = i_a - self.current - friction / d.k_t
         self.reading = theta - (self.path - self.mean)
         self.observer.step(h, self.steady, self.reading, 0.0, 0.0, 0.0)
-        return self.observer.s[2], self.observer.s[1]
+        return self.observer.s[2]
 
     def command(self, h: float) -> tuple[float, float]:
         """The dither's current over the next step (A) and the friction to cancel (N·m).

@@ -279,7 +279,7 @@ class MotionController:
             d_m = self.motor.s[0]
         else:  # at rest: the motor's angle below a count, from the reading less the
             # dither's path; the velocity stays the crossed edge's (hold_dither's doc)
-            th_m = dither.measure(h, i_a, th_m)[0]
+            th_m = dither.measure(h, i_a, th_m)
             self.motor.step(h, dither.steady, dither.reading, theta_1, omega_1, 0.0)
             d_m = 0.0
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
