@@ -1,0 +1,65 @@
+"""The sensorless loop's poles, from the controller's and the plant's own code
+(``benchmarks/control_margins.py``: an exact encoder, no Coulomb friction, so the loop is
+linear, differentiated by finite differences).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from arcosim.fmu.flexchain.control_design import design_controller
+from benchmarks.control_margins import (
+    CHAINS,
+    H,
+    params,
+    sensorless_decay,
+    sensorless_jacobian,
+    sensorless_loop,
+)
+
+CORNERS = {"J +10 %, k -10 %": (1.1, 0.9), "J -10 %, k +10 %": (0.9, 1.1)}
+
+
+def test_an_exact_model_puts_the_state_feedbacks_poles_in_the_loop() -> None:
+    """Separation: with the model exact, the loop's poles are the state feedback's
+    (eig(F − g K)) and the estimator's; the finite differences (relative step 1e-6 on a
+    linear map) leave each within 1e-6 of its own."""
+    chain = CHAINS["bench, two masses"]
+    design = design_controller({**params(*chain), "f_c": 0.0, "encoder_cpr": 0}, h=H)
+    feedback = np.linalg.eigvals(np.array(design.F) - np.outer(design.g, design.K))
+    loop = np.linalg.eigvals(sensorless_jacobian(sensorless_loop(chain, chain)))
+    assert len(loop) > len(feedback)
+    assert max(np.abs(loop - pole).min() for pole in feedback) < 1e-6
+
+
+UNSTABLE = pytest.mark.xfail(
+    strict=True,
+    reason="measured: grows at 0.85 1/s at 79.9 rad/s, by the chain's fourth mode (74.6 "
+    "rad/s): the estimator's poles there decay at 1.6 1/s with the model exact, and the state "
+    "feedback's margins do not cover them; at rest the encoder's crossed edge, nearly 0 "
+    "inside a count, holds it (docs/development.md); open",
+)
+CASES = [
+    pytest.param(
+        name,
+        corner,
+        id=f"{name}, {corner}",
+        marks=[UNSTABLE] if (name, corner) == ("five masses", "J +10 %, k -10 %") else [],
+    )
+    for name in CHAINS
+    for corner in CORNERS
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "corner"), CASES)
+def test_the_sensorless_loop_is_stable_with_the_model_ten_percent_off(
+    name: str, corner: str
+) -> None:
+    """Every pole of the sensorless loop inside the unit circle (a decay > 0) with the
+    model's J all 10 % off one way and its k the other."""
+    J, k, B = chain = CHAINS[name]
+    fj, fk = CORNERS[corner]
+    decay, _ = sensorless_decay(chain, (np.array(J) * fj, np.array(k) * fk, B))
+    assert decay > 0.0
