@@ -107,7 +107,7 @@ def _leaves(obj, path: tuple = (), seen: set | None = None) -> list[tuple]:
     found = []
     for key, value in items:
         frozen = getattr(getattr(type(value), "__dataclass_params__", None), "frozen", False)
-        if key in UNPERTURBED or isinstance(value, bool) or frozen:
+        if key in UNPERTURBED or frozen:
             continue
         if isinstance(value, float):
             found.append((*path, key))
@@ -144,17 +144,14 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     1e-6; those the step leaves exactly as they were (parameters) are dropped, so the
     eigenvalues are the loop's poles (an exact model puts the state feedback's among them).
     """
-    root = {"controller": loop.controller, "plant": loop.plant, "signals": loop.signals}
-    paths = _leaves(root)
-    z0 = np.array([_get(root, p) for p in paths])
+    paths = _leaves(loop)
+    z0 = np.array([_get(loop, p) for p in paths])
 
     def stepped(path=None, value=0.0) -> np.ndarray:
-        copied = copy.deepcopy(root)
+        copied = copy.deepcopy(loop)
         if path is not None:
             _put(copied, path, value)
-        moved = SensorlessLoop(copied["controller"], copied["plant"], copied["signals"], loop.delay)
-        advance(moved)
-        copied["signals"] = moved.signals
+        advance(copied)
         return np.array([_get(copied, p) for p in paths])
 
     z1 = stepped()
