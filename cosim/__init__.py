@@ -30,11 +30,13 @@ uniform_chain       -- the paper's uniform chain: k and B by output error
 estimate_load_torque -- the torque on a load mass over a log (the observer's estimator)
 ObserverSettings    -- the observer FMU's parameters as one value (estimate_load_torque's)
 
-Motion and vibration control (the controller FMU's algorithms, standard library)
+Motion and vibration control (the FMU's algorithms, standard library; margins on numpy)
 -------------------------------------------------------------------------------
 design_controller   -- state feedback and reference shaping for a chain and a move time
 ControllerDesign    -- its result: the discrete model, the gain, the goals
 MotionController    -- moves a load mass and damps the chain from current and encoder
+controller_margins  -- both loops' margins for a chain and goals, model errors included (numpy)
+ControllerMargins   -- its result, with a verdict
 
 Scenarios and co-simulation
 ---------------------------
@@ -73,8 +75,8 @@ The paper's experiments and the report are the command ``arcosim reproduce``
 
 Every name above is importable from ``arcosim`` directly (loaded on first use, so
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
-``arcosim.host``, ``arcosim.build``, ``arcosim.experiments``, ``arcosim.sweeps``,
-``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
+``arcosim.host``, ``arcosim.build``, ``arcosim.control``, ``arcosim.experiments``,
+``arcosim.sweeps``, ``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
 
 Modules and subpackages, in the order data flows (each subpackage's docstring lists its
 modules):
@@ -87,6 +89,7 @@ host                      -- the FMUs run on fmpy: instances, the master, replay
 logs                      -- drive logs read and checked; recordings written as CSV
 identification            -- the drive identified offline from a log (numpy/scipy, no FMU)
 chainfile                 -- a whole-chain report read back as its chain (``read_chain``)
+control                   -- the motion controller's margins checked on numpy (``arcosim control``)
 experiments               -- the paper's experiments on the simulated bench, the report
 sweeps                    -- Monte Carlo and grid sweeps of co-simulations
 outputs                   -- every file a command writes: checked first, written atomically
@@ -126,6 +129,8 @@ _API = {
     "design_controller": "arcosim.fmu.flexchain.control_design",
     "ControllerDesign": "arcosim.fmu.flexchain.control_design",
     "MotionController": "arcosim.fmu.flexchain.motion_control",
+    "controller_margins": "arcosim.control.margins",
+    "ControllerMargins": "arcosim.control.margins",
     "SCENARIOS": "arcosim.experiments.scenarios",
     "Scenario": "arcosim.experiments.scenarios",
     "run_scenario": "arcosim.experiments.scenarios",

@@ -1,6 +1,7 @@
 """The sensorless loop's poles, from the controller's and the plant's own code
-(``benchmarks/control_margins.py``: an exact encoder, no Coulomb friction, so the loop is
-linear, differentiated by finite differences).
+(:mod:`arcosim.control.sensorless_loop`: an exact encoder, no Coulomb friction, so the loop
+is linear, differentiated by finite differences), on the chains of
+``benchmarks/control_margins.py``.
 """
 
 from __future__ import annotations
@@ -8,22 +9,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.control_margins import (
-    CHAINS,
-    sensorless_decay,
-    sensorless_jacobian,
-    sensorless_loop,
-)
+from arcosim.control.model_errors import corners
+from arcosim.control.sensorless_loop import sensorless_decay, sensorless_jacobian, sensorless_loop
+from benchmarks.control_margins import CHAINS, H, params
 
-CORNERS = {"J +10 %, k -10 %": (1.1, 0.9), "J -10 %, k +10 %": (0.9, 1.1)}
+#: The test ids (ASCII) → the corners' names (:func:`arcosim.control.model_errors.corners`).
+CORNERS = {"J +10 %, k -10 %": "J +10 %, k −10 %", "J -10 %, k +10 %": "J −10 %, k +10 %"}
 
 
 def test_an_exact_model_puts_the_state_feedbacks_poles_in_the_loop() -> None:
     """Separation: with the model exact, the loop's poles are the state feedback's
     (eig(F − g K)) and the estimator's; the finite differences (relative step 1e-6 on a
     linear map) leave each within 1e-6 of its own."""
-    chain = CHAINS["bench, two masses"]
-    loop = sensorless_loop(chain, chain)
+    chain = params(*CHAINS["bench, two masses"])
+    loop = sensorless_loop(chain, chain, h=H)
     design = loop.controller.design
     feedback = np.linalg.eigvals(np.array(design.F) - np.outer(design.g, design.K))
     poles = np.linalg.eigvals(sensorless_jacobian(loop))
@@ -57,7 +56,7 @@ def test_the_sensorless_loop_is_stable_with_the_model_ten_percent_off(
 ) -> None:
     """Every pole of the sensorless loop inside the unit circle (a decay > 0) with the
     model's J all 10 % off one way and its k the other."""
-    J, k, B = chain = CHAINS[name]
-    fj, fk = CORNERS[corner]
-    decay, _ = sensorless_decay(chain, (np.array(J) * fj, np.array(k) * fk, B))
+    chain = params(*CHAINS[name])
+    error = next(e for e in corners(len(CHAINS[name][0])) if e.name == CORNERS[corner])
+    decay, _ = sensorless_decay(chain, error.apply(chain), h=H)
     assert decay > 0.0

@@ -91,6 +91,7 @@ ALLOWED = {
         "arcosim.portability",
         "arcosim.version",
     ),
+    "arcosim.control": ("arcosim.errors", "arcosim.fmu", "arcosim.plant"),
     "arcosim.build": (
         "arcosim.errors",
         "arcosim.fmu",

@@ -16,6 +16,7 @@ identify_observer      -- ``--method observer``: the observer FMU replayed over 
 identify_output_error  -- ``--method output-error``: the uniform chain's k and B
 identify_whole_chain   -- ``--method whole-chain``: every J_i, k_i, B_i and n
 identify_load_torque   -- ``--method load-torque``: the torque on a load mass over time
+control                -- ``arcosim control``: the motion controller for a chain, its margins
 example                -- ``arcosim example``: the sample log and its script into a folder
 reproduce              -- ``arcosim reproduce``: the paper's experiments and the report
 sweep                  -- ``arcosim sweep``: Monte Carlo and grid sweeps on Dask
@@ -52,6 +53,7 @@ from arcosim.cli import (
     bench,
     build,
     check,
+    control,
     example,
     excite,
     identify,
@@ -95,6 +97,7 @@ def make_parser() -> argparse.ArgumentParser:
         excite,
         check,
         identify,
+        control,
         example,
         reproduce,
         sweep,

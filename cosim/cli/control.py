@@ -1,0 +1,163 @@
+"""``arcosim control [--chain FIT.json]``: the motion controller for a chain, checked
+before it runs.
+
+Designs the sensorless controller as the ``ActionReactionController`` FMU does at
+initialization (the same code) for the chain and the goals given with the FMU's own
+parameter names, and prints both loops' margins (:func:`arcosim.control.controller_margins`):
+the full-state loop's (the upper bound) and the sensorless loop's, linearized, with the
+model exact, one step late and with every J_i, k_i scaled within ``--error`` of the
+chain's. Exit status 0 when the sensorless loop decays in every case, 1 when some case
+grows (the verdict says which, and within which smaller error it would not), 2 for a bad
+input. Parameters not given take the FMU's defaults (the paper bench's), and the output
+says which.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Mapping, Sequence
+
+from arcosim.cli.identify_options import chain_assignments, chain_option, masses_option
+from arcosim.cli.options import add_command, number, step_option
+from arcosim.cli.parameters import defaults_note, drive_parameters, set_names
+from arcosim.control.margins import controller_margins
+from arcosim.control.model_errors import ERROR, RANDOM_MODELS
+from arcosim.errors import UserError
+from arcosim.fmu.arcontroller.fmu import ActionReactionController
+from arcosim.host.overrides import check_name, parse_assignment, typed_value
+
+#: The goals among the controller's parameters (the rest describe the drive).
+GOALS = ("control_mass", "move_time", "bandwidth", "i_max", "hold_dither")
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register ``arcosim control``."""
+    p = add_command(
+        subparsers,
+        "control",
+        summary="design the motion controller for a chain and check its margins",
+        description=f"""
+Design the sensorless motion controller (the ActionReactionController FMU's own design)
+for a chain and goals, and check both of its loops before it runs: the full-state
+loop's margins (phase, delay, max |S|: the upper bound) and the sensorless loop's
+slowest decay, linearized (exact encoder, no Coulomb friction), with the model exact, one
+step late (a parallel master) and with every J_i, k_i scaled within --error of the
+chain's ({RANDOM_MODELS} random models and the two corners: all J +e with all k -e, and
+the reverse). The chain given is taken as the truth: "if my identified chain were this
+far off, would the loop still decay?". Exit status 0 when it decays in every case, 1
+when some case grows (the verdict names it), 2 for a bad input. Takes a few seconds
+(about 15 s for five masses).
+
+The chain and the goals under the controller FMU's parameter names:
+  --chain FIT.json            J[i], k[i], B[i], D_m, f_c and the masses of a
+                              whole-chain report (arcosim identify --method
+                              whole-chain --out FIT.json); --set wins
+  --set J_mo=VALUE            motor inertia, kg.m2 (also k_to N.m/A, D_m N.m.s/rad,
+                              f_c N.m, J[i], k[i], B[i], g_dist rad/s, encoder_cpr)
+  --set move_time=T           s, or --set move_time=0 --set bandwidth=W (rad/s)
+  --set control_mass=L        the load mass moved (default the last)
+Anything not given takes the FMU's default (the paper bench's), and the output says so.""",
+        examples="""
+arcosim control --chain chain.json --set J_mo=2.09e-5 --set k_to=0.0406
+arcosim control --masses 2 --set move_time=0.8 --json""",
+    )
+    p.add_argument(
+        "--chain", metavar="FIT.json", help="a whole-chain report to read the chain from"
+    )
+    p.add_argument(
+        "--masses",
+        metavar="N",
+        help="the number of load masses when no --chain gives it (default 3, the bench's)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a controller FMU parameter, in its unit; repeatable",
+    )
+    step_option(p)
+    p.add_argument(
+        "--error",
+        type=number(0.0, 1.0, low_open=True),
+        default=ERROR,
+        metavar="E",
+        help=f"the relative model error checked, 0 < E < 1 (default {ERROR:g}: "
+        f"±{100 * ERROR:g} %%)",
+    )
+    p.add_argument("--json", action="store_true", help="print the report as one JSON object")
+    p.set_defaults(execute=_execute)
+
+
+def _execute(args: argparse.Namespace) -> int:
+    chain = chain_option(args.chain) if args.chain else {}
+    n = _masses(args, chain)
+    assignments = [*chain_assignments(chain, args.set), *args.set]
+    values = controller_parameters(n, assignments)
+    problems = parameter_problems(n, values)
+    if problems:
+        raise UserError("; ".join(problems))
+    goals = {name: values[name] for name in GOALS}
+    goals["control_mass"] = int(goals["control_mass"])
+    try:
+        found = controller_margins(values, h=args.step, error=args.error, **goals)
+    except ValueError as error:
+        raise UserError(str(error)) from None
+    note = defaults_note(values, drive_parameters(n), set_names(assignments))
+    if args.json:
+        out = found.as_dict()
+        out["assumptions"] = {"defaults": note} if note else {}
+        print(json.dumps(out, indent=2))
+    else:
+        print(f"controller for {n} load mass{'es' if n > 1 else ''}"
+              + (f" from {args.chain}" if args.chain else ""))  # fmt: skip
+        print(found.text())
+        if note:
+            print(f"assumption: {note}")
+    return 0 if found.robust else 1
+
+
+def _masses(args: argparse.Namespace, chain: dict[str, float]) -> int:
+    """n from the chain file (removed from it), else ``--masses``, else 3; refuse both
+    disagreeing."""
+    given = None if args.masses is None else masses_option(args.masses)
+    if not chain:
+        return 3 if given is None else given
+    n = int(chain.pop("masses"))
+    if given is not None and given != n:
+        raise UserError(f"--masses {given} but --chain {args.chain} holds {n}: give one of them")
+    return n
+
+
+def controller_parameters(n: int, assignments: Sequence[str]) -> dict[str, float]:
+    """The controller FMU's Real and Integer parameters for ``n`` masses: its defaults with
+    ``--set`` applied (each in its unit).
+
+    Raises
+    ------
+    UserError
+        When an assignment names no parameter of the controller or its value does not fit.
+    """
+    variables = ActionReactionController.interface(n)
+    values = {
+        name: float(v.start)
+        for name, v in variables.items()
+        if v.causality == "parameter" and v.type in ("Real", "Integer")
+    }
+    for text in assignments:
+        name, value = parse_assignment(text)
+        check_name(name, variables, "the controller")
+        if name not in values:
+            raise UserError(f"--set {text!r}: {name} is not a parameter of the controller")
+        values[name] = float(typed_value(name, value, variables[name].type))
+    return values
+
+
+def parameter_problems(n: int, values: Mapping[str, float]) -> list[str]:
+    """What the controller FMU would refuse at initialization, one sentence each: its own
+    check (:meth:`ActionReactionController.check_parameters`) on these values."""
+    checked = type(
+        "Checked", (ActionReactionController,), {"n_masses": n, "value": lambda _, k: values[k]}
+    )
+    return checked.check_parameters(checked.__new__(checked))

@@ -1,0 +1,198 @@
+"""The sensorless loop's poles, from the controller's and the plant's own code.
+
+The controller (:class:`~arcosim.fmu.flexchain.motion_control.MotionController`, designed
+on a model) drives the plant (:class:`~arcosim.plant.motorchain.physics.PlantPhysics`, the
+true chain) with an exact encoder and no Coulomb friction, so that the loop is linear
+(the encoder's counts, the friction and the hold's dither, which need both, are left
+out: they add a limit cycle of a few counts, not an instability). After a 1 rad move the
+loop's one-step map is differentiated by finite differences over every float the two
+objects hold (caches, frozen settings and clocks left alone; what the step leaves exactly
+as it was, a parameter, dropped). With the model exact the state feedback's poles
+``eig(F − g K)`` are among the result to 1e-6 (separation; ``tests/test_control_margins.py``).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from arcosim.fmu.flexchain.control_design import design_controller, indexed_values
+from arcosim.fmu.flexchain.motion_control import MotionController
+from arcosim.plant.motorchain.physics import PlantPhysics
+
+#: Attributes the linearization leaves alone: caches and settings (constant over a run)
+#: and clocks (times and the step, which no state feeds back into).
+UNPERTURBED = frozenset(
+    {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
+    | {"t", "_moved", "_h"}
+)
+#: When the loop is linearized: this long after the move ends (s).
+AFTER_MOVE = 0.6
+#: The finite differences' relative step (dimensionless).
+RELATIVE_STEP = 1e-6
+
+
+@dataclass
+class SensorlessLoop:
+    """The controller, the plant and what passes between them at the next sample.
+
+    ``signals`` = [i_a (A), ω_m (rad/s), θ_m (rad), the command still pending (A)];
+    ``delay`` 1 applies each command one step late (a parallel master), 0 at once.
+    """
+
+    controller: MotionController
+    plant: PlantPhysics
+    signals: list[float]
+    delay: int
+
+    @property
+    def h(self) -> float:
+        """The step (s)."""
+        return self.controller.design.h
+
+
+def sensorless_loop(
+    truth: Mapping[str, float], model: Mapping[str, float], *, h: float, delay: int = 0, **goals
+) -> SensorlessLoop:
+    """The controller designed on ``model`` driving the plant ``truth``, through a 1 rad
+    move of the controlled mass to :data:`AFTER_MOVE` after it ends.
+
+    Parameters
+    ----------
+    truth, model : mapping of str to float
+        The plant and the controller's model under the observer's names: ``J_mo``
+        (kg·m²), ``k_to`` (N·m/A), ``D_m`` (N·m·s/rad), ``J[i]``, ``k[i]``, ``B[i]``;
+        the controller's ``g_dist`` (rad/s) from ``model`` when given. Coulomb friction
+        and the encoder are left out of both.
+    h : float
+        The control step (s).
+    delay : int
+        0: each command acts over the next step; 1: one step later.
+    **goals
+        ``control_mass``, ``move_time``, ``bandwidth``, ``i_max`` for
+        :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
+
+    Returns
+    -------
+    SensorlessLoop
+        At rest after the move.
+
+    Examples
+    --------
+    >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5,
+    ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
+    >>> loop = sensorless_loop(chain, chain, h=1e-3)
+    >>> round(loop.plant.x[1], 3)  # the load mass (rad)
+    1.0
+    """
+    design = design_controller({**model, "f_c": 0.0, "encoder_cpr": 0}, h=h, **goals)
+    J, k, B = (indexed_values(truth, name) for name in ("J", "k", "B"))
+    plant = PlantPhysics(truth["J_mo"], truth["k_to"], truth["D_m"], 0.0, J, k, B)
+    loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay)
+    for _ in range(round((design.move_time + AFTER_MOVE) / h)):
+        advance(loop)
+    return loop
+
+
+def advance(loop: SensorlessLoop) -> None:
+    """One sample of the loop: the controller's step, then the plant's over h."""
+    h = loop.h
+    i_a, omega, theta, pending = loop.signals
+    command = loop.controller.step(h, 1.0, i_a, omega, theta)
+    applied = pending if loop.delay else command
+    n = loop.plant.n
+    loop.plant.advance(h, applied, [0.0] * n)
+    x = loop.plant.x
+    loop.signals = [loop.plant.step_average_current(h), x[n + 1], x[0], command]
+
+
+def _leaves(obj, path: tuple = (), seen: set | None = None) -> list[tuple]:
+    """Paths to every float the object holds (attributes, dict entries, list items)."""
+    seen = set() if seen is None else seen
+    if id(obj) in seen:
+        return []
+    seen.add(id(obj))
+    items = obj.items() if isinstance(obj, dict) else vars(obj).items()
+    found = []
+    for key, value in items:
+        frozen = getattr(getattr(type(value), "__dataclass_params__", None), "frozen", False)
+        if key in UNPERTURBED or frozen:
+            continue
+        if isinstance(value, float):
+            found.append((*path, key))
+        elif isinstance(value, list):
+            found += [(*path, key, i) for i, v in enumerate(value) if isinstance(v, float)]
+        elif isinstance(value, dict) or hasattr(value, "__dict__"):
+            found += _leaves(value, (*path, key), seen)
+    return found
+
+
+def _holder(root, path: tuple):
+    for key in path[:-1]:
+        root = root[key] if isinstance(root, (dict, list)) else getattr(root, key)
+    return root
+
+
+def _get(root, path: tuple) -> float:
+    holder = _holder(root, path)
+    return holder[path[-1]] if isinstance(holder, (dict, list)) else getattr(holder, path[-1])
+
+
+def _put(root, path: tuple, value: float) -> None:
+    holder = _holder(root, path)
+    if isinstance(holder, (dict, list)):
+        holder[path[-1]] = value
+    else:
+        setattr(holder, path[-1], value)
+
+
+def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
+    """The loop's one-step map differentiated at its present state, shape ``(m, m)``.
+
+    Every float of the controller, the plant and the signals is perturbed by a relative
+    :data:`RELATIVE_STEP`; those the step leaves exactly as they were (parameters) are
+    dropped, so the eigenvalues are the loop's poles.
+    """
+    paths = _leaves(loop)
+    z0 = np.array([_get(loop, p) for p in paths])
+
+    def stepped(path=None, value=0.0) -> np.ndarray:
+        copied = copy.deepcopy(loop)
+        if path is not None:
+            _put(copied, path, value)
+        advance(copied)
+        return np.array([_get(copied, p) for p in paths])
+
+    z1 = stepped()
+    jac = np.empty((len(paths), len(paths)))
+    for j, path in enumerate(paths):
+        eps = RELATIVE_STEP * max(1.0, abs(z0[j]))
+        jac[:, j] = (stepped(path, float(z0[j] + eps)) - z1) / eps
+    unit = np.eye(len(paths))
+    keep = [i for i in range(len(paths)) if not np.allclose(jac[i], unit[i], atol=1e-7)]
+    return jac[np.ix_(keep, keep)]
+
+
+def sensorless_decay(
+    truth: Mapping[str, float], model: Mapping[str, float], *, h: float, delay: int = 0, **goals
+) -> tuple[float, float]:
+    """The sensorless loop's slowest decay and where it is.
+
+    Parameters
+    ----------
+    truth, model, h, delay, **goals
+        As :func:`sensorless_loop`.
+
+    Returns
+    -------
+    tuple of float
+        The slowest decay rate (1/s; negative: growing) and that pole's frequency (rad/s).
+    """
+    loop = sensorless_loop(truth, model, h=h, delay=delay, **goals)
+    poles = np.linalg.eigvals(sensorless_jacobian(loop))
+    worst = poles[np.argmax(np.abs(poles))]
+    return -math.log(abs(worst)) / h, abs(float(np.angle(worst))) / h

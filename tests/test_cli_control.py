@@ -1,0 +1,97 @@
+"""``arcosim control``: the controller designed for a chain and its loops checked.
+
+The figures come from :func:`arcosim.controller_margins` (its linearization is tested in
+``tests/test_control_margins.py``); here: what the command reads, prints and exits with.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from arcosim.cli import main
+from benchmarks.control_margins import CHAINS, params
+
+
+def run(capsys, *argv: object) -> tuple[int, str, str]:
+    """``arcosim ARGV`` in this process: (exit status, stdout, stderr)."""
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def refusal(capsys, *argv: object) -> str:
+    """The one line ``arcosim: error: …`` of a refused input (exit status 2)."""
+    code, out, err = run(capsys, *argv)
+    lines = err.strip().splitlines()
+    assert code == 2 and not out and len(lines) == 1, (code, out, err)
+    assert lines[0].startswith("arcosim: error: ")
+    return lines[0]
+
+
+def chain_file(tmp_path: Path, name: str) -> Path:
+    """A whole-chain report holding one of the margins table's chains."""
+    values = {key: v for key, v in params(*CHAINS[name]).items() if key[0] in "JkB"}
+    values.pop("J_mo")
+    path = tmp_path / "chain.json"
+    path.write_text(json.dumps({"masses": len(CHAINS[name][0]), **values}), encoding="utf-8")
+    return path
+
+
+def test_a_robust_chain_exits_0_with_units_and_the_defaults_it_used(capsys) -> None:
+    code, out, err = run(capsys, "control", "--masses", 1)
+    assert code == 0, err
+    assert "verdict: robust" in out
+    assert "rad/s" in out and "1/s" in out and "ms" in out
+    assert "move_time 1 s" in out and "bandwidth 8 rad/s" in out
+    assert "assumption: not given, so the paper bench's value was used: J_mo" in out
+
+
+def test_the_json_report_names_its_units(capsys) -> None:
+    code, out, _ = run(capsys, "control", "--masses", 1, "--set", "move_time=0.5", "--json")
+    report = json.loads(out)
+    assert code == 0 and report["robust"] is True
+    assert report["move_time_s"] == 0.5 and report["bandwidth_rad_s"] == 16.0
+    assert len(report["sensorless_under_errors"]) == 22
+    assert report["sensorless"]["decay"] > 0.0
+
+
+@pytest.mark.slow
+def test_the_five_mass_chain_is_refused_at_ten_percent_naming_the_corner(
+    capsys, tmp_path: Path
+) -> None:
+    """The linear loop grows at the J +10 %, k −10 % corner (docs/control.md#margins):
+    exit 1, the corner and the frequency named, and the smaller error it passes."""
+    path = chain_file(tmp_path, "five masses")
+    code, out, err = run(capsys, "control", "--chain", path)
+    assert code == 1, err
+    verdict = out.splitlines()[-2]
+    assert verdict.startswith("verdict: NOT robust to ±10 %: with J +10 %, k −10 %"), verdict
+    assert "at 80 rad/s" in verdict and "within ±5 %" in verdict
+    assert "the bench's chain" not in out  # the chain came from the file
+    code, out, _ = run(capsys, "control", "--chain", path, "--error", 0.05)
+    assert code == 0 and "verdict: robust" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (("--set", "move_time=0"), "move_time = 0.0 s and bandwidth = 0.0 rad/s"),
+        (("--set", "jmo=1"), "did you mean J_mo"),
+        (("--masses", 2, "--set", "control_mass=3"), "control_mass"),
+        (("--masses", 2, "--set", "k[2]=-1"), "k[2]"),
+        (("--masses", 2, "--set", "theta_ref=1"), "not a parameter"),
+        (("--error", 0), "--error"),
+        (("--masses", "two"), "--masses"),
+    ],
+)
+def test_a_bad_input_is_one_line_naming_it(capsys, argv: tuple, named: str) -> None:
+    assert named in refusal(capsys, "control", *argv)
+
+
+def test_masses_that_disagree_with_the_chain_file_are_refused(capsys, tmp_path: Path) -> None:
+    path = chain_file(tmp_path, "bench, two masses")
+    line = refusal(capsys, "control", "--chain", path, "--masses", 3)
+    assert "--masses 3" in line and "holds 2" in line
