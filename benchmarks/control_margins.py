@@ -8,7 +8,9 @@ its slowest decay with every J_i, k_i scaled by independent factors in [0.9, 1.1
 seeds) and the two corners, and one step late; then the *sensorless* loop's slowest
 decays (:mod:`arcosim.control.sensorless_loop`: the controller's and the plant's own
 code, exact encoder, no Coulomb friction, linearized) with the model exact, one step
-late, and under the same model errors.
+late, and under the same model errors; and at rest with the hold's dither running
+(``hold=True``: the dither's observer in the loop, the finest motor velocity there is),
+the model exact and at the two corners.
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from arcosim.control.margins import controller_margins
+from arcosim.control.model_errors import corners
+from arcosim.control.sensorless_loop import sensorless_decay
 from arcosim.fmu.flexchain import defaults
 
 H = 1e-3
@@ -37,8 +41,11 @@ def params(J, k, B) -> dict[str, float]:
 
 def margins(J, k, B) -> dict[str, object]:
     """One row of the table."""
-    found = controller_margins(params(J, k, B), h=H)
+    chain = params(J, k, B)
+    found = controller_margins(chain, h=H)
     fs = found.full_state
+    hold = [sensorless_decay(chain, chain, h=H, hold=True)[0]]
+    hold += [sensorless_decay(chain, c.apply(chain), h=H, hold=True)[0] for c in corners(len(J))]
     return {
         "modes": [round(w, 1) for w in found.modes],
         "slowest_decay": fs["slowest_decay"],
@@ -53,6 +60,8 @@ def margins(J, k, B) -> dict[str, object]:
         "sensorless_worst_at": found.worst.frequency,
         "sensorless_corners": [e.decay for e in found.under_errors[:2]],
         "sensorless_one_step_late": found.sensorless_late.decay,
+        "hold_decay": hold[0],
+        "hold_corners": hold[1:],
     }
 
 

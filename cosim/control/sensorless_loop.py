@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.control_design import design_controller, indexed_values
 from arcosim.fmu.flexchain.motion_control import MotionController
 from arcosim.plant.motorchain.physics import PlantPhysics
@@ -32,6 +33,11 @@ UNPERTURBED = frozenset(
 )
 #: When the loop is linearized: this long after the move ends (s).
 AFTER_MOVE = 0.6
+#: With ``hold``: the target, which the step compares with ``theta_ref`` to start a move
+#: (a switch, not a state), is left alone too, and so is the dither's own path (a signal
+#: generator: its floats follow the step count, whatever the loop does), all but its
+#: observer.
+HOLD_UNPERTURBED = frozenset({"target"})
 #: The finite differences' relative step (dimensionless).
 RELATIVE_STEP = 1e-6
 
@@ -41,13 +47,15 @@ class SensorlessLoop:
     """The controller, the plant and what passes between them at the next sample.
 
     ``signals`` = [i_a (A), ω_m (rad/s), θ_m (rad), the command still pending (A)];
-    ``delay`` 1 applies each command one step late (a parallel master), 0 at once.
+    ``delay`` 1 applies each command one step late (a parallel master), 0 at once;
+    ``hold``: linearized with the hold's dither running (:func:`sensorless_loop`).
     """
 
     controller: MotionController
     plant: PlantPhysics
     signals: list[float]
     delay: int
+    hold: bool = False
 
     @property
     def h(self) -> float:
@@ -56,10 +64,24 @@ class SensorlessLoop:
 
 
 def sensorless_loop(
-    truth: Mapping[str, float], model: Mapping[str, float], *, h: float, delay: int = 0, **goals
+    truth: Mapping[str, float],
+    model: Mapping[str, float],
+    *,
+    h: float,
+    delay: int = 0,
+    hold: bool = False,
+    **goals,
 ) -> SensorlessLoop:
     """The controller designed on ``model`` driving the plant ``truth``, through a 1 rad
     move of the controlled mass to :data:`AFTER_MOVE` after it ends.
+
+    With ``hold`` the controller is designed with the model's encoder (``encoder_cpr``,
+    default ``defaults.ENCODER_CPR``) so that its hold's dither runs at rest
+    (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle from the dither's
+    observer), while the plant's angle stays exact and friction stays out; the loop is
+    run to :data:`AFTER_MOVE` after the dither starts. Without Coulomb friction the
+    controller feeds back the measured motor velocity (exact here), not the encoder's
+    crossed edge, so this is the hold's loop with the finest velocity there is.
 
     Parameters
     ----------
@@ -72,8 +94,10 @@ def sensorless_loop(
         The control step (s).
     delay : int
         0: each command acts over the next step; 1: one step later.
+    hold : bool
+        Linearize at rest with the hold's dither running (above).
     **goals
-        ``control_mass``, ``move_time``, ``bandwidth``, ``i_max`` for
+        ``control_mass``, ``move_time``, ``bandwidth``, ``i_max``, ``hold_dither`` for
         :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
 
     Returns
@@ -89,11 +113,17 @@ def sensorless_loop(
     >>> round(loop.plant.x[1], 3)  # the load mass (rad)
     1.0
     """
-    design = design_controller({**model, "f_c": 0.0, "encoder_cpr": 0}, h=h, **goals)
+    cpr = model.get("encoder_cpr", defaults.ENCODER_CPR) if hold else 0
+    design = design_controller({**model, "f_c": 0.0, "encoder_cpr": cpr}, h=h, **goals)
+    if hold and not design.dither_current > 0.0:
+        raise ValueError(
+            "hold: the design has no dither (give encoder_cpr > 0 and hold_dither > 0)"
+        )
     J, k, B = (indexed_values(truth, name) for name in ("J", "k", "B"))
     plant = PlantPhysics(truth["J_mo"], truth["k_to"], truth["D_m"], 0.0, J, k, B)
-    loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay)
-    for _ in range(round((design.move_time + AFTER_MOVE) / h)):
+    loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay, hold)
+    wait = (1.0 + defaults.HOLD_DITHER_AFTER) * design.move_time if hold else design.move_time
+    for _ in range(round((wait + AFTER_MOVE) / h)):
         advance(loop)
     return loop
 
@@ -110,8 +140,11 @@ def advance(loop: SensorlessLoop) -> None:
     loop.signals = [loop.plant.step_average_current(h), x[n + 1], x[0], command]
 
 
-def _leaves(obj, path: tuple = (), seen: set | None = None) -> list[tuple]:
-    """Paths to every float the object holds (attributes, dict entries, list items)."""
+def _leaves(
+    obj, path: tuple = (), seen: set | None = None, skip: frozenset = UNPERTURBED
+) -> list[tuple]:
+    """Paths to every float the object holds (attributes, dict entries, list items),
+    those named in ``skip`` left out."""
     seen = set() if seen is None else seen
     if id(obj) in seen:
         return []
@@ -120,14 +153,14 @@ def _leaves(obj, path: tuple = (), seen: set | None = None) -> list[tuple]:
     found = []
     for key, value in items:
         frozen = getattr(getattr(type(value), "__dataclass_params__", None), "frozen", False)
-        if key in UNPERTURBED or frozen:
+        if key in skip or frozen:
             continue
         if isinstance(value, float):
             found.append((*path, key))
         elif isinstance(value, list):
             found += [(*path, key, i) for i, v in enumerate(value) if isinstance(v, float)]
         elif isinstance(value, dict) or hasattr(value, "__dict__"):
-            found += _leaves(value, (*path, key), seen)
+            found += _leaves(value, (*path, key), seen, skip)
     return found
 
 
@@ -157,7 +190,9 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     :data:`RELATIVE_STEP`; those the step leaves exactly as they were (parameters) are
     dropped, so the eigenvalues are the loop's poles.
     """
-    paths = _leaves(loop)
+    paths = _leaves(loop, skip=UNPERTURBED | (HOLD_UNPERTURBED if loop.hold else frozenset()))
+    if loop.hold:
+        paths = [p for p in paths if p[:2] != ("controller", "dither") or p[2] == "observer"]
     z0 = np.array([_get(loop, p) for p in paths])
 
     def stepped(path=None, value=0.0) -> np.ndarray:
@@ -178,13 +213,19 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
 
 
 def sensorless_decay(
-    truth: Mapping[str, float], model: Mapping[str, float], *, h: float, delay: int = 0, **goals
+    truth: Mapping[str, float],
+    model: Mapping[str, float],
+    *,
+    h: float,
+    delay: int = 0,
+    hold: bool = False,
+    **goals,
 ) -> tuple[float, float]:
     """The sensorless loop's slowest decay and where it is.
 
     Parameters
     ----------
-    truth, model, h, delay, **goals
+    truth, model, h, delay, hold, **goals
         As :func:`sensorless_loop`.
 
     Returns
@@ -192,7 +233,7 @@ def sensorless_decay(
     tuple of float
         The slowest decay rate (1/s; negative: growing) and that pole's frequency (rad/s).
     """
-    loop = sensorless_loop(truth, model, h=h, delay=delay, **goals)
+    loop = sensorless_loop(truth, model, h=h, delay=delay, hold=hold, **goals)
     poles = np.linalg.eigvals(sensorless_jacobian(loop))
     worst = poles[np.argmax(np.abs(poles))]
     return -math.log(abs(worst)) / h, abs(float(np.angle(worst))) / h
