@@ -24,6 +24,19 @@ from arcosim.fmu.flexchain.control_design import (
 FREQUENCIES = 20000
 
 
+def slowest(poles: np.ndarray, h: float) -> tuple[float, float]:
+    """The slowest of discrete poles: its decay rate (1/s; negative: growing) and its
+    frequency (rad/s).
+
+    Examples
+    --------
+    >>> [round(x, 2) for x in slowest(np.array([0.99, 0.5]), 1e-3)]
+    [10.05, 0.0]
+    """
+    worst = poles[np.argmax(np.abs(poles))]
+    return -math.log(float(abs(worst))) / h, abs(float(np.angle(worst))) / h
+
+
 def decay(poles: np.ndarray, h: float) -> float:
     """The slowest decay rate of discrete poles (1/s; negative: growing).
 
@@ -95,7 +108,8 @@ def margins(design: ControllerDesign) -> dict[str, float]:
     True
     """
     h = design.h
-    w = np.logspace(-1, math.log10(math.pi / h), FREQUENCIES)
+    low = min(0.1, 0.01 * design.bandwidth)  # rad/s, well below any crossover
+    w = np.logspace(math.log10(low), math.log10(math.pi / h), FREQUENCIES)
     L = loop_gain(design, w)
     cross = np.flatnonzero(np.diff(np.sign(np.abs(L) - 1.0)))
     pm = [(180.0 - abs(math.degrees(np.angle(L[i]))), float(w[i])) for i in cross]
@@ -112,6 +126,7 @@ def margins(design: ControllerDesign) -> dict[str, float]:
     }
 
 
-def decay_on(design: ControllerDesign, truth: Mapping[str, float]) -> float:
-    """The full-state loop's slowest decay (1/s) with the design's gain on ``truth``."""
-    return decay(np.linalg.eigvals(closed_loop(design, truth)), design.h)
+def decay_on(design: ControllerDesign, truth: Mapping[str, float]) -> tuple[float, float]:
+    """The full-state loop's slowest pole with the design's gain on the plant ``truth``:
+    its decay (1/s) and frequency (rad/s) (:func:`slowest`)."""
+    return slowest(np.linalg.eigvals(closed_loop(design, truth)), design.h)

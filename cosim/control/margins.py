@@ -3,40 +3,81 @@
 :func:`controller_margins` designs the controller as the FMU does, then computes the
 full-state loop's margins (:mod:`~arcosim.control.full_state`) and the sensorless loop's
 decays (:mod:`~arcosim.control.sensorless_loop`) with the model exact, one step late and
-under the model errors of :mod:`~arcosim.control.model_errors`: the chain given is taken
-as the truth and the controller's model as that chain with every J_i, k_i scaled, i.e.
-"if the identified chain were this far off". ``arcosim control`` prints it.
+under the model errors of :mod:`~arcosim.control.model_errors`. The chain given is taken
+as the truth, and the controller is designed on that chain with every J_i, k_i scaled
+("if the identified chain were this far off"), for both loops alike.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from arcosim.control import full_state
-from arcosim.control.model_errors import ERROR, RANDOM_MODELS, model_errors
+from arcosim.control.model_errors import ERROR, RANDOM_MODELS, ModelError, model_errors
 from arcosim.control.sensorless_loop import sensorless_decay
 from arcosim.fmu.flexchain import control_design
 from arcosim.fmu.flexchain.control_design import (
     ControllerDesign,
     design_controller,
+    goals,
+    indexed_values,
     plant_matrices,
 )
 
 #: Smaller errors tried, in turn, when the loop is not stable at the error asked for.
 SMALLER_ERRORS = (0.05, 0.02, 0.01)
+#: The slowest decay a loop must reach to count as decaying (1/s): a time constant of
+#: 10 s at most, not a pole the plant's own friction barely holds inside the unit circle.
+MIN_DECAY = 0.1
+#: The feedback's bandwidth may be at most this share of the Nyquist frequency π/h, and
+#: the chain's fastest mode at most this share of it too (dimensionless).
+NYQUIST_SHARE_BANDWIDTH = 0.1
+NYQUIST_SHARE_MODE = 0.5
+#: Names of the full-state margins in the JSON, with their units.
+FULL_STATE_KEYS = {
+    "slowest_decay": "slowest_decay_1_s",
+    "decay_one_step_late": "decay_one_step_late_1_s",
+    "phase_margin": "phase_margin_deg",
+    "crossover": "crossover_rad_s",
+    "delay_margin": "delay_margin_s",
+    "max_sensitivity": "max_sensitivity",
+}
 
 
 @dataclass(frozen=True)
 class LoopDecay:
-    """One linearized loop's slowest pole: its decay (1/s; < 0 grows) and frequency (rad/s),
-    for the model error named."""
+    """One linearized loop's slowest pole under the case named.
+
+    ``decay`` (1/s; < 0 grows; −inf when the run did not come to rest) and ``frequency``
+    (rad/s; nan then); ``J``, ``k``: the factors on J_i, k_i of a model error
+    (dimensionless; empty for the model exact).
+    """
 
     model: str
     decay: float
     frequency: float
+    J: tuple[float, ...] = ()
+    k: tuple[float, ...] = ()
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready, units in the keys, None for what is not finite."""
+        out = {"model": self.model, "decay_1_s": _finite(self.decay)}
+        out["frequency_rad_s"] = _finite(self.frequency)
+        if self.J:
+            out.update(J_factors=list(self.J), k_factors=list(self.k))
+        return out
+
+    def text(self) -> str:
+        """``"0.73 1/s at 32 rad/s (J −10 %, k +10 %)"``."""
+        model = "" if self.model.startswith("the model exact") else f" ({self.model})"
+        if not math.isfinite(self.decay):
+            return f"no rest: the simulated move diverged or held the current at i_max{model}"
+        where = f" at {self.frequency:.3g} rad/s" if self.frequency > 0.0 else ""
+        return f"{self.decay:.3g} 1/s{where}{model}"
 
 
 @dataclass(frozen=True)
@@ -54,7 +95,7 @@ class ControllerMargins:
         phase margin (degrees) at its crossover (rad/s), the delay margin (s), max |S|
         (dimensionless).
     full_state_worst : LoopDecay
-        The full-state loop's slowest decay over the model errors.
+        The full-state loop's slowest pole over the model errors.
     sensorless : LoopDecay
         The sensorless loop with the model exact.
     sensorless_late : LoopDecay
@@ -92,9 +133,23 @@ class ControllerMargins:
         return min(self.under_errors, key=lambda d: d.decay)
 
     @property
+    def failing(self) -> list[LoopDecay]:
+        """The cases whose loop decays slower than ``MIN_DECAY`` (or grows), in the order
+        model exact, one step late, the worst model error, the full-state loop's."""
+        fs = self.full_state
+        cases = [
+            self.sensorless,
+            self.sensorless_late,
+            self.worst,
+            LoopDecay("the full state, the model exact", fs["slowest_decay"], 0.0),
+            LoopDecay("the full state, one step late", fs["decay_one_step_late"], 0.0),
+        ]
+        return [c for c in cases if not c.decay >= MIN_DECAY]
+
+    @property
     def robust(self) -> bool:
-        """Every linearized sensorless loop decays: model exact, one step late, every error."""
-        return min(self.sensorless.decay, self.sensorless_late.decay, self.worst.decay) > 0.0
+        """Every loop checked decays at ``MIN_DECAY`` or faster."""
+        return not self.failing
 
     def text(self) -> str:
         """The report, one finding a line."""
@@ -102,20 +157,20 @@ class ControllerMargins:
         lines = [
             f"design: load mass {d.control_mass} of {d.n} moved; move_time {d.move_time:g} s, "
             f"bandwidth {d.bandwidth:.4g} rad/s (move_time × bandwidth = "
-            f"{control_design.MOVE_BANDWIDTH_PRODUCT:g}), every pole given a decay of "
-            f"{control_design.DECAY_RATIO * d.bandwidth:.3g} 1/s; step {1e3 * d.h:g} ms; "
-            f"i_max {d.i_max:g} A",
+            f"{control_design.MOVE_BANDWIDTH_PRODUCT:g}), every pole given a decay of at "
+            f"least {control_design.DECAY_RATIO * d.bandwidth:.3g} 1/s; step {1e3 * d.h:g} "
+            f"ms; i_max {d.i_max:g} A; g_dist {d.g_dist:g} rad/s",
             "modes with the motor free: " + ", ".join(f"{w:.1f}" for w in self.modes) + " rad/s",
             f"full-state loop (true angles and velocities, the upper bound): slowest decay "
-            f"{fs['slowest_decay']:.2f} 1/s, one step late {fs['decay_one_step_late']:.2f} "
-            f"1/s; phase margin {fs['phase_margin']:.0f}° at {fs['crossover']:.0f} rad/s, "
-            f"delay margin {1e3 * fs['delay_margin']:.1f} ms, max |S| "
+            f"{fs['slowest_decay']:.3g} 1/s, one step late {fs['decay_one_step_late']:.3g} "
+            f"1/s; phase margin {fs['phase_margin']:.0f}° at {fs['crossover']:.3g} rad/s, "
+            f"delay margin {1e3 * fs['delay_margin']:.2g} ms, max |S| "
             f"{fs['max_sensitivity']:.2f}; worst over J_i, k_i {pct}: "
-            f"{_decay_text(self.full_state_worst)}",
+            f"{self.full_state_worst.text()}",
             f"sensorless loop (estimates; linearized: exact encoder, no Coulomb friction): "
-            f"slowest decay {_decay_text(self.sensorless)}; one step late "
-            f"{_decay_text(self.sensorless_late)}; worst over J_i, k_i {pct} "
-            f"({len(self.under_errors)} models): {_decay_text(self.worst)}",
+            f"slowest decay {self.sensorless.text()}; one step late "
+            f"{self.sensorless_late.text()}; worst over J_i, k_i {pct} "
+            f"({len(self.under_errors)} models): {self.worst.text()}",
         ]
         return "\n".join([*lines, self.verdict()])
 
@@ -124,26 +179,41 @@ class ControllerMargins:
         pct = f"±{100 * self.error:g} %"
         if self.robust:
             return (
-                f"verdict: robust: the sensorless loop decays with the model exact, one step "
-                f"late and with every J_i, k_i checked within {pct} of the chain's"
+                f"verdict: robust: the sensorless loop decays at {MIN_DECAY:g} 1/s or faster "
+                f"with the model exact, one step late and with every J_i, k_i checked within "
+                f"{pct} of the chain's"
             )
-        growing = [e for e in (self.sensorless, self.sensorless_late, self.worst) if e.decay <= 0]
-        first = growing[0]
-        if self.stable_within is not None:
+        first = self.failing[0]
+        what = f"with {first.model}, the loop " + (
+            "does not come to rest in the simulated move"
+            if not math.isfinite(first.decay)
+            else (
+                f"grows at {-first.decay:.3g} 1/s"
+                if first.decay < 0.0
+                else f"decays at only {first.decay:.3g} 1/s (< {MIN_DECAY:g})"
+            )
+            + f" at {first.frequency:.3g} rad/s"
+        )
+        if first is self.worst and self.stable_within is not None:
             within = f"±{100 * self.stable_within:g} %"
             advice = (
                 f"it decays at every model checked within {within}: identify the chain to "
                 f"within {within}, or check another move_time or bandwidth the same way"
             )
-        else:
+            return f"verdict: NOT robust to {pct}: {what}; {advice}"
+        if first is self.worst:
             advice = "check another move_time or bandwidth the same way"
-        return (
-            f"verdict: NOT robust to {pct}: with {first.model} the sensorless loop grows at "
-            f"{-first.decay:.2f} 1/s at {first.frequency:.0f} rad/s; {advice}"
+            return f"verdict: NOT robust to {pct}: {what}; {advice}"
+        advice = (
+            "a shorter step, or a sequential master, which applies each command at once"
+            if "late" in first.model
+            else "a shorter step, another move_time or bandwidth, or a higher i_max"
         )
+        return f"verdict: NOT stable: {what}; try {advice}"
 
     def as_dict(self) -> dict[str, object]:
-        """Everything as JSON-ready values (SI units; keys name them)."""
+        """Everything as JSON-ready values: units in the keys, None for what is not
+        finite."""
         d = self.design
         return {
             "control_mass": d.control_mass,
@@ -152,24 +222,24 @@ class ControllerMargins:
             "bandwidth_rad_s": d.bandwidth,
             "step_s": d.h,
             "i_max_A": d.i_max,
+            "g_dist_rad_s": d.g_dist,
             "gain_K": list(d.K),
             "modes_rad_s": list(self.modes),
-            "full_state": dict(self.full_state),
-            "full_state_worst": vars(self.full_state_worst),
-            "sensorless": vars(self.sensorless),
-            "sensorless_one_step_late": vars(self.sensorless_late),
-            "sensorless_under_errors": [vars(e) for e in self.under_errors],
+            "full_state": {FULL_STATE_KEYS[k]: _finite(v) for k, v in self.full_state.items()},
+            "full_state_worst": self.full_state_worst.as_dict(),
+            "sensorless": self.sensorless.as_dict(),
+            "sensorless_one_step_late": self.sensorless_late.as_dict(),
+            "sensorless_under_errors": [e.as_dict() for e in self.under_errors],
             "error": self.error,
+            "min_decay_1_s": MIN_DECAY,
             "robust": self.robust,
             "stable_within": self.stable_within,
             "verdict": self.verdict(),
         }
 
 
-def _decay_text(d: LoopDecay) -> str:
-    where = f" at {d.frequency:.0f} rad/s" if d.frequency > 0.0 else ""
-    model = "" if d.model == "exact" else f" ({d.model})"
-    return f"{d.decay:.2f} 1/s{where}{model}"
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
 
 
 def controller_margins(
@@ -178,7 +248,8 @@ def controller_margins(
     h: float,
     error: float = ERROR,
     random_models: int = RANDOM_MODELS,
-    **goals,
+    started: Callable[[], object] | None = None,
+    **goals_,
 ) -> ControllerMargins:
     """Design the controller for a chain and check both of its loops.
 
@@ -194,7 +265,9 @@ def controller_margins(
         The relative model error checked, e (dimensionless, 0 < e < 1).
     random_models : int
         Random models besides the two corners (a count).
-    **goals
+    started : callable, optional
+        Called once the inputs are checked, before the runs (which take seconds).
+    **goals_
         ``control_mass``, ``move_time``, ``bandwidth``, ``i_max``, ``hold_dither`` for
         :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
 
@@ -206,8 +279,9 @@ def controller_margins(
     Raises
     ------
     ValueError
-        For a chain or goals the design refuses (the message names the parameter), or an
-        error outside (0, 1).
+        For a chain or goals the design refuses (the message names the parameter), a
+        step too coarse for the bandwidth or the chain's fastest mode, or an error
+        outside (0, 1).
 
     Examples
     --------
@@ -219,37 +293,80 @@ def controller_margins(
     """
     if not 0.0 < error < 1.0:
         raise ValueError(f"model error {error!r} must lie between 0 and 1 (0.1 for ±10 %)")
-    design = design_controller(params, h=h, **goals)
-    linear = {key: goals[key] for key in ("control_mass", "move_time", "bandwidth", "i_max")
-              if key in goals}  # fmt: skip
+    _check_step(params, h, goals_.get("move_time", 1.0), goals_.get("bandwidth", 0.0))
+    design = _design(params, h, goals_)
+    linear = {key: goals_[key] for key in ("control_mass", "move_time", "bandwidth", "i_max")
+              if key in goals_}  # fmt: skip
     truth = dict(params)
     errors = model_errors(design.n, error, random_models)
-    full_worst = min(
-        (LoopDecay(e.name, full_state.decay_on(design, e.apply(truth)), 0.0) for e in errors),
-        key=lambda d: d.decay,
-    )
+    if started is not None:
+        started()
 
-    def sensorless(name: str, model: Mapping[str, float], delay: int = 0) -> LoopDecay:
-        return LoopDecay(name, *sensorless_decay(truth, model, h=h, delay=delay, **linear))
+    def full(e: ModelError) -> LoopDecay:
+        wrong = _design(e.apply(truth), h, goals_)
+        return LoopDecay(e.name, *full_state.decay_on(wrong, truth), e.J, e.k)
 
-    under = tuple(sensorless(e.name, e.apply(truth)) for e in errors)
+    def sensorless(e: ModelError | None, delay: int = 0) -> LoopDecay:
+        model = truth if e is None else e.apply(truth)
+        found = sensorless_decay(truth, model, h=h, delay=delay, **linear)
+        if e is None:
+            return LoopDecay("the model exact" + (", one step late" if delay else ""), *found)
+        return LoopDecay(e.name, *found, e.J, e.k)
+
     found = ControllerMargins(
         design=design,
         modes=_modes(design),
         full_state=full_state.margins(design),
-        full_state_worst=full_worst,
-        sensorless=sensorless("exact", truth),
-        sensorless_late=sensorless("exact", truth, delay=1),
-        under_errors=under,
+        full_state_worst=min((full(e) for e in errors), key=lambda d: d.decay),
+        sensorless=sensorless(None),
+        sensorless_late=sensorless(None, delay=1),
+        under_errors=tuple(sensorless(e) for e in errors),
         error=error,
     )
-    if found.robust or min(found.sensorless.decay, found.sensorless_late.decay) <= 0.0:
+    if found.robust or found.failing[0] is not found.worst:
         return found
     for smaller in (e for e in SMALLER_ERRORS if e < error):
         models = model_errors(design.n, smaller, random_models)
-        if all(sensorless(e.name, e.apply(truth)).decay > 0.0 for e in models):
+        if all(sensorless(e).decay >= MIN_DECAY for e in models):
             return ControllerMargins(**{**vars(found), "stable_within": smaller})
     return found
+
+
+def _design(params: Mapping[str, float], h: float, goals_: Mapping) -> ControllerDesign:
+    """The FMU's design; an overflow on extreme values becomes a ValueError saying so."""
+    try:
+        return design_controller(params, h=h, **goals_)
+    except (ArithmeticError, ValueError) as error:
+        if isinstance(error, ValueError) and "fsum" not in str(error):
+            raise
+        raise ValueError(
+            f"the design overflows for these values ({error}): check J[i], k[i], B[i], "
+            "the step and move_time or bandwidth"
+        ) from None
+
+
+def _check_step(params: Mapping[str, float], h: float, move_time: float, bandwidth: float) -> None:
+    """Refuse a step too coarse for the bandwidth or the chain's fastest mode (ValueError)."""
+    _, wc = goals(move_time, bandwidth)
+    nyquist = math.pi / h
+    if wc > NYQUIST_SHARE_BANDWIDTH * nyquist:
+        raise ValueError(
+            f"bandwidth {wc:.4g} rad/s is over {NYQUIST_SHARE_BANDWIDTH:g} × the Nyquist "
+            f"frequency π/h = {nyquist:.4g} rad/s: use a step ≤ "
+            f"{NYQUIST_SHARE_BANDWIDTH * math.pi / wc:.3g} s or a longer move_time"
+        )
+    J, k, B = (indexed_values(params, name) for name in ("J", "k", "B"))
+    try:
+        A, _ = plant_matrices(params["J_mo"], params["k_to"], params["D_m"], J, k, B)
+        fastest = float(np.abs(np.linalg.eigvals(np.array(A))).max())
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError, ZeroDivisionError):
+        return  # the design names what is wrong with the chain
+    if math.isfinite(fastest) and fastest > NYQUIST_SHARE_MODE * nyquist:
+        raise ValueError(
+            f"the chain's fastest mode, {fastest:.4g} rad/s, is over {NYQUIST_SHARE_MODE:g} × "
+            f"the Nyquist frequency π/h = {nyquist:.4g} rad/s: use a step ≤ "
+            f"{NYQUIST_SHARE_MODE * math.pi / fastest:.3g} s"
+        )
 
 
 def _modes(design: ControllerDesign) -> tuple[float, ...]:

@@ -38,6 +38,11 @@ AFTER_MOVE = 0.6
 #: generator: its floats follow the step count, whatever the loop does), all but its
 #: observer.
 HOLD_UNPERTURBED = frozenset({"target"})
+#: The loop counts as come to rest when, over this last stretch of the run (s), the command
+#: stayed below i_max and the controlled mass ends within SETTLE_ANGLE of its target.
+SETTLE_WINDOW = 0.1
+#: … within this angle of the 1 rad target (rad).
+SETTLE_ANGLE = 0.1
 #: The finite differences' relative step (dimensionless).
 RELATIVE_STEP = 1e-6
 
@@ -48,7 +53,9 @@ class SensorlessLoop:
 
     ``signals`` = [i_a (A), ω_m (rad/s), θ_m (rad), the command still pending (A)];
     ``delay`` 1 applies each command one step late (a parallel master), 0 at once;
-    ``hold``: linearized with the hold's dither running (:func:`sensorless_loop`).
+    ``hold``: linearized with the hold's dither running (:func:`sensorless_loop`);
+    ``settled``: whether the run came to rest (:data:`SETTLE_WINDOW`), without which its
+    linearization means nothing (a loop pinned at ±i_max shows only the plant's poles).
     """
 
     controller: MotionController
@@ -56,6 +63,7 @@ class SensorlessLoop:
     signals: list[float]
     delay: int
     hold: bool = False
+    settled: bool = True
 
     @property
     def h(self) -> float:
@@ -123,8 +131,15 @@ def sensorless_loop(
     plant = PlantPhysics(truth["J_mo"], truth["k_to"], truth["D_m"], 0.0, J, k, B)
     loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay, hold)
     wait = (1.0 + defaults.HOLD_DITHER_AFTER) * design.move_time if hold else design.move_time
-    for _ in range(round((wait + AFTER_MOVE) / h)):
+    steps = round((wait + AFTER_MOVE) / h)
+    window = steps - max(1, round(SETTLE_WINDOW / h))
+    for k in range(steps):
         advance(loop)
+        if k >= window and not abs(loop.signals[3]) < design.i_max:
+            loop.settled = False
+    L = design.control_mass
+    if not abs(loop.plant.x[L] - 1.0) < SETTLE_ANGLE:
+        loop.settled = False
     return loop
 
 
@@ -231,9 +246,13 @@ def sensorless_decay(
     Returns
     -------
     tuple of float
-        The slowest decay rate (1/s; negative: growing) and that pole's frequency (rad/s).
+        The slowest decay rate (1/s; negative: growing) and that pole's frequency (rad/s);
+        (−inf, nan) when the run did not come to rest (``SensorlessLoop.settled``): it
+        diverged or saturated, and no pole describes it.
     """
     loop = sensorless_loop(truth, model, h=h, delay=delay, hold=hold, **goals)
+    if not loop.settled:
+        return -math.inf, math.nan
     poles = np.linalg.eigvals(sensorless_jacobian(loop))
     worst = poles[np.argmax(np.abs(poles))]
     return -math.log(abs(worst)) / h, abs(float(np.angle(worst))) / h
