@@ -49,8 +49,8 @@ chain's ({RANDOM_MODELS} random models and the two corners: all J +e with all k 
 the reverse). The chain given is taken as the truth: "if my identified chain were this
 far off, would the loop still decay?". Exit status 0 when it decays in every case, 1
 when some case decays slower than 0.1 1/s or grows (the verdict names it), 2 for a bad
-input. It simulates 24 moves or more: about 7 s for one mass, 10 s for three, 20-35 s
-for five, 80 s for ten and 160 s for twenty on a 2-core machine (a line on stderr says so).
+input. It simulates 24 moves or more: about 8 s for one mass, 12 s for three, 20-35 s
+for five, 35 s for ten and 130 s for twenty on a 2-core machine (a line on stderr says so).
 
 The chain and the goals under the controller FMU's parameter names:
   --chain FIT.json            J[i], k[i], B[i], D_m, f_c and the masses of a
