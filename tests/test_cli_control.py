@@ -11,15 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from arcosim.cli import main
 from benchmarks.control_margins import CHAINS, params
-
-
-def run(capsys, *argv: object) -> tuple[int, str, str]:
-    """``arcosim ARGV`` in this process: (exit status, stdout, stderr)."""
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
+from tests.cli_runs import run
 
 
 def refusal(capsys, *argv: object) -> str:

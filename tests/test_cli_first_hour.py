@@ -18,17 +18,11 @@ import pytest
 from arcosim.cli import main, make_parser
 from arcosim.cli.example import FILES
 from arcosim.fmu.flexchain import defaults
+from tests.cli_runs import run
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Markup a terminal shows raw: ``code``, Sphinx roles, a literal block's ``::``.
 MARKUP = re.compile(r"``|:func:|:mod:|:class:|:data:|:meth:|::$", re.MULTILINE)
-
-
-def run(capsys, *argv: object) -> tuple[int, str, str]:
-    """``arcosim ARGV`` in this process: (exit status, stdout, stderr)."""
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def subcommands() -> dict[str, argparse.ArgumentParser]:

@@ -15,13 +15,7 @@ from pathlib import Path
 import pytest
 
 from arcosim.cli import EXIT_INTERNAL, main
-
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    """``arcosim ARGV`` in this process: (exit status, stdout, stderr)."""
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
+from tests.cli_runs import run
 
 
 def refused(capsys, *argv: str) -> str:

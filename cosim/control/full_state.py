@@ -45,7 +45,7 @@ def decay(poles: np.ndarray, h: float) -> float:
     >>> round(decay(np.array([0.99, 0.5]), 1e-3), 2)
     10.05
     """
-    return -math.log(float(np.abs(poles).max())) / h
+    return slowest(poles, h)[0]
 
 
 def closed_loop(design: ControllerDesign, truth: Mapping[str, float] | None = None) -> np.ndarray:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from arcosim.control.full_state import slowest
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.control_design import design_controller, indexed_values
 from arcosim.fmu.flexchain.motion_control import MotionController
@@ -253,6 +254,4 @@ def sensorless_decay(
     loop = sensorless_loop(truth, model, h=h, delay=delay, hold=hold, **goals)
     if not loop.settled:
         return -math.inf, math.nan
-    poles = np.linalg.eigvals(sensorless_jacobian(loop))
-    worst = poles[np.argmax(np.abs(poles))]
-    return -math.log(abs(worst)) / h, abs(float(np.angle(worst))) / h
+    return slowest(np.linalg.eigvals(sensorless_jacobian(loop)), h)
