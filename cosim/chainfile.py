@@ -53,7 +53,9 @@ def read_chain(path: str | Path) -> dict[str, float]:
         When the file is not JSON, not an object, a value is not a finite number, or
         ``masses`` is not a whole number, or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing,
         or the report is a rigid drive's (masses = 0: the message gives the ``--set``
-        for the observer instead); the message starts with the file's name.
+        for the observer instead), or it holds no ``J[i]`` at all (an output-error
+        report: the message names the whole-chain fit that writes a chain); the message
+        starts with the file's name.
     UserError
         When the file is missing, a folder or not UTF-8 text
         (:func:`arcosim.logs.read_text_file`), or n is not a supported number of masses
@@ -91,6 +93,8 @@ def read_chain(path: str | Path) -> dict[str, float]:
             + " ".join(f"--set {k}={data[k]:.6g}" for k in ("D_m", "f_c") if k in data)
             + " (the DOB's tau_reac_hat is then the load torque)"
         )
+    if masses == 0:
+        raise ChainFileError(f"{path}: {_no_chain(data)}")
     n = check_masses(int(masses))
     missing = [
         f"{p}[{i}]" for p in CHAIN_PARAMETERS for i in range(1, n + 1) if f"{p}[{i}]" not in chain
@@ -98,6 +102,17 @@ def read_chain(path: str | Path) -> dict[str, float]:
     if missing:
         raise ChainFileError(f"{path}: missing {', '.join(missing)}")
     return {**{k: float(v) for k, v in chain.items()}, "masses": n}
+
+
+def _no_chain(data: dict) -> str:
+    """What a file with no ``J[i]`` holds instead, and the fit that writes a chain."""
+    method = data.get("method")
+    kind = f"an {method} report" if method == "output-error" else "no J[1], k[1], B[1]"
+    what = " (the uniform chain's k_hat, B_hat)" if method == "output-error" else ""
+    return (
+        f"{kind}{what}, not a chain: write one with "
+        "arcosim identify LOG.csv --method whole-chain --out chain.json"
+    )
 
 
 def _is_chain_value(key: str) -> bool:

@@ -131,3 +131,27 @@ def test_a_rigid_drive_chain_file_says_what_the_observer_takes(tmp_path) -> None
     path.write_text(json.dumps({"masses": 0, "J_load": 6e-4, "D_m": 2e-5, "f_c": 2e-3}))
     with pytest.raises(ChainFileError, match=r"rigid drive.*--set dJm=0\.0006"):
         read_chain(path)
+
+
+@pytest.mark.parametrize(
+    ("report", "named"),
+    [
+        ({"k_hat": 0.126, "B_hat": 1.2e-4, "method": "output-error"}, r"output-error report"),
+        ({"D_m": 2e-5}, r"no J\[1\], k\[1\], B\[1\]"),
+    ],
+)
+def test_a_report_without_a_chain_names_the_whole_chain_fit(tmp_path, report, named) -> None:
+    """An output-error report (the uniform chain's k_hat, B_hat) or any file with no
+    J[i] is not a chain of 0 masses: the message names the file's kind and the fit that
+    writes a chain, not "--masses 0: must be 1 to 20"."""
+    import json
+
+    from arcosim.chainfile import ChainFileError, read_chain
+
+    path = tmp_path / "oe.json"
+    path.write_text(json.dumps(report))
+    with pytest.raises(ChainFileError, match=named) as caught:
+        read_chain(path)
+    message = str(caught.value)
+    assert "--method whole-chain --out" in message
+    assert "--masses 0" not in message
