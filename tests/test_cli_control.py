@@ -117,3 +117,19 @@ def test_a_run_that_never_comes_to_rest_is_not_linearized() -> None:
     assert not sensorless_loop(chain, chain, h=0.01, delay=1).settled
     decay, frequency = sensorless_decay(chain, chain, h=0.01, delay=1)
     assert decay == -float("inf") and frequency != frequency
+
+
+def test_a_chain_in_grams_is_named_a_unit_mistake(capsys) -> None:
+    """J[i] given in g·m² (1000 × too large): the 1 rad move in 1 s would need about
+    190 A on the chain's inertia (1.03 kg·m² × 7.5 rad/s² / 0.0406 N·m/A), 19 × i_max,
+    and the loop never comes to rest. The verdict says what the move needs and names
+    the units to check, where it only suggested a shorter step."""
+    code, out, _ = run(
+        capsys, "control", "--masses", 2, "--set", "J[1]=0.515", "--set", "J[2]=0.515"
+    )
+    assert code == 1
+    verdict = out.splitlines()[-2]
+    assert verdict.startswith("verdict: NOT stable: with the model exact, the loop does not")
+    needs = float(verdict.split(" needs ")[1].split(" A")[0])
+    assert 180.0 < needs < 200.0
+    assert "check the units" in verdict and "kg·m²" in verdict and "move_time" in verdict

@@ -27,9 +27,13 @@ from arcosim.fmu.flexchain.control_design import (
     indexed_values,
     plant_matrices,
 )
+from arcosim.fmu.flexchain.motion_control import REFERENCE_SHARE, shaped_step
 
 #: Smaller errors tried, in turn, when the loop is not stable at the error asked for.
 SMALLER_ERRORS = (0.05, 0.02, 0.01)
+#: The shaped step's largest |d²s/dτ²| (dimensionless, at τ ≈ 0.28): 1 rad in T s peaks
+#: at this over T² rad/s².
+PEAK_ACCELERATION = max(abs(shaped_step(j / 4000)[2]) for j in range(4001))
 #: The slowest decay a loop must reach to count as decaying (1/s): a time constant of
 #: 10 s at most, not a pole the plant's own friction barely holds inside the unit circle.
 MIN_DECAY = 0.1
@@ -204,12 +208,26 @@ class ControllerMargins:
         if first is self.worst:
             advice = "check another move_time or bandwidth the same way"
             return f"verdict: NOT robust to {pct}: {what}; {advice}"
-        advice = (
-            "a shorter step, or a sequential master, which applies each command at once"
-            if "late" in first.model
-            else "a shorter step, another move_time or bandwidth, or a higher i_max"
-        )
+        if "late" in first.model:
+            advice = "a shorter step, or a sequential master, which applies each command at once"
+        else:
+            advice = "a shorter step, another move_time or bandwidth, or a higher i_max"
+        needs = self.move_current()
+        d = self.design
+        if not math.isfinite(first.decay) and needs > REFERENCE_SHARE * d.i_max:
+            return (
+                f"verdict: NOT stable: {what}: the 1 rad move in {d.move_time:g} s needs "
+                f"{needs:.3g} A on the chain's {d.inertia:.3g} kg·m² (i_max {d.i_max:g} A); "
+                "check the units of J_mo, J[i] (kg·m²) and k_to (N·m/A), or give a longer "
+                "move_time"
+            )
         return f"verdict: NOT stable: {what}; try {advice}"
+
+    def move_current(self) -> float:
+        """The current the checked move (1 rad in ``move_time``) needs at its peak on the
+        chain taken as rigid: J_tot max|s̈| / k_t (A)."""
+        d = self.design
+        return d.inertia * PEAK_ACCELERATION / (d.move_time**2 * d.k_t)
 
     def as_dict(self) -> dict[str, object]:
         """Everything as JSON-ready values: units in the keys, None for what is not
