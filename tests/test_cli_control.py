@@ -51,6 +51,40 @@ def test_the_json_report_names_its_units(capsys) -> None:
     assert len(report["sensorless_under_errors"]) == 22
     assert report["sensorless"]["decay_1_s"] > 0.0
     assert report["sensorless_under_errors"][0]["J_factors"] == [1.1]
+    hold = report["hold_with_dither"]  # the model exact and the two corners, at rest
+    assert [h["model"] for h in hold[:3]] == [
+        "the model exact, at rest with the dither",
+        "J +10 %, k −10 %, at rest with the dither",
+        "J −10 %, k +10 %, at rest with the dither",
+    ]
+    assert all(h["decay_1_s"] >= report["min_decay_1_s"] for h in hold)
+
+
+def test_without_a_dither_the_hold_is_the_moving_loop_and_not_checked_again(capsys) -> None:
+    code, out, _ = run(capsys, "control", "--masses", 1, "--set", "hold_dither=0", "--json")
+    assert code == 0 and json.loads(out)["hold_with_dither"] == []
+    code, out, _ = run(capsys, "control", "--masses", 1, "--set", "hold_dither=0")
+    assert "at rest with the hold's dither" not in out and "and at rest" not in out
+
+
+def test_a_hold_that_grows_where_the_move_decays_is_named_with_its_way_out() -> None:
+    """The verdict when only the loop at rest fails: it names that case and the
+    parameter that holds without the dither (the logic, on a hold case set to grow)."""
+    import dataclasses
+
+    from arcosim.control.margins import LoopDecay, controller_margins
+
+    chain = params(*CHAINS["bench, two masses"])
+    found = controller_margins(chain, h=1e-3, random_models=0)
+    assert found.robust and len(found.hold) == 3
+    growing = LoopDecay("J +10 %, k −10 %, at rest with the dither", -0.5, 78.0)
+    found = dataclasses.replace(found, hold=(found.hold[0], growing))
+    assert not found.robust and found.failing == [growing]
+    verdict = found.verdict()
+    assert verdict.startswith(
+        "verdict: NOT robust at rest: with J +10 %, k −10 %, at rest with the dither, the loop"
+    )
+    assert "grows at 0.5 1/s at 78 rad/s" in verdict and "hold_dither=0" in verdict
 
 
 @pytest.mark.slow
@@ -66,6 +100,7 @@ def test_the_five_mass_chain_is_refused_at_ten_percent_naming_the_corner(
     assert verdict.startswith("verdict: NOT robust to ±10 %: with J +10 %, k −10 %, the loop")
     assert "grows at 0.855 1/s" in verdict and "at 79.9 rad/s" in verdict
     assert "within ±5 %" in verdict
+    assert "J +10 %, k −10 %: -0.5" in out  # the hold at that corner grows too (0.55 1/s)
     assert "the bench's chain" not in out  # the chain came from the file
     code, out, _ = run(capsys, "control", "--chain", path, "--error", 0.05)
     assert code == 0 and "verdict: robust" in out

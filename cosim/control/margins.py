@@ -3,7 +3,8 @@
 :func:`controller_margins` designs the controller as the FMU does, then computes the
 full-state loop's margins (:mod:`~arcosim.control.full_state`) and the sensorless loop's
 decays (:mod:`~arcosim.control.sensorless_loop`) with the model exact, one step late and
-under the model errors of :mod:`~arcosim.control.model_errors`. The chain given is taken
+under the model errors of :mod:`~arcosim.control.model_errors`, and at rest with the
+hold's dither (the model exact and the corners). The chain given is taken
 as the truth, and the controller is designed on that chain with every J_i, k_i scaled
 ("if the identified chain were this far off"), for both loops alike.
 """
@@ -41,6 +42,8 @@ MIN_DECAY = 0.1
 #: the chain's fastest mode at most this share of it too (dimensionless).
 NYQUIST_SHARE_BANDWIDTH = 0.1
 NYQUIST_SHARE_MODE = 0.5
+#: What a hold case's name ends with.
+AT_REST = ", at rest with the dither"
 #: Names of the full-state margins in the JSON, with their units.
 FULL_STATE_KEYS = {
     "slowest_decay": "slowest_decay_1_s",
@@ -111,6 +114,11 @@ class ControllerMargins:
     stable_within : float or None
         When some model error makes the loop grow: the largest of ``SMALLER_ERRORS`` at
         which none does (dimensionless; None if none of them).
+    hold : tuple of LoopDecay
+        The sensorless loop at rest with the hold's dither running
+        (:func:`~arcosim.control.sensorless_loop.sensorless_loop` with ``hold=True``):
+        the model exact, the two corners and the worst model error if it is neither;
+        empty when the design has no dither (``encoder_cpr`` or ``hold_dither`` 0).
 
     Examples
     --------
@@ -130,6 +138,7 @@ class ControllerMargins:
     under_errors: tuple[LoopDecay, ...]
     error: float
     stable_within: float | None = field(default=None)
+    hold: tuple[LoopDecay, ...] = ()
 
     @property
     def worst(self) -> LoopDecay:
@@ -139,7 +148,8 @@ class ControllerMargins:
     @property
     def failing(self) -> list[LoopDecay]:
         """The cases whose loop decays slower than ``MIN_DECAY`` (or grows), in the order
-        model exact, one step late, the worst model error, the full-state loop's."""
+        model exact, one step late, the worst model error, the full-state loop's, the
+        hold's at rest."""
         fs = self.full_state
         cases = [
             self.sensorless,
@@ -147,6 +157,7 @@ class ControllerMargins:
             self.worst,
             LoopDecay("the full state, the model exact", fs["slowest_decay"], 0.0),
             LoopDecay("the full state, one step late", fs["decay_one_step_late"], 0.0),
+            *self.hold,
         ]
         return [c for c in cases if not c.decay >= MIN_DECAY]
 
@@ -176,6 +187,11 @@ class ControllerMargins:
             f"{self.sensorless_late.text()}; worst over J_i, k_i {pct} "
             f"({len(self.under_errors)} models): {self.worst.text()}",
         ]
+        if self.hold:
+            lines.append(
+                "at rest with the hold's dither (its observer's angle fed back; linearized "
+                "as above): " + "; ".join(_at_rest_text(h) for h in self.hold)
+            )
         return "\n".join([*lines, self.verdict()])
 
     def verdict(self) -> str:
@@ -185,7 +201,7 @@ class ControllerMargins:
             return (
                 f"verdict: robust: the sensorless loop decays at {MIN_DECAY:g} 1/s or faster "
                 f"with the model exact, one step late and with every J_i, k_i checked within "
-                f"{pct} of the chain's"
+                f"{pct} of the chain's" + (", and at rest with the dither" if self.hold else "")
             )
         first = self.failing[0]
         what = f"with {first.model}, the loop " + (
@@ -198,6 +214,12 @@ class ControllerMargins:
             )
             + f" at {first.frequency:.3g} rad/s"
         )
+        if any(first is h for h in self.hold):  # the moving loop passed every case
+            return (
+                f"verdict: NOT robust at rest: {what}, where the moving loop decays in "
+                "every case checked; hold_dither=0 holds without the dither (the motor then "
+                "hunts over 2 to 4 counts, docs/control.md)"
+            )
         if first is self.worst and self.stable_within is not None:
             within = f"±{100 * self.stable_within:g} %"
             advice = (
@@ -248,12 +270,19 @@ class ControllerMargins:
             "sensorless": self.sensorless.as_dict(),
             "sensorless_one_step_late": self.sensorless_late.as_dict(),
             "sensorless_under_errors": [e.as_dict() for e in self.under_errors],
+            "hold_with_dither": [e.as_dict() for e in self.hold],
             "error": self.error,
             "min_decay_1_s": MIN_DECAY,
             "robust": self.robust,
             "stable_within": self.stable_within,
             "verdict": self.verdict(),
         }
+
+
+def _at_rest_text(case: LoopDecay) -> str:
+    """``"J +10 %, k −10 %: 1.82 1/s at 31.1 rad/s"`` for a hold case."""
+    name = case.model.removesuffix(AT_REST)
+    return f"{name}: " + LoopDecay("the model exact", case.decay, case.frequency).text()
 
 
 def _finite(x: float) -> float | None:
@@ -331,6 +360,16 @@ def controller_margins(
             return LoopDecay("the model exact" + (", one step late" if delay else ""), *found)
         return LoopDecay(e.name, *found, e.J, e.k)
 
+    def at_rest(e: ModelError | None) -> LoopDecay:
+        model = truth if e is None else e.apply(truth)
+        dither = {k: goals_[k] for k in ("hold_dither",) if k in goals_}
+        found = sensorless_decay(truth, model, h=h, hold=True, **linear, **dither)
+        if e is None:
+            return LoopDecay(f"the model exact{AT_REST}", *found)
+        return LoopDecay(f"{e.name}{AT_REST}", *found, e.J, e.k)
+
+    under = tuple(sensorless(e) for e in errors)
+    worst = errors[min(range(len(errors)), key=lambda i: under[i].decay)]
     found = ControllerMargins(
         design=design,
         modes=_modes(design),
@@ -338,8 +377,9 @@ def controller_margins(
         full_state_worst=min((full(e) for e in errors), key=lambda d: d.decay),
         sensorless=sensorless(None),
         sensorless_late=sensorless(None, delay=1),
-        under_errors=tuple(sensorless(e) for e in errors),
+        under_errors=under,
         error=error,
+        hold=tuple(at_rest(e) for e in _hold_models(design, errors, worst)),
     )
     if found.robust or found.failing[0] is not found.worst:
         return found
@@ -348,6 +388,16 @@ def controller_margins(
         if all(sensorless(e).decay >= MIN_DECAY for e in models):
             return ControllerMargins(**{**vars(found), "stable_within": smaller})
     return found
+
+
+def _hold_models(
+    design: ControllerDesign, errors: list[ModelError], worst: ModelError
+) -> list[ModelError | None]:
+    """The models the hold is checked on: none without a dither; else the model exact
+    (None), the two corners and the moving loop's worst model if it is neither."""
+    if not design.dither_current > 0.0:
+        return []
+    return [None, *errors[:2], *([worst] if worst not in errors[:2] else [])]
 
 
 def _design(params: Mapping[str, float], h: float, goals_: Mapping) -> ControllerDesign:
