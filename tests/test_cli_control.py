@@ -88,22 +88,23 @@ def test_a_hold_that_grows_where_the_move_decays_is_named_with_its_way_out() -> 
 
 
 @pytest.mark.slow
-def test_the_five_mass_chain_is_refused_at_ten_percent_naming_the_corner(
+def test_the_five_mass_chain_is_refused_at_twenty_percent_naming_the_corner(
     capsys, tmp_path: Path
 ) -> None:
-    """The linear loop grows at the J +10 %, k −10 % corner (docs/control.md#margins):
-    exit 1, the corner and the frequency named, and the smaller error it passes."""
+    """Robust to ±10 % with the estimator bank (docs/control.md#margins); at ±20 % the J
+    +20 %, k −20 % corner lies beyond the bank's ±7 % models and the loop grows there by
+    the chain's top modes: exit 1, the corner and the frequency named, and the smaller
+    error it passes."""
     path = chain_file(tmp_path, "five masses")
-    code, out, err = run(capsys, "control", "--chain", path)
+    code, out, err = run(capsys, "control", "--chain", path, "--error", 0.2)
     assert code == 1, err
     verdict = out.splitlines()[-2]
-    assert verdict.startswith("verdict: NOT robust to ±10 %: with J +10 %, k −10 %, the loop")
-    assert "grows at 0.855 1/s" in verdict and "at 79.9 rad/s" in verdict
-    assert "within ±5 %" in verdict
-    assert "J +10 %, k −10 %: -0.5" in out  # the hold at that corner grows too (0.55 1/s)
+    assert verdict.startswith("verdict: NOT robust to ±20 %: with J +20 %, k −20 %, the loop")
+    rate = float(verdict.split("grows at ")[1].split(" 1/s")[0])
+    frequency = float(verdict.split(" 1/s at ")[1].split(" rad/s")[0])
+    assert rate > 0.1 and 70.0 < frequency < 85.0  # the top modes, 63.5–145.9 rad/s free
+    assert "within ±10 %" in verdict
     assert "the bench's chain" not in out  # the chain came from the file
-    code, out, _ = run(capsys, "control", "--chain", path, "--error", 0.05)
-    assert code == 0 and "verdict: robust" in out
 
 
 @pytest.mark.parametrize(

@@ -31,7 +31,7 @@ from arcosim.fmu.flexchain.control_design import (
 from arcosim.fmu.flexchain.motion_control import REFERENCE_SHARE, shaped_step
 
 #: Smaller errors tried, in turn, when the loop is not stable at the error asked for.
-SMALLER_ERRORS = (0.05, 0.02, 0.01)
+SMALLER_ERRORS = (0.1, 0.05, 0.02, 0.01)
 #: The shaped step's largest |d²s/dτ²| (dimensionless, at τ ≈ 0.28): 1 rad in T s peaks
 #: at this over T² rad/s².
 PEAK_ACCELERATION = max(abs(shaped_step(j / 4000)[2]) for j in range(4001))
@@ -126,7 +126,7 @@ class ControllerMargins:
     ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
     >>> found = arcosim.controller_margins(chain, h=1e-3, random_models=0)
     >>> found.robust, found.worst.model  # the slowest of the two corners
-    (True, 'J +10 %, k −10 %')
+    (True, 'J −10 %, k +10 %')
     """
 
     design: ControllerDesign

@@ -31,6 +31,7 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
     | {"t", "_moved", "_h"}
+    | {"open_loop", "score", "factors"}  # the bank's choice: a switch, not a state
 )
 #: When the loop is linearized: this long after the move ends (s).
 AFTER_MOVE = 0.6
@@ -165,7 +166,10 @@ def _leaves(
     if id(obj) in seen:
         return []
     seen.add(id(obj))
-    items = obj.items() if isinstance(obj, dict) else vars(obj).items()
+    if isinstance(obj, dict):
+        items = obj.items()
+    else:
+        items = enumerate(obj) if isinstance(obj, list) else vars(obj).items()
     found = []
     for key, value in items:
         frozen = getattr(getattr(type(value), "__dataclass_params__", None), "frozen", False)
@@ -173,9 +177,7 @@ def _leaves(
             continue
         if isinstance(value, float):
             found.append((*path, key))
-        elif isinstance(value, list):
-            found += [(*path, key, i) for i, v in enumerate(value) if isinstance(v, float)]
-        elif isinstance(value, dict) or hasattr(value, "__dict__"):
+        elif isinstance(value, (list, dict)) or hasattr(value, "__dict__"):
             found += _leaves(value, (*path, key), seen, skip)
     return found
 
@@ -209,6 +211,9 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     paths = _leaves(loop, skip=UNPERTURBED | (HOLD_UNPERTURBED if loop.hold else frozenset()))
     if loop.hold:
         paths = [p for p in paths if p[:2] != ("controller", "dither") or p[2] == "observer"]
+    # of the estimator bank, the member the feedback takes: the others feed nothing back
+    pick = ("controller", "bank", "members", loop.controller.bank.pick)
+    paths = [p for p in paths if p[:3] != pick[:3] or p[:4] == pick]
     z0 = np.array([_get(loop, p) for p in paths])
 
     def stepped(path=None, value=0.0) -> np.ndarray:

@@ -103,6 +103,16 @@ CONTROL_TORQUE_NOISE_STD = 1e-3
 #: (five-mass chain: 1.74 × the full-state bound's settling time, 0.98 × with it; 0.05,
 #: 0.3 and 1 rad/s were also tried on `arcosim bench control`'s chains).
 CONTROL_MOVING_SPEED = 0.6
+#: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`): every
+#: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;
+#: 3 × 3 models, the chain itself among them). ±7 %, not the ±10 % the controller is
+#: scored at, so that its corners are not in the bank (docs/development.md).
+BANK_SCALES = (0.93, 1.0, 1.07)
+#: The time over which a member's squared open-loop error of τ̂_reac is averaged (s).
+BANK_MEMORY = 0.5
+#: The bank moves to another member only when its score is below (1 − this) × the present
+#: one's (dimensionless): with none, the choice changed between members that predict alike.
+BANK_HYSTERESIS = 0.3
 #: The hold's dither (encoder counts, peak to peak): at rest the controller adds a square
 #: current that moves the motor over this much of a count, so that the encoder's reading,
 #: less the dither's known path, tells where the motor is inside its count

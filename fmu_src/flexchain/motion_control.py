@@ -5,8 +5,11 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
 
 * **estimates**: the observer's model-based estimator with its load-torque state on mass
   L (:class:`~arcosim.fmu.flexchain.observer.Observer`, mode 2, estimator 1, the same
-  code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``)
-  gives every load angle and velocity and the torque d̂ on mass L; the motor's angle
+  code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``),
+  run on the chain and on its models with every J_i and k_i scaled
+  (:class:`~arcosim.fmu.flexchain.estimator_bank.EstimatorBank`, the one whose model
+  predicts τ̂_reac best chosen), gives every load angle and velocity and the torque d̂ on
+  mass L; the motor's angle
   enters as measured (the middle of its count), its velocity, where Coulomb friction is
   cancelled, as the backward difference of the encoder's last crossed edge
   (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a dither across one
@@ -46,6 +49,7 @@ from .codes import Estimator, Mode
 from .control_design import ControllerDesign, design_controller
 from .dob import Actuator, ReactionObserver, clamp, sign
 from .encoder_edge import CrossedEdge
+from .estimator_bank import EstimatorBank
 from .filters import lowpass_pole
 from .hold_dither import HoldDither
 from .load_observer import LoadTorqueObserver
@@ -219,6 +223,10 @@ class MotionController:
             torque_noise_std=defaults.CONTROL_TORQUE_NOISE_STD,
         )
         self.observer = Observer(settings, theta_m0, 0.0)
+        # the estimator on the chain and on its scaled models (estimator_bank); the
+        # observer keeps its DOB and offset, the bank owns the estimators
+        self.bank = EstimatorBank(self.observer.estimator)
+        self.observer.estimator = None
         self.offset = settings.angle_offset()
         self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
         # the crossed edge's velocity only with an encoder and the friction cancelled:
@@ -261,7 +269,7 @@ class MotionController:
             ``i_ref`` (A).
         """
         obs = self.observer
-        est = obs.estimator
+        est = self.bank.chosen
         t0 = self.theta0
         theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
@@ -285,7 +293,8 @@ class MotionController:
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
         if dob.sticking:
             settle_sticking(dob, est, h, drive)
-        est.step(h, dob.tau_reac_hat, drive)
+        self.bank.step(h, dob.tau_reac_hat, drive)
+        est = self.bank.chosen
         # the motor's own states as measured: its observer's (model-based) estimates of
         # them cost the loop its stability under a 10 % model error (docs/control.md)
         x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]

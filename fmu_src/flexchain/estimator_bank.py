@@ -1,0 +1,123 @@
+"""A bank of the chain's estimators on scaled models, and the one whose model predicts best.
+
+The controller's estimator runs on the identified chain. With every J_i 10 % high and
+every k_i 10 % low it rings 10 % off the chain's modes, its estimate of the last mass lags
+the truth, and the loop settles up to 2.4 × slower than the same gains on the true states
+(or, on a five-mass chain, grows at its top mode). :class:`EstimatorBank` runs the same
+estimator on the chain with every J_i × a and every k_i × b, for a and b each in
+``defaults.BANK_SCALES`` (3 × 3 models with the defaults, the chain itself among them),
+all on the same inputs (τ̂_reac and the drive's angle), and gives the controller the
+estimates of the member whose model predicts τ̂_reac best.
+
+What "best" means: each member's model also runs open loop (no Kalman correction) from
+the start, and the square of its open-loop prediction error of τ̂_reac, low-passed over
+``defaults.BANK_MEMORY`` s, is its score. The corrected filters' own innovations do not
+tell the models apart (every member follows τ̂_reac; chosen by them, the choice changed
+every few steps); an open-loop model's error grows with its modes' frequency error. The
+bank moves to another member only when that one's score is below
+(1 − ``defaults.BANK_HYSTERESIS``) × the present one's, so it does not chatter between
+members that predict alike (the chain itself is kept at rest and on an identified chain).
+
+A load torque, unknown to the open-loop models, enters every member's error alike.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from operator import mul
+
+from . import defaults
+from .load_observer import LoadTorqueObserver
+
+
+class EstimatorBank:
+    """The chain's estimator on every scaled model, and the one chosen (module doc).
+
+    Parameters
+    ----------
+    estimator : LoadTorqueObserver
+        The estimator on the chain as given, at its start; copied, not stepped.
+    scales : tuple of float
+        The factors on every J_i and, independently, every k_i (dimensionless).
+
+    Attributes
+    ----------
+    members : list of LoadTorqueObserver
+        One per (J factor, k factor), J's factor the outer loop.
+    factors : list of tuple of float
+        Each member's (J factor, k factor).
+    score : list of float
+        Each member's low-passed squared open-loop error of τ̂_reac (N²·m²).
+    pick : int
+        The member whose estimates the controller takes.
+
+    Examples
+    --------
+    >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3,
+    ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
+    >>> bank = arcosim.MotionController(arcosim.design_controller(chain, h=1e-3)).bank
+    >>> len(bank.members), bank.factors[bank.pick], bank.chosen.J
+    (9, (1.0, 1.0), (0.0005,))
+    """
+
+    def __init__(
+        self, estimator: LoadTorqueObserver, scales: tuple[float, ...] = defaults.BANK_SCALES
+    ) -> None:
+        self.members: list[LoadTorqueObserver] = []
+        self.factors: list[tuple[float, float]] = []
+        for a in scales:
+            for b in scales:
+                member = copy.deepcopy(estimator)
+                member.J = tuple(a * x for x in estimator.J)
+                member.k = tuple(b * x for x in estimator.k)
+                member._models = {}  # designed on first use for the scaled chain
+                self.members.append(member)
+                self.factors.append((a, b))
+        self.open_loop = [list(m.s) for m in self.members]
+        self.score = [0.0] * len(self.members)
+        self.pick = min(
+            range(len(self.factors)),
+            key=lambda j: abs(self.factors[j][0] - 1.0) + abs(self.factors[j][1] - 1.0),
+        )
+
+    @property
+    def chosen(self) -> LoadTorqueObserver:
+        """The member whose estimates the controller takes."""
+        return self.members[self.pick]
+
+    def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
+        """Step every member on the sample that ends a step, then choose.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        tau_reac_hat : float
+            The reaction torque observer's estimate τ̂_reac (N·m).
+        theta_m : float
+            The motor angle the estimators take (rad).
+        """
+        forget = math.exp(-h / defaults.BANK_MEMORY)
+        for j, member in enumerate(self.members):
+            error = self._open_loop_error(j, member, h, tau_reac_hat, theta_m)
+            member.step(h, tau_reac_hat, theta_m)
+            self.score[j] = forget * self.score[j] + (1.0 - forget) * error * error
+        best = min(range(len(self.members)), key=self.score.__getitem__)
+        if self.score[best] < (1.0 - defaults.BANK_HYSTERESIS) * self.score[self.pick]:
+            self.pick = best
+
+    def _open_loop_error(
+        self, j: int, member: LoadTorqueObserver, h: float, tau_reac_hat: float, theta_m: float
+    ) -> float:
+        """Advance member ``j``'s open-loop model (its step model without the Kalman
+        correction, on the member's own previous motor angle) and return τ̂_reac less
+        its prediction (N·m). Call before the member's own step."""
+        sm = member.model(h)
+        u = theta_m - member.theta0
+        w0, w1 = member.u_prev, (u - member.u_prev) / h
+        s = self.open_loop[j]
+        self.open_loop[j] = s = [
+            sum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
+        ]
+        return tau_reac_hat - s[-1]
