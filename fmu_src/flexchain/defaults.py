@@ -113,6 +113,9 @@ BANK_MEMORY = 0.5
 #: The bank moves to another member only when its score is below (1 − this) × the present
 #: one's (dimensionless): with none, the choice changed between members that predict alike.
 BANK_HYSTERESIS = 0.3
+#: The bank chooses from a move's response only: from its start until this share of the
+#: move time after it (dimensionless).
+BANK_CHOICE_AFTER = 0.5
 #: The hold's dither (encoder counts, peak to peak): at rest the controller adds a square
 #: current that moves the motor over this much of a count, so that the encoder's reading,
 #: less the dither's known path, tells where the motor is inside its count

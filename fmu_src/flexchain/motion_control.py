@@ -293,7 +293,8 @@ class MotionController:
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
         if dob.sticking:
             settle_sticking(dob, est, h, drive)
-        self.bank.step(h, dob.tau_reac_hat, drive)
+        choosing = self.t - self._moved < defaults.BANK_CHOICE_AFTER * self.design.move_time
+        self.bank.step(h, dob.tau_reac_hat, drive, choosing)
         est = self.bank.chosen
         # the motor's own states as measured: its observer's (model-based) estimates of
         # them cost the loop its stability under a 10 % model error (docs/control.md)
@@ -311,6 +312,8 @@ class MotionController:
         """
         design = self._design_for(h)
         if self.path.moves:
+            if self.t - self._moved > 1.5 * h:  # a move starts: the bank chooses anew
+                self.bank.restart()
             self._moved = self.t
         rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
         if not (rest and design.dither_current > 0.0):
