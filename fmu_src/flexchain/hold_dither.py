@@ -9,11 +9,13 @@ periodic path of peak-to-peak ``A k_t (P h)² / (16 J_m)``; the amplitude is cho
 ``defaults.HOLD_DITHER`` counts. The reading less that path has a quantization error
 that changes from sample to sample (subtractive dither), and an observer of the motor
 alone (:class:`~arcosim.fmu.flexchain.motor_observer.MotorObserver` without its spring)
-averages it into the motor's angle below a count, for the state feedback and the
-estimator's input. Its velocity is not used: it carries the dither's periodic error (about
-0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s) and, fed back, made the
-five-mass chain diverge with its model's J 10 % high and k 10 % low; at 1000 rad/s it
-diverged with one step of delay, at 2000 no run held one count (docs/development.md).
+averages it into the motor's angle and velocity below a count, for the state feedback
+(both) and the estimator's input (the angle). The velocity carries the dither's periodic
+error (about 0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s); fed back with
+the estimator on the identified chain alone, it made the five-mass chain diverge with its
+model's J 10 % high and k 10 % low. With the estimator bank
+(:mod:`~arcosim.fmu.flexchain.estimator_bank`), which moves to a model near the truth,
+that chain holds one count there (docs/development.md).
 
 Friction is cancelled along the dither's velocity, which the motor follows; what the
 slow motion meets then is a viscous friction of about ``2 f_c / v_peak`` per rad/s, the
@@ -96,8 +98,8 @@ class HoldDither:
         Returns
         -------
         float
-            The observer's angle, the dither's path taken out (its velocity, not used by
-            the controller, is ``observer.s[1]``). Also kept: ``reading`` (rad), the
+            The observer's angle, the dither's path taken out (its velocity, which the
+            controller feeds back too, is ``observer.s[1]``). Also kept: ``reading`` (rad), the
             reading less the path, and ``steady`` (A), the current less the dither's and
             less the Coulomb friction that acted (f_c times the mean sign of the dither's
             velocity plus the observer's slow one).

@@ -285,9 +285,10 @@ class MotionController:
         if dither is None:
             self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
             d_m = self.motor.s[0]
-        else:  # at rest: the motor's angle below a count, from the reading less the
-            # dither's path; the velocity stays the crossed edge's (hold_dither's doc)
+        else:  # at rest: the motor's angle and velocity below a count, from the reading
+            # less the dither's path (hold_dither's doc); the DOB keeps the crossed edge's
             th_m = dither.measure(h, i_a, th_m)
+            omega_m = dither.observer.s[1]
             self.motor.step(h, dither.steady, dither.reading, theta_1, omega_1, 0.0)
             d_m = 0.0
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
