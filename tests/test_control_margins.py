@@ -43,7 +43,7 @@ def test_the_sensorless_loop_is_stable_with_the_model_ten_percent_off(
 ) -> None:
     """Every pole of the sensorless loop inside the unit circle (a decay > 0) with the
     model's J all 10 % off one way and its k the other; also at rest with the hold's
-    dither running (its observer's angle fed back, the motor's velocity exact). Before the
+    dither running (its observer's angle and velocity fed back). Before the
     estimator bank the five-mass J +10 %, k −10 % corner grew, at 0.85 1/s at 79.9 rad/s
     (0.55 1/s at rest): its top modes, where the estimator on the wrong model rang."""
     chain = params(*CHAINS[name])

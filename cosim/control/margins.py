@@ -189,8 +189,8 @@ class ControllerMargins:
         ]
         if self.hold:
             lines.append(
-                "at rest with the hold's dither (its observer's angle fed back; linearized "
-                "as above): " + "; ".join(_at_rest_text(h) for h in self.hold)
+                "at rest with the hold's dither (its observer's angle and velocity fed back; "
+                "linearized as above): " + "; ".join(_at_rest_text(h) for h in self.hold)
             )
         return "\n".join([*lines, self.verdict()])
 

@@ -87,11 +87,9 @@ def sensorless_loop(
 
     With ``hold`` the controller is designed with the model's encoder (``encoder_cpr``,
     default ``defaults.ENCODER_CPR``) so that its hold's dither runs at rest
-    (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle from the dither's
-    observer), while the plant's angle stays exact and friction stays out; the loop is
-    run to :data:`AFTER_MOVE` after the dither starts. Without Coulomb friction the
-    controller feeds back the measured motor velocity (exact here), not the encoder's
-    crossed edge, so this is the hold's loop with the finest velocity there is.
+    (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle and velocity from
+    the dither's observer, as in the runs), while the plant's angle stays exact and
+    friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts.
 
     Parameters
     ----------
