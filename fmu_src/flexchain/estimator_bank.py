@@ -109,15 +109,21 @@ class EstimatorBank:
         theta_m : float
             The motor angle the estimators take (rad).
         choose : bool
-            Whether the choice may change at this sample (the scores run on either way).
+            Whether the choice may change at this sample. When not, only the members
+            step: the scores and open-loop models are not read again before
+            :meth:`restart` sets them anew.
         """
+        if not choose:  # the scores and open-loop models are restarted before they count
+            for member in self.members:
+                member.step(h, tau_reac_hat, theta_m)
+            return
         forget = math.exp(-h / defaults.BANK_MEMORY)
         for j, member in enumerate(self.members):
             error = self._open_loop_error(j, member, h, tau_reac_hat, theta_m)
             member.step(h, tau_reac_hat, theta_m)
             self.score[j] = forget * self.score[j] + (1.0 - forget) * error * error
         best = min(range(len(self.members)), key=self.score.__getitem__)
-        if choose and self.score[best] < (1.0 - defaults.BANK_HYSTERESIS) * self.score[self.pick]:
+        if self.score[best] < (1.0 - defaults.BANK_HYSTERESIS) * self.score[self.pick]:
             self.pick = best
 
     def _open_loop_error(
