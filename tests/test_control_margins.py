@@ -79,3 +79,26 @@ def test_the_estimator_bank_takes_the_model_nearest_the_truth(factors, member) -
     }
     bank = sensorless_loop(chain, model, h=H).controller.bank
     assert bank.factors[bank.pick] == member
+
+
+def test_at_rest_the_bank_runs_the_holds_gain_until_the_next_move() -> None:
+    """Once the hold has kept the controlled mass near its target, every member runs the
+    hold's gain (unmodelled torque × HOLD_TORQUE_NOISE_SCALE: it corrects less from
+    τ̂_reac); a new target gives back the move's gain, the one designed at the start, bit
+    for bit, and the estimates carry on from where they were."""
+    chain = params(*CHAINS["bench, two masses"])
+    loop = sensorless_loop(chain, chain, h=H, hold=True)
+    controller = loop.controller
+    bank = controller.bank
+    assert bank.quiet
+    member = bank.chosen
+    hold_gain = np.array(member.model(H).K)
+    state = list(member.s)
+    controller.step(H, 2.0, *loop.signals[:3])  # a new target: a move starts
+    assert not bank.quiet
+    move_gain = np.array(member.model(H).K)
+    assert move_gain.tolist() == list(member.design(H).K)
+    assert np.linalg.norm(hold_gain) < np.linalg.norm(move_gain)
+    assert member.s != state  # stepped on from its own estimates, not restarted
+    bank.set_quiet(True)
+    assert np.array(member.model(H).K).tolist() == hold_gain.tolist()

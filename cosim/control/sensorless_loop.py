@@ -30,8 +30,8 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 #: and clocks (times and the step, which no state feeds back into).
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
-    | {"t", "_moved", "_h"}
-    | {"open_loop", "score", "factors"}  # the bank's choice: a switch, not a state
+    | {"t", "_moved", "_h", "_still"}
+    | {"open_loop", "score", "factors", "_other"}  # the bank's choice: a switch, not a state
 )
 #: When the loop is linearized: this long after the move ends (s).
 AFTER_MOVE = 0.6
@@ -40,6 +40,9 @@ AFTER_MOVE = 0.6
 #: generator: its floats follow the step count, whatever the loop does), all but its
 #: observer.
 HOLD_UNPERTURBED = frozenset({"target"})
+#: With ``hold``: how much longer the run may go on for the estimators to take the hold's
+#: gain (s; the controller switches once the controlled mass is still).
+QUIET_WAIT = 2.0
 #: The loop counts as come to rest when, over this last stretch of the run (s), the command
 #: stayed below i_max and the controlled mass ends within SETTLE_ANGLE of its target.
 SETTLE_WINDOW = 0.1
@@ -89,7 +92,8 @@ def sensorless_loop(
     default ``defaults.ENCODER_CPR``) so that its hold's dither runs at rest
     (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle and velocity from
     the dither's observer, as in the runs), while the plant's angle stays exact and
-    friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts.
+    friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts and
+    then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain.
 
     Parameters
     ----------
@@ -137,6 +141,10 @@ def sensorless_loop(
         advance(loop)
         if k >= window and not abs(loop.signals[3]) < design.i_max:
             loop.settled = False
+    for _ in range(round(QUIET_WAIT / h) if hold else 0):
+        if loop.controller.bank.quiet:
+            break
+        advance(loop)
     L = design.control_mass
     if not abs(loop.plant.x[L] - 1.0) < SETTLE_ANGLE:
         loop.settled = False

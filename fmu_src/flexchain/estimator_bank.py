@@ -24,11 +24,15 @@ lets the choice change only until ``defaults.BANK_CHOICE_AFTER`` move times afte
 move. A load torque, unknown to the open-loop models, grows every member's error, not
 alike: left to choose at rest, the bank took a load step on the bench's three-mass chain
 for a model error and moved to the wrong members (0.91 mrad left, 0.43 on the chain).
+
+At rest the controller makes every member trust its model more (:meth:`set_quiet`: the
+unmodelled torque × ``defaults.HOLD_TORQUE_NOISE_SCALE``), each gain designed once.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from operator import mul
 
@@ -56,6 +60,10 @@ class EstimatorBank:
         Each member's low-passed squared open-loop error of τ̂_reac (N²·m²).
     pick : int
         The member whose estimates the controller takes.
+    quiet : bool
+        Whether the members run the hold's gain (:meth:`set_quiet`).
+    move_noise : list of NoiseModel
+        Each member's noise model for a move (its own at the start).
 
     Examples
     --------
@@ -65,6 +73,8 @@ class EstimatorBank:
     >>> len(bank.members), bank.factors[bank.pick], bank.chosen.J
     (9, (1.0, 1.0), (0.0005,))
     """
+
+    _transient = ("_other",)  # the other gain's designs, rebuilt on use after a restore
 
     def __init__(
         self, estimator: LoadTorqueObserver, scales: tuple[float, ...] = defaults.BANK_SCALES
@@ -81,6 +91,9 @@ class EstimatorBank:
                 self.factors.append((a, b))
         self.open_loop = [list(m.s) for m in self.members]
         self.score = [0.0] * len(self.members)
+        self.quiet = False
+        self.move_noise = [m.noise for m in self.members]
+        self._other: dict[int, dict] = {}
         self.pick = min(
             range(len(self.factors)),
             key=lambda j: abs(self.factors[j][0] - 1.0) + abs(self.factors[j][1] - 1.0),
@@ -96,6 +109,27 @@ class EstimatorBank:
         (at a move's start)."""
         self.open_loop = [list(m.s) for m in self.members]
         self.score = [0.0] * len(self.members)
+
+    def set_quiet(self, quiet: bool) -> None:
+        """Give every member the hold's gain (``quiet``) or the move's, keeping its state.
+
+        The hold's trusts the model more: each member's unmodelled torque on a load mass
+        times ``defaults.HOLD_TORQUE_NOISE_SCALE`` (``torque_noise_std``, N·m). Each gain
+        is designed on first use, then kept for the next switch.
+
+        Parameters
+        ----------
+        quiet : bool
+            True at rest, False for a move.
+        """
+        if quiet == self.quiet:
+            return
+        scale = defaults.HOLD_TORQUE_NOISE_SCALE
+        for j, (member, noise) in enumerate(zip(self.members, self.move_noise)):
+            std = noise.torque_noise_std * scale
+            member.noise = dataclasses.replace(noise, torque_noise_std=std) if quiet else noise
+            member._models, self._other[j] = self._other.get(j, {}), member._models
+        self.quiet = quiet
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float, choose: bool = True) -> None:
         """Step every member on the sample that ends a step, then choose.

@@ -9,13 +9,12 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   run on the chain and on its models with every J_i and k_i scaled
   (:class:`~arcosim.fmu.flexchain.estimator_bank.EstimatorBank`, the one whose model
   predicts τ̂_reac best chosen), gives every load angle and velocity and the torque d̂ on
-  mass L; the motor's angle
-  enters as measured (the middle of its count), its velocity, where Coulomb friction is
-  cancelled, as the backward difference of the encoder's last crossed edge
-  (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a dither across one
-  edge), in the feedback and the DOB alike; a motor observer (:class:`MotorObserver`)
-  gives the friction d̂_m the friction model misses, from the current and the encoder,
-  with the first spring pulling towards the estimated mass 1;
+  mass L; the motor's angle enters as measured (the middle of its count), its velocity,
+  where Coulomb friction is cancelled, as the backward difference of the encoder's last
+  crossed edge (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a
+  dither across one edge), in the feedback and the DOB alike; a motor observer
+  (:class:`MotorObserver`) gives the friction d̂_m the friction model misses, from the
+  current and the encoder, with the first spring pulling towards the estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
   (:func:`shaped_step`, zero velocity, acceleration and jerk at both ends, lasting
   ``move_time``) whose sum is the target path s(t); a reference model, the design model
@@ -245,6 +244,7 @@ class MotionController:
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
         self.dither: HoldDither | None = None  # while the hold's dither runs
         self._moved = 0.0  # when the target path last moved (s)
+        self._still = 0.0  # how long the hold has kept the controlled mass near its target (s)
 
     def step(self, h: float, theta_ref: float, i_a: float, omega_m: float, theta_m: float) -> float:
         """Take the sample at t_k and return the current to hold over the next step.
@@ -309,7 +309,8 @@ class MotionController:
         """Start, run or stop the hold's dither for the next step; return ``i_ref`` (A).
 
         It runs from ``defaults.HOLD_DITHER_AFTER`` move times after the target path
-        stops until the next move, where the design has one (``dither_current`` > 0).
+        stops until the next move, where the design has one (``dither_current`` > 0);
+        the estimators take the hold's gain once mass L is still (``defaults.HOLD_QUIET_*``).
         """
         design = self._design_for(h)
         if self.path.moves:
@@ -319,10 +320,16 @@ class MotionController:
         rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
         if not (rest and design.dither_current > 0.0):
             self.dither = None
+            self.bank.set_quiet(False)
+            self._still = 0.0
             return self.i_ref
         if self.dither is None or self.dither.design.h != h:
             self.dither = HoldDither(design)
             self.dither.start(x[0], x[design.n + 1])
+        near = abs(self.theta_hat_ctrl - self.path.target) < defaults.HOLD_QUIET_ANGLE
+        self._still = self._still + h if near else 0.0
+        if self._still >= defaults.HOLD_QUIET_TIME:
+            self.bank.set_quiet(True)
         current, friction = self.dither.command(h)
         # the friction cancelled along the dither's velocity, which the motor follows
         self.i_fb += current + (friction - self.friction) / design.k_t
