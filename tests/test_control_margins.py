@@ -11,6 +11,7 @@ import pytest
 
 from arcosim.control.model_errors import corners
 from arcosim.control.sensorless_loop import sensorless_decay, sensorless_jacobian, sensorless_loop
+from arcosim.fmu.flexchain import defaults
 from benchmarks.control_margins import CHAINS, H, params
 
 #: The test ids (ASCII) → the corners' names (:func:`arcosim.control.model_errors.corners`).
@@ -102,3 +103,26 @@ def test_at_rest_the_bank_runs_the_holds_gain_until_the_next_move() -> None:
     assert member.s != state  # stepped on from its own estimates, not restarted
     bank.set_quiet(True)
     assert np.array(member.model(H).K).tolist() == hold_gain.tolist()
+
+
+def test_the_holds_gain_waits_for_the_mass_to_be_still_and_leaves_for_a_load_step() -> None:
+    """EstimatorBank.settle: the hold's gain after HOLD_QUIET_TIME within HOLD_QUIET_ANGLE
+    of the target (not sooner, the clock restarting whenever the estimate strays), the
+    move's back as soon as it is more than HOLD_QUIET_LEAVE off."""
+    chain = params(*CHAINS["bench, two masses"])
+    bank = sensorless_loop(chain, chain, h=H).controller.bank
+    near, far = 0.5 * defaults.HOLD_QUIET_ANGLE, 1.5 * defaults.HOLD_QUIET_LEAVE
+    steps = round(defaults.HOLD_QUIET_TIME / H)
+    for _ in range(steps - 2):
+        bank.settle(H, near)
+    bank.settle(H, 2.0 * defaults.HOLD_QUIET_ANGLE)  # strays: the clock restarts
+    for _ in range(steps - 2):
+        bank.settle(H, near)
+    assert not bank.quiet
+    for _ in range(3):
+        bank.settle(H, near)
+    assert bank.quiet
+    bank.settle(H, 0.5 * (defaults.HOLD_QUIET_ANGLE + defaults.HOLD_QUIET_LEAVE))
+    assert bank.quiet  # between the two: kept
+    bank.settle(H, far)
+    assert not bank.quiet

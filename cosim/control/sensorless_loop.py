@@ -30,7 +30,7 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 #: and clocks (times and the step, which no state feeds back into).
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
-    | {"t", "_moved", "_h", "_still"}
+    | {"t", "_moved", "_h", "still"}
     | {"open_loop", "score", "factors", "_other"}  # the bank's choice: a switch, not a state
 )
 #: When the loop is linearized: this long after the move ends (s).

@@ -25,8 +25,9 @@ move. A load torque, unknown to the open-loop models, grows every member's error
 alike: left to choose at rest, the bank took a load step on the bench's three-mass chain
 for a model error and moved to the wrong members (0.91 mrad left, 0.43 on the chain).
 
-At rest the controller makes every member trust its model more (:meth:`set_quiet`: the
-unmodelled torque × ``defaults.HOLD_TORQUE_NOISE_SCALE``), each gain designed once.
+At rest, while the controlled mass is still (:meth:`settle`), every member trusts its
+model more (:meth:`set_quiet`: the unmodelled torque × ``defaults.HOLD_TORQUE_NOISE_SCALE``),
+each gain designed once.
 """
 
 from __future__ import annotations
@@ -62,6 +63,9 @@ class EstimatorBank:
         The member whose estimates the controller takes.
     quiet : bool
         Whether the members run the hold's gain (:meth:`set_quiet`).
+    still : float
+        How long the controlled mass's estimate has stayed near its target at rest (s,
+        :meth:`settle`).
     move_noise : list of NoiseModel
         Each member's noise model for a move (its own at the start).
 
@@ -92,6 +96,7 @@ class EstimatorBank:
         self.open_loop = [list(m.s) for m in self.members]
         self.score = [0.0] * len(self.members)
         self.quiet = False
+        self.still = 0.0
         self.move_noise = [m.noise for m in self.members]
         self._other: dict[int, dict] = {}
         self.pick = min(
@@ -122,6 +127,8 @@ class EstimatorBank:
         quiet : bool
             True at rest, False for a move.
         """
+        if not quiet:
+            self.still = 0.0
         if quiet == self.quiet:
             return
         scale = defaults.HOLD_TORQUE_NOISE_SCALE
@@ -130,6 +137,25 @@ class EstimatorBank:
             member.noise = dataclasses.replace(noise, torque_noise_std=std) if quiet else noise
             member._models, self._other[j] = self._other.get(j, {}), member._models
         self.quiet = quiet
+
+    def settle(self, h: float, off: float) -> None:
+        """At rest: the hold's gain (:meth:`set_quiet`) once the controlled mass's estimate
+        has stayed within ``defaults.HOLD_QUIET_ANGLE`` of its target for
+        ``defaults.HOLD_QUIET_TIME``, the move's while it is more than
+        ``defaults.HOLD_QUIET_LEAVE`` off (a load step).
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        off : float
+            How far the controlled mass's estimate is from its target (rad), ≥ 0.
+        """
+        self.still = self.still + h if off < defaults.HOLD_QUIET_ANGLE else 0.0
+        if off > defaults.HOLD_QUIET_LEAVE:
+            self.set_quiet(False)
+        elif self.still >= defaults.HOLD_QUIET_TIME:
+            self.set_quiet(True)
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float, choose: bool = True) -> None:
         """Step every member on the sample that ends a step, then choose.

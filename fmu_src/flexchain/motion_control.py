@@ -244,7 +244,6 @@ class MotionController:
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
         self.dither: HoldDither | None = None  # while the hold's dither runs
         self._moved = 0.0  # when the target path last moved (s)
-        self._still = 0.0  # how long the hold has kept the controlled mass near its target (s)
 
     def step(self, h: float, theta_ref: float, i_a: float, omega_m: float, theta_m: float) -> float:
         """Take the sample at t_k and return the current to hold over the next step.
@@ -310,7 +309,7 @@ class MotionController:
 
         It runs from ``defaults.HOLD_DITHER_AFTER`` move times after the target path
         stops until the next move, where the design has one (``dither_current`` > 0);
-        the estimators take the hold's gain once mass L is still (``defaults.HOLD_QUIET_*``).
+        the estimators take the hold's gain while mass L is still (``EstimatorBank.settle``).
         """
         design = self._design_for(h)
         if self.path.moves:
@@ -321,15 +320,11 @@ class MotionController:
         if not (rest and design.dither_current > 0.0):
             self.dither = None
             self.bank.set_quiet(False)
-            self._still = 0.0
             return self.i_ref
         if self.dither is None or self.dither.design.h != h:
             self.dither = HoldDither(design)
             self.dither.start(x[0], x[design.n + 1])
-        near = abs(self.theta_hat_ctrl - self.path.target) < defaults.HOLD_QUIET_ANGLE
-        self._still = self._still + h if near else 0.0
-        if self._still >= defaults.HOLD_QUIET_TIME:
-            self.bank.set_quiet(True)
+        self.bank.settle(h, abs(self.theta_hat_ctrl - self.path.target))
         current, friction = self.dither.command(h)
         # the friction cancelled along the dither's velocity, which the motor follows
         self.i_fb += current + (friction - self.friction) / design.k_t
