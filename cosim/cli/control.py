@@ -49,8 +49,8 @@ chain's ({RANDOM_MODELS} random models and the two corners: all J +e with all k 
 the reverse). The chain given is taken as the truth: "if my identified chain were this
 far off, would the loop still decay?". Exit status 0 when it decays in every case, 1
 when some case decays slower than 0.1 1/s or grows (the verdict names it), 2 for a bad
-input. It simulates 24 moves or more: about 8 s for one mass, 12 s for three, 20-35 s
-for five, 35 s for ten and 130 s for twenty on a 2-core machine (a line on stderr says so).
+input. It simulates 24 moves or more: about 20 s for one mass, 30 s for three, 50-60 s
+for five and 2 min for ten on a 2-core machine, more for twenty (a line on stderr says so).
 
 The chain and the goals under the controller FMU's parameter names:
   --chain FIT.json            J[i], k[i], B[i], D_m, f_c and the masses of a
@@ -136,7 +136,7 @@ def _status(n: int) -> None:
     """The line on stderr before the runs, which take seconds (stdout stays the report's)."""
     print(
         f"arcosim control: simulating {RANDOM_MODELS + 4} moves of the {n}-mass loop and "
-        "linearizing each (seconds: 20-35 s for five masses)…",
+        "linearizing each (about a minute for five masses)…",
         file=sys.stderr,
         flush=True,
     )
