@@ -94,13 +94,19 @@ def test_at_rest_the_bank_runs_the_holds_gain_until_the_next_move() -> None:
     assert bank.quiet
     member = bank.chosen
     hold_gain = np.array(member.model(H).K)
+    scale = member.noise.torque_noise_std / bank.move_noise[bank.pick].torque_noise_std
+    assert scale == pytest.approx(defaults.HOLD_TORQUE_NOISE_SCALE, rel=1e-12)
+    assert hold_gain.tolist() == list(member.design(H).K)  # designed on the scaled noise
     state = list(member.s)
-    controller.step(H, 2.0, *loop.signals[:3])  # a new target: a move starts
-    assert not bank.quiet
+    bank.set_quiet(False)
+    assert member.s == state  # the estimates carry on
     move_gain = np.array(member.model(H).K)
     assert move_gain.tolist() == list(member.design(H).K)
     assert np.linalg.norm(hold_gain) < np.linalg.norm(move_gain)
-    assert member.s != state  # stepped on from its own estimates, not restarted
+    bank.set_quiet(True)
+    controller.step(H, 2.0, *loop.signals[:3])  # a new target: a move starts
+    assert not bank.quiet
+    assert np.array(member.model(H).K).tolist() == move_gain.tolist()
     bank.set_quiet(True)
     assert np.array(member.model(H).K).tolist() == hold_gain.tolist()
 

@@ -23,12 +23,13 @@ from arcosim.fmu.flexchain.control_design import (
 )
 from arcosim.fmu.flexchain.motion_control import shaped_step
 from arcosim.fmu.flexchain.riccati import solve_doubling
+from benchmarks.control_accuracy import CHAINS
 from tests.control_runs import ACTUATOR, BENCH_2, FIVE, closed_loop, observer_params
 
 H = 1e-3
 COUNT = 2 * math.pi / 2000  # one encoder count (rad)
 #: `arcosim bench control`'s four-mass chain: 31.7 rad/(N·m) from the motor to the last mass.
-FOUR = dict(J=(3e-4, 4e-4, 3e-4, 5e-4), k=(0.15, 0.12, 0.15, 0.1), B=(1e-5,) * 4)
+FOUR = {key: getattr(CHAINS[-1], key) for key in ("J", "k", "B")}
 
 
 def _true_loop(design, chain: dict) -> np.ndarray:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -93,7 +94,8 @@ def sensorless_loop(
     (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle and velocity from
     the dither's observer, as in the runs), while the plant's angle stays exact and
     friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts and
-    then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain.
+    then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain (if they
+    never do, it is linearized with the move's, as the FMU would run on).
 
     Parameters
     ----------
@@ -136,15 +138,14 @@ def sensorless_loop(
     loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay, hold)
     wait = (1.0 + defaults.HOLD_DITHER_AFTER) * design.move_time if hold else design.move_time
     steps = round((wait + AFTER_MOVE) / h)
-    window = steps - max(1, round(SETTLE_WINDOW / h))
-    for k in range(steps):
-        advance(loop)
-        if k >= window and not abs(loop.signals[3]) < design.i_max:
-            loop.settled = False
-    for _ in range(round(QUIET_WAIT / h) if hold else 0):
-        if loop.controller.bank.quiet:
+    within = deque(maxlen=max(1, round(SETTLE_WINDOW / h)))  # the command below i_max
+    for k in range(steps + (round(QUIET_WAIT / h) if hold else 0)):
+        if k >= steps and loop.controller.bank.quiet:
             break
         advance(loop)
+        within.append(abs(loop.signals[3]) < design.i_max)
+    if not all(within):
+        loop.settled = False
     L = design.control_mass
     if not abs(loop.plant.x[L] - 1.0) < SETTLE_ANGLE:
         loop.settled = False

@@ -140,10 +140,14 @@ HOLD_DITHER_AFTER = 0.5
 #: to the load estimates, and the feedback moved the motor with them: `bench control`'s
 #: four-mass chain, seeds 1–3, held one count on 0 of 12 runs, on 7, 10, 12 and 11 of 12
 #: at 0.5 (and 0.4), 0.3, 0.2 and 0.1. Switched at the dither's start, with the chain
-#: still ringing, its corners settled 0.7 s later (docs/development.md).
+#: still ringing, its corners settled 0.7 s later (docs/development.md). The factor
+#: (dimensionless):
 HOLD_TORQUE_NOISE_SCALE = 0.2
+#: … how near its target the controlled mass's estimate must stay (rad),
 HOLD_QUIET_ANGLE = 5e-3
+#: … for how long before the hold's gain is taken (s),
 HOLD_QUIET_TIME = 0.3
+#: … and how far off it gives the move's gain back (rad).
 HOLD_QUIET_LEAVE = 20e-3
 #: Bandwidth of the motor-alone observer that averages the de-dithered reading (rad/s):
 #: at 150, with its velocity and the DOB fed from it too, two chains diverged at the J

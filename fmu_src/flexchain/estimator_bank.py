@@ -25,9 +25,10 @@ move. A load torque, unknown to the open-loop models, grows every member's error
 alike: left to choose at rest, the bank took a load step on the bench's three-mass chain
 for a model error and moved to the wrong members (0.91 mrad left, 0.43 on the chain).
 
-At rest, while the controlled mass is still (:meth:`settle`), every member trusts its
-model more (:meth:`set_quiet`: the unmodelled torque × ``defaults.HOLD_TORQUE_NOISE_SCALE``),
-each gain designed once.
+At rest, while the hold's dither runs and the controlled mass is still (:meth:`settle`;
+never without an encoder or with ``hold_dither`` 0), every member trusts its model more
+(:meth:`set_quiet`: the unmodelled torque × ``defaults.HOLD_TORQUE_NOISE_SCALE``), each
+gain designed once.
 """
 
 from __future__ import annotations
@@ -139,10 +140,12 @@ class EstimatorBank:
         self.quiet = quiet
 
     def settle(self, h: float, off: float) -> None:
-        """At rest: the hold's gain (:meth:`set_quiet`) once the controlled mass's estimate
-        has stayed within ``defaults.HOLD_QUIET_ANGLE`` of its target for
-        ``defaults.HOLD_QUIET_TIME``, the move's while it is more than
-        ``defaults.HOLD_QUIET_LEAVE`` off (a load step).
+        """Choose the gain at rest from how near the controlled mass's estimate stays.
+
+        The hold's gain (:meth:`set_quiet`) once the estimate has stayed within
+        ``defaults.HOLD_QUIET_ANGLE`` of its target for ``defaults.HOLD_QUIET_TIME``; the
+        move's while it is more than ``defaults.HOLD_QUIET_LEAVE`` off (a load step);
+        between the two, the gain it has.
 
         Parameters
         ----------
