@@ -94,7 +94,7 @@ def test_at_rest_the_bank_runs_the_holds_gain_until_the_next_move() -> None:
     assert bank.quiet
     member = bank.chosen
     hold_gain = np.array(member.model(H).K)
-    scale = member.noise.torque_noise_std / bank.move_noise[bank.pick].torque_noise_std
+    scale = member.noise.torque_noise_std / bank.move_noise.torque_noise_std
     assert scale == pytest.approx(defaults.HOLD_TORQUE_NOISE_SCALE, rel=1e-12)
     assert hold_gain.tolist() == list(member.design(H).K)  # designed on the scaled noise
     state = list(member.s)

@@ -36,7 +36,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from operator import mul
 
 from . import defaults
 from .load_observer import LoadTorqueObserver
@@ -67,8 +66,8 @@ class EstimatorBank:
     still : float
         How long the controlled mass's estimate has stayed near its target at rest (s,
         :meth:`settle`).
-    move_noise : list of NoiseModel
-        Each member's noise model for a move (its own at the start).
+    move_noise : NoiseModel
+        The members' noise model for a move (the estimator's).
 
     Examples
     --------
@@ -98,7 +97,7 @@ class EstimatorBank:
         self.score = [0.0] * len(self.members)
         self.quiet = False
         self.still = 0.0
-        self.move_noise = [m.noise for m in self.members]
+        self.move_noise = estimator.noise
         self._other: dict[int, dict] = {}
         self.pick = min(
             range(len(self.factors)),
@@ -132,10 +131,12 @@ class EstimatorBank:
             self.still = 0.0
         if quiet == self.quiet:
             return
-        scale = defaults.HOLD_TORQUE_NOISE_SCALE
-        for j, (member, noise) in enumerate(zip(self.members, self.move_noise)):
-            std = noise.torque_noise_std * scale
-            member.noise = dataclasses.replace(noise, torque_noise_std=std) if quiet else noise
+        noise = self.move_noise
+        if quiet:
+            std = noise.torque_noise_std * defaults.HOLD_TORQUE_NOISE_SCALE
+            noise = dataclasses.replace(noise, torque_noise_std=std)
+        for j, member in enumerate(self.members):
+            member.noise = noise
             member._models, self._other[j] = self._other.get(j, {}), member._models
         self.quiet = quiet
 
@@ -195,11 +196,5 @@ class EstimatorBank:
         """Advance member ``j``'s open-loop model (its step model without the Kalman
         correction, on the member's own previous motor angle) and return τ̂_reac less
         its prediction (N·m). Call before the member's own step."""
-        sm = member.model(h)
-        u = theta_m - member.theta0
-        w0, w1 = member.u_prev, (u - member.u_prev) / h
-        s = self.open_loop[j]
-        self.open_loop[j] = s = [
-            sum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
-        ]
+        self.open_loop[j] = s = member.predict(h, theta_m, self.open_loop[j])
         return tau_reac_hat - s[-1]

@@ -271,6 +271,41 @@ class ModelObserver:
         """The step model for ``h`` (:func:`step_model`; subclasses add states)."""
         return step_model(self.J, self.k, self.B, self.g_dist, self.noise, h)
 
+    def predict(self, h: float, theta_m: float, s: Sequence[float]) -> list[float]:
+        """The step model's state at this sample from the state ``s`` at the previous
+        one, without the Kalman correction.
+
+        The motor's angle enters as the model's input over the step: from this
+        estimator's previous sample (``u_prev``) to ``theta_m``.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        theta_m : float
+            The measured motor angle at this sample (rad).
+        s : Sequence[float]
+            A state at the previous sample, as :attr:`s` (its shape).
+
+        Returns
+        -------
+        list of float
+            The predicted state, its last entry the predicted τ̂_reac (N·m).
+
+        Examples
+        --------
+        >>> noise = NoiseModel(theta_noise_std=1e-3, torque_noise_std=1e-3, tau_noise_std=1e-3)
+        >>> est = ModelObserver((5e-4,), (0.16,), (1e-5,), 500.0, noise, 0.0)
+        >>> est.predict(1e-3, 0.0, est.s)  # at rest, nothing moves
+        [0.0, 0.0, 0.0]
+        """
+        sm = self._models.get(h) or self.model(h)
+        u = theta_m - self.theta0
+        w0, w1 = self.u_prev, (u - self.u_prev) / h
+        return [
+            math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
+        ]
+
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
         """Take the sample that ends a step.
 
@@ -284,16 +319,11 @@ class ModelObserver:
             The measured motor angle (rad).
         """
         sm = self._models.get(h) or self.model(h)
-        u = theta_m - self.theta0
-        w0, w1 = self.u_prev, (u - self.u_prev) / h
-        s = self.s
-        pred = [
-            math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
-        ]
+        pred = self.predict(h, theta_m, self.s)
         e = tau_reac_hat - pred[-1]
         self.s = s = [p + kk * e for p, kk in zip(pred, sm.K)]
         self.innovation = e
-        self.u_prev = u
+        self.u_prev = theta_m - self.theta0
         n = self.n
         t0 = self.theta0
         self.theta = [t0 + x for x in s[:n]]

@@ -157,11 +157,8 @@ def settle_sticking(
     theta_m : float
         The motor angle the estimator takes at the sample (rad).
     """
-    sm = est.model(h)
-    u = theta_m - est.theta0
-    w = (est.u_prev, (u - est.u_prev) / h)
     a = lowpass_pole(dob.g, h)
-    predicted = (_dot(sm.F[-1], est.s) + _dot(sm.Gamma[-1], w) - a * est.s[-1]) / (1.0 - a)
+    predicted = (est.predict(h, theta_m, est.s)[-1] - a * est.s[-1]) / (1.0 - a)
     f_c = dob.actuator.f_c
     torque = min(max(predicted, dob.drive - f_c), dob.drive + f_c)
     dob.tau_reac_hat += (1.0 - a) * (torque - dob.torque)
