@@ -132,3 +132,25 @@ def test_the_holds_gain_waits_for_the_mass_to_be_still_and_leaves_for_a_load_ste
     assert bank.quiet  # between the two: kept
     bank.settle(H, far)
     assert not bank.quiet
+
+
+def test_the_jacobian_leaves_the_loop_as_it_was() -> None:
+    """The copies it steps share the loop's designs (frozen) but change nothing of it:
+    every float of the loop, and every design, is the same after as before."""
+    from arcosim.control.sensorless_loop import _leaves
+
+    chain = params(*CHAINS["bench, two masses"])
+    loop = sensorless_loop(chain, chain, h=H)
+    paths = _leaves(loop, skip=frozenset())
+    before = [_value(loop, p) for p in paths]
+    member = loop.controller.bank.chosen
+    models = dict(member._models)
+    sensorless_jacobian(loop)
+    assert [_value(loop, p) for p in paths] == before
+    assert member._models == models and all(member._models[h] is models[h] for h in models)
+
+
+def _value(root, path):
+    for key in path:
+        root = root[key] if isinstance(root, (dict, list)) else getattr(root, key)
+    return root
