@@ -10,6 +10,7 @@ the build trial (default 1 round here; the report's figures come from more).
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -122,16 +123,17 @@ def test_a_refusal_names_a_holder_that_has_just_taken_the_lock(tmp_path: Path) -
 @pytest.mark.slow
 def test_two_sweeps_into_one_folder_run_every_run_once(build_fmus, tmp_path: Path) -> None:
     """Two fresh starts at once and a --resume while they run: one sweep runs, the
-    others are refused naming it, and every run is in the results once. The sweep runs
-    for about 10 s (six runs of 60 s): with runs of 1 s (3.3 s, most of it the sweep's
-    start) a --resume started under load, about 2 s of imports when idle, found it
-    finished and exited 0."""
+    others are refused naming it, and every run is in the results once. The holder is
+    stopped (SIGSTOP) while the --resume runs, so that it cannot finish first: a --resume
+    started under load (about 2 s of imports when idle) found a holder of a few seconds
+    finished and exited 0, and a longer sweep (six runs of 60 s, about 10 s) only
+    narrowed that race."""
     from arcosim.sweeps.summary import read_results
 
     build_fmus(3)
     spec = tmp_path / "spec.toml"
     runs = 6
-    spec.write_text(SPEC.format(duration=60.0, runs=runs))
+    spec.write_text(SPEC.format(duration=1.0, runs=runs))
     out = tmp_path / "out"
     lock = out / ".arcosim-sweep.lock"
     fresh = [arcosim("sweep", spec, "--out", out, "--workers", 1, "--no-progress") for _ in "ab"]
@@ -140,8 +142,13 @@ def test_two_sweeps_into_one_folder_run_every_run_once(build_fmus, tmp_path: Pat
         assert time.monotonic() < deadline, [p.poll() for p in fresh]
         time.sleep(0.05)
     holder = int(lock.read_text().split()[1])
-    resume = arcosim("sweep", spec, "--out", out, "--workers", 1, "--resume", "--no-progress")
-    results = {p.pid: finish(p) for p in (*fresh, resume)}
+    os.kill(holder, signal.SIGSTOP)  # alive and holding the lock, but not finishing
+    try:
+        resume = arcosim("sweep", spec, "--out", out, "--workers", 1, "--resume", "--no-progress")
+        results = {resume.pid: finish(resume)}
+    finally:
+        os.kill(holder, signal.SIGCONT)
+    results.update({p.pid: finish(p) for p in fresh})
     assert results[holder][0] == 0, results[holder][2]
     for pid, (code, _, err) in results.items():
         if pid != holder:
