@@ -36,17 +36,14 @@ from arcosim.experiments.motion_experiment import (
     Runs,
     design_parameters,
     identify_chain,
-    model_errors,
     scaled,
     sensorless,
 )
+from arcosim.experiments.motion_findings import UPPER_BOUND_FACTOR
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.estimator_bank import EstimatorBank
 from arcosim.fmu.flexchain.motion_control import MotionController
-from benchmarks.control_accuracy import CHAINS, score
-
-#: The criterion's factor on the upper bound's settling time.
-NEAR = 1.3
+from benchmarks.control_accuracy import CHAINS, score, seed_models
 
 
 class WithoutLoadTorque(MotionController):
@@ -83,14 +80,10 @@ def reach(chain_index: int, seeds: Sequence[int]) -> list[dict[str, object]]:
     for seed in seeds:
         params = design_parameters(identify_chain(folder, chain, False, seed), False)
         runs = Runs(folder, chain, False, seed=seed)
-        errors = list(model_errors(chain.n, (seed,)).items())
-        models = [("identified", (np.ones(chain.n), np.ones(chain.n)))]
-        models += errors if seed == seeds[0] else errors[:1]
-        for label, (fJ, fk) in models:
+        for label, (fJ, fk) in seed_models(chain.n, seed, seed == seeds[0]).items():
             wrong = scaled(params, fJ, fk)
             shipped = sensorless(wrong)
-            name = "random" if label.startswith("random") else label
-            row: dict[str, object] = {"seed": seed, "model": name}
+            row: dict[str, object] = {"seed": seed, "model": label}
             row["bound"] = settling(runs, sensorless(wrong), full_state=True)
             row["shipped"] = settling(runs, shipped)
             row["chosen"] = shipped.bank.factors[shipped.bank.pick]
@@ -113,7 +106,7 @@ def _line(row: dict[str, object]) -> str:
 
 
 def markdown(rows: list[dict[str, object]]) -> str:
-    """The table and the counts within NEAR × the bound."""
+    """The table and the counts within UPPER_BOUND_FACTOR × the bound."""
     header = [
         "seed",
         "model",
@@ -139,11 +132,12 @@ def markdown(rows: list[dict[str, object]]) -> str:
     ]
 
     def within(key: str) -> int:
-        return sum(float(r[key]) <= NEAR * float(r["bound"]) for r in rows)
+        return sum(float(r[key]) <= UPPER_BOUND_FACTOR * float(r["bound"]) for r in rows)
 
     counts = (
-        f"Within {NEAR} × the bound, of {len(rows)}: as shipped {within('shipped')}, the best "
-        f"fixed member {within('best')}, without d̂ {within('without_d')}."
+        f"Within {UPPER_BOUND_FACTOR:g} × the bound, of {len(rows)}: as shipped "
+        f"{within('shipped')}, the best fixed member {within('best')}, without d̂ "
+        f"{within('without_d')}."
     )
     return markdown_table(header, body) + "\n\n" + counts + "\n"
 

@@ -85,11 +85,8 @@ def score_seed(
         return score(run, encoder_cpr)
 
     cascade = _score(runs.run(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX)))
-    errors = model_errors(chain.n, (seed,))
-    models = {"identified": (np.ones(chain.n), np.ones(chain.n))}
-    models.update(list(zip(MODELS[1:], errors.values()))[: 3 if corners else 1])
     out = {}
-    for label, (fJ, fk) in models.items():
+    for label, (fJ, fk) in seed_models(chain.n, seed, corners).items():
         wrong = scaled(params, fJ, fk)
         moving = _score(runs.run(sensorless(wrong)))
         upper = _score(runs.run(sensorless(wrong), full_state=True))
@@ -100,6 +97,22 @@ def score_seed(
             "criteria": done_when(moving, cascade, upper),
         }
     return out
+
+
+def seed_models(n: int, seed: int, corners: bool) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The models one seed is designed on, by :data:`MODELS` name: the factors on every J_i
+    and k_i (dimensionless, shape ``(n,)`` each) of the identified chain, the seed's random
+    errors and, when ``corners``, the two corners.
+
+    Examples
+    --------
+    >>> list(seed_models(2, 1, corners=False))
+    ['identified', 'random errors']
+    """
+    errors = model_errors(n, (seed,))
+    models = {"identified": (np.ones(n), np.ones(n))}
+    models.update(list(zip(MODELS[1:], errors.values()))[: 3 if corners else 1])
+    return models
 
 
 def score(run: LoopRun, encoder_cpr: int = ENCODER_CPR) -> MoveScore:
