@@ -54,15 +54,20 @@ class WithoutLoadTorque(MotionController):
 
 
 def fixed(params: dict[str, float], member: int) -> MotionController:
-    """The controller on ``params`` with the bank's member ``member`` taken throughout."""
+    """The controller on ``params`` with the bank's member ``member`` taken throughout,
+    as it is (not refined from the move)."""
     controller = sensorless(params)
     bank = controller.bank
     bank.pick = member
 
-    def step(h: float, tau_reac_hat: float, theta_m: float, choose: bool = True) -> None:
+    def step(h: float, tau_reac_hat: float, theta_m: float, *_: object) -> None:
         EstimatorBank.step(bank, h, tau_reac_hat, theta_m, False)
 
-    bank.step = step
+    def restart() -> None:
+        EstimatorBank.restart(bank)
+        bank.record = None  # nor refined from the move (move_fit)
+
+    bank.step, bank.restart = step, restart
     return controller
 
 

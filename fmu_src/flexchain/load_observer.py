@@ -177,6 +177,61 @@ def check_load_settings(n: int, load_mass: int, bandwidth: float) -> None:
         raise ValueError(f"load torque bandwidth {bandwidth!r} rad/s: it must be > 0")
 
 
+def load_prediction(
+    J: Sequence[float],
+    k: Sequence[float],
+    B: Sequence[float],
+    g_dist: float,
+    h: float,
+    load_mass: int,
+) -> tuple[Matrix, Matrix]:
+    """The step model with the load torque and the DOB's filter, without a Kalman gain.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape
+        ``(n,)`` each.
+    g_dist : float
+        DOB bandwidth (rad/s).
+    h : float
+        Step (s).
+    load_mass : int
+        The mass the torque acts on, 1 … n (an index).
+
+    Returns
+    -------
+    tuple of (list of list of float, list of list of float)
+        ``F``, shape ``(m, m)`` with m = 2n + 2, and ``Γ``, shape ``(m, 2)``: the state
+        ``[θ_1…θ_n, ω_1…ω_n, d, y]`` steps as ``F s + Γ [u_prev, (u − u_prev) / h]``
+        (module doc).
+
+    Examples
+    --------
+    >>> F, Gamma = load_prediction((5e-4,), (0.16,), (1e-5,), 100.0, 1e-3, 1)
+    >>> len(F), len(Gamma[0]), F[2][2]  # d is a random walk: held over the step
+    (4, 2, 1.0)
+    """
+    n = len(J)
+    chain = discretize(J, k, B, h)
+    b_d = load_column(J, k, B, h, load_mass)
+    m = 2 * n + 2
+    a = lowpass_pole(g_dist, h)
+    b = 1.0 - a
+    c, du = chain.torque_row()
+    e_d = math.fsum(J[i] / h * b_d[n + i] for i in range(n)) - 1.0  # τ̄ per unit d over the step
+    F = linalg.zeros(m, m)
+    for i in range(2 * n):
+        F[i][: 2 * n] = chain.Ad[i][:]
+        F[i][2 * n] = b_d[i]
+    F[2 * n][2 * n] = 1.0
+    F[m - 1][: 2 * n] = [b * x for x in c]
+    F[m - 1][2 * n] = b * e_d
+    F[m - 1][m - 1] = a
+    Gamma = [row[:] for row in chain.Bd] + [[0.0, 0.0], [b * du[0], b * du[1]]]
+    return F, Gamma
+
+
 def load_step_model(
     J: Sequence[float],
     k: Sequence[float],
@@ -218,26 +273,12 @@ def load_step_model(
     """
     n = len(J)
     check_load_settings(n, load_mass, bandwidth)
-    chain = discretize(J, k, B, h)
-    b_d = load_column(J, k, B, h, load_mass)
+    F, Gamma = load_prediction(J, k, B, g_dist, h, load_mass)
     m = 2 * n + 2
-    a = lowpass_pole(g_dist, h)
-    b = 1.0 - a
-    c, du = chain.torque_row()
-    e_d = math.fsum(J[i] / h * b_d[n + i] for i in range(n)) - 1.0  # τ̄ per unit d over the step
-    F = linalg.zeros(m, m)
-    for i in range(2 * n):
-        F[i][: 2 * n] = chain.Ad[i][:]
-        F[i][2 * n] = b_d[i]
-    F[2 * n][2 * n] = 1.0
-    F[m - 1][: 2 * n] = [b * x for x in c]
-    F[m - 1][2 * n] = b * e_d
-    F[m - 1][m - 1] = a
-    Gamma = [row[:] for row in chain.Bd] + [[0.0, 0.0], [b * du[0], b * du[1]]]
     Q = chain_process_noise(Gamma, J, noise, h)
     r = measurement_noise(noise)
     q = (bandwidth * math.sqrt(r) * h) ** 2  # the random walk's increment variance
-    g = [*b_d, 1.0, b * e_d]  # where an increment of d goes within the step
+    g = [F[i][2 * n] for i in range(m)]  # where an increment of d goes within the step
     for i in range(m):
         for j in range(m):
             Q[i][j] += q * g[i] * g[j]

@@ -241,6 +241,8 @@ class MotionController:
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
         self.dither: HoldDither | None = None  # while the hold's dither runs
         self._moved = 0.0  # when the target path last moved (s)
+        self._first_move = True
+        self._refine_after = defaults.REFINE_AT * d.move_time  # after a move's start (s)
 
     def step(self, h: float, theta_ref: float, i_a: float, omega_m: float, theta_m: float) -> float:
         """Take the sample at t_k and return the current to hold over the next step.
@@ -275,7 +277,8 @@ class MotionController:
         if self.crossed is not None:
             omega_m = self.crossed.step(h, theta_m)
             motion = self.crossed.edge - self.offset
-        dob.step(h, i_a, omega_m, motion, self._reference_heading())
+        reference_heading = self._reference_heading()
+        dob.step(h, i_a, omega_m, motion, reference_heading)
         th_m = theta_m + self.offset - t0
         dither = self.dither
         if dither is None:
@@ -291,8 +294,12 @@ class MotionController:
         if dob.sticking:
             settle_sticking(dob, est, h, drive)
         choosing = self.t - self._moved < defaults.BANK_CHOICE_AFTER * self.design.move_time
-        self.bank.step(h, dob.tau_reac_hat, drive, choosing)
-        est = self.bank.chosen
+        bank = self.bank
+        bank.step(h, dob.tau_reac_hat, drive, choosing, reference_heading)
+        record = bank.record
+        if record is not None and record.elapsed >= self._refine_after - 0.5 * h:
+            bank.refine()  # every J_i and k_i from the move so far (move_fit)
+        est = bank.chosen
         # the motor's own states as measured: its observer's (model-based) estimates of
         # them cost the loop its stability under a 10 % model error (docs/control.md)
         x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]
@@ -310,8 +317,9 @@ class MotionController:
         """
         design = self._design_for(h)
         if self.path.moves:
-            if self.t - self._moved > 1.5 * h:  # a move starts: the bank chooses anew
-                self.bank.restart()
+            if self._first_move or self.t - self._moved > 1.5 * h:  # a move starts:
+                self.bank.restart()  # the bank chooses and records anew
+                self._first_move = False
             self._moved = self.t
         rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
         if not (rest and design.dither_current > 0.0):
