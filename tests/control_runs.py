@@ -138,7 +138,13 @@ def closed_loop(
         theta_meas = new
     a = np.array(rows)
     return Run(
-        a[:, 0], a[:, 1 : n + 2], a[:, n + 2], a[:, n + 3], a[:, n + 4], a[:, n + 5], a[:, n + 6],
+        a[:, 0],
+        a[:, 1 : n + 2],
+        a[:, n + 2],
+        a[:, n + 3],
+        a[:, n + 4],
+        a[:, n + 5],
+        a[:, n + 6],
         extra={"controller": ctrl},
     )
 
