@@ -119,8 +119,10 @@ def test_a_refusal_keeps_the_member():
     bank.restart()
     for sample in move_samples(TRUE_J, TRUE_K):
         bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 0.0)  # no heading
-    before = bank.chosen
-    assert bank.refine() is None and bank.chosen is before and bank.refined
+    before, scores = bank.chosen, list(bank.score)
+    assert bank.refine() is None and bank.chosen is before and not bank.refined
+    bank.step(H, 0.0, 0.7, True, 0.0)  # the choice goes on as without the refinement
+    assert bank.score != scores and bank.record is None
 
 
 #: The four-mass chain of ``arcosim bench control`` (modes from about 10 rad/s).
@@ -141,3 +143,30 @@ def test_the_controller_refines_towards_the_plant(a, b):
     chosen = bank.chosen
     for found, true in zip(chosen.J + chosen.k, FOUR["J"] + FOUR["k"]):
         assert abs(math.log(found / true)) < 0.03
+
+
+def test_a_model_that_already_predicts_the_move_is_not_refitted():
+    # the truth's own model: its error is the filter's rounding, far below the evidence
+    # the fit asks for (a few units of the noise on τ̂_reac)
+    samples = move_samples(TRUE_J, TRUE_K)
+    assert fit_chain(estimator(TRUE_J, TRUE_K), samples) is None
+
+
+def test_a_refined_bank_keeps_its_fit_on_a_weak_move_and_rests_its_choice():
+    model_J = tuple(j * e for j, e in zip(TRUE_J, J_ERR))
+    model_k = tuple(k * e for k, e in zip(TRUE_K, K_ERR))
+    bank = EstimatorBank(estimator(model_J, model_k))
+    strong = move_samples(TRUE_J, TRUE_K, duration=0.7, move_time=0.5)  # a faster move
+    bank.restart()
+    for sample in strong:
+        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 1.0)
+    first = bank.refine()
+    assert first is not None and first.cost_before > defaults.REFINE_AGAIN
+    refined, beliefs = bank.chosen, list(bank.beliefs)
+    # the next move: the refined model predicts it within REFINE_AGAIN, so no refit; the
+    # choice rests for good once a member was refined
+    bank.restart()
+    for sample in move_samples(TRUE_J, TRUE_K):
+        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 1.0)
+    assert bank.score == [0.0] * len(bank.members)  # not scored: the choice rests
+    assert bank.refine() is None and bank.chosen.J == refined.J and bank.beliefs == beliefs

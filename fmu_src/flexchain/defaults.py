@@ -118,9 +118,10 @@ BANK_HYSTERESIS = 0.3
 BANK_CHOICE_AFTER = 0.5
 #: The bank refines its chosen model's every J_i and k_i from a move's response
 #: (:mod:`~arcosim.fmu.flexchain.move_fit`) this share of the move time after the move's
-#: start (dimensionless). On `arcosim bench control`'s four-mass chain (20 seeds, 42 runs)
-#: 0.6, 0.7 and 0.8 met all four criteria on 36, 38 and 35 (none, 23): the choice is
-#: within the counts' noise; later leaves the feedback less time, earlier less data.
+#: start (dimensionless). On `arcosim bench control`'s four-mass chain (20 seeds, 42 runs;
+#: a prototype) 0.6, 0.7 and 0.8 met all four criteria on 36, 38 and 35 (none, 23): the
+#: choice is within the counts' noise; later leaves the feedback less time, earlier less
+#: data (docs/development.md).
 REFINE_AT = 0.7
 #: The fit's low-pass on the open-loop error of τ̂_reac (rad/s): above the chain's modes,
 #: below the encoder's noise in the DOB's acceleration.
@@ -136,9 +137,26 @@ REFINE_TRUST_AFTER = 0.05
 REFINE_MASS_SPREAD = 0.075
 #: … and the common factors on every J_i and every k_i (dimensionless).
 REFINE_COMMON_SPREAD = 0.5
-#: The fit refuses a move with fewer trusted samples than this …
-REFINE_MIN_TRUSTED = 50
-#: … and factors outside this range (dimensionless).
+#: The time each sample's squared error stands for in the fit's cost (s): the cost is an
+#: integral over the record, whatever the step.
+REFINE_DATA_TIME = 1e-3
+#: The fit refuses a move whose trusted samples span less than this (s) …
+REFINE_MIN_TRUSTED_TIME = 0.05
+#: … whose model as it stands misses τ̂_reac by less than this cost (the data's half sum
+#: of squares in units of the noise on τ̂_reac; dimensionless): the move does not tell
+#: the model's errors from the noise (on the four-mass chain of `arcosim bench control` the
+#: identified chain's cost was 0.5–1.2, ±10 % models' 1.7–177) …
+REFINE_MIN_EVIDENCE = 3.0
+#: … the least cost at which a member already refined refits (dimensionless): a later
+#: move starts from a hold's estimates, not from rest, and a fit on the four-mass chain's
+#: return moves (cost 5–7) took the model from 1.8 % to 5–8 % off the plant …
+REFINE_AGAIN = 20.0
+#: … whose fitted model still misses it by more than this rms (in units of that noise,
+#: over the trusted time; dimensionless): the chain model cannot explain the data (there,
+#: 0.033–0.060 after every fit; a master alternating 1 and 0.5 ms steps left 0.40) …
+REFINE_MAX_MISFIT = 0.15
+#: … and factors outside this range from the member's model as first built
+#: (dimensionless).
 REFINE_FACTOR_RANGE = (0.5, 2.0)
 #: At most this many Levenberg–Marquardt iterations …
 REFINE_ITERATIONS = 10

@@ -31,8 +31,11 @@ records the move (:class:`~arcosim.fmu.flexchain.move_fit.MoveRecord`, from
 calls :meth:`refine`: the chosen member's every J_i and k_i are fitted to the move's
 τ̂_reac (:func:`~arcosim.fmu.flexchain.move_fit.fit_chain`), the member is replaced by
 the estimator on the fitted chain run over the move from the member's state at its
-start, and the choice ends until the next move. On `arcosim bench control`'s four-mass
-chain this took the runs meeting all four criteria from 23 to 37 of 42.
+start, and the choice rests for good: a later move starts from a hold's estimates, not
+from rest, and its data took a refined model away from the plant, so a refined member
+refits only where a move shows its model wrong well above the noise
+(``defaults.REFINE_AGAIN``). On `arcosim bench control`'s four-mass
+chain this took the runs meeting all four criteria from 23 to 36 of 42.
 
 At rest, while the hold's dither runs and the controlled mass is still (:meth:`settle`;
 never without an encoder or with ``hold_dither`` 0), every member trusts its model more
@@ -48,7 +51,7 @@ import math
 
 from . import defaults
 from .load_observer import LoadTorqueObserver
-from .move_fit import ChainFit, MoveRecord, fit_chain
+from .move_fit import Belief, ChainFit, MoveRecord, fit_chain
 
 
 class EstimatorBank:
@@ -78,6 +81,20 @@ class EstimatorBank:
         :meth:`settle`).
     move_noise : NoiseModel
         The members' noise model for a move (the estimator's).
+    origins : list of tuple
+        Each member's (J, k) as built (kg·m², N·m/rad), what its refinements count from.
+    beliefs : list of Belief or None
+        What the moves told of each member's refinement (None: nothing yet).
+    record : MoveRecord or None
+        The move since :meth:`restart`, until :meth:`refine`.
+    starts : list of LoadTorqueObserver
+        Each member as it was at the move's start, until :meth:`refine`.
+    fit : ChainFit or None
+        The last :meth:`refine`'s fit (None: none, or refused).
+    refined : bool
+        Whether the chosen member was refined from this move (the choice then rests).
+    settled : bool
+        Whether a member was ever refined: the choice then rests for good.
 
     Examples
     --------
@@ -103,6 +120,10 @@ class EstimatorBank:
                 member._models = {}  # designed on first use for the scaled chain
                 self.members.append(member)
                 self.factors.append((a, b))
+        # each member's model as built: what its refinements are counted from (move_fit)
+        self.origins = [(m.J, m.k) for m in self.members]
+        self.beliefs: list[Belief | None] = [None] * len(self.members)  # what moves told
+        self.settled = False  # refined once: the choice rests for good
         self.open_loop = [list(m.s) for m in self.members]
         self.score = [0.0] * len(self.members)
         self.record: MoveRecord | None = None  # from a move's start until refine()
@@ -129,18 +150,22 @@ class EstimatorBank:
         self.open_loop = [list(m.s) for m in self.members]
         self.score = [0.0] * len(self.members)
         self.record = MoveRecord()
-        self.starts = [copy.copy(m) for m in self.members]  # steps replace, not mutate, their lists
+        # the steps replace the members' lists rather than change them, so a shallow
+        # copy keeps each state at the move's start (the step-model cache, _models, is
+        # shared; the fit does not use it)
+        self.starts = [copy.copy(m) for m in self.members]
         self.fit = None
         self.refined = False
 
     def refine(self) -> ChainFit | None:
         """Refine the chosen member's every J_i and k_i from the move so far, and end the
-        choice and the record until the next :meth:`restart`.
+        record until the next :meth:`restart`.
 
         The member is replaced by the estimator on the refined chain, run over the move's
         samples from the chosen member's state at the move's start
-        (:func:`~arcosim.fmu.flexchain.move_fit.fit_chain`); where the fit refuses, the
-        member stays as it was.
+        (:func:`~arcosim.fmu.flexchain.move_fit.fit_chain`, its prior centred on the
+        member's model as built), and the choice ends until the next move; where the fit
+        refuses, the member stays as it was and the choice goes on.
 
         Returns
         -------
@@ -150,15 +175,23 @@ class EstimatorBank:
         record, self.record = self.record, None
         if record is None or self.refined:
             return None
-        self.refined = True
         start = self.starts[self.pick]
         self.starts = []
-        self.fit = fit = fit_chain(start, record.samples)
-        if fit is None:
+        try:
+            belief = self.beliefs[self.pick]
+            # once refined, a member refits only where a move shows its model wrong well
+            # above the noise (later moves start from a hold's estimates, not from rest)
+            evidence = defaults.REFINE_MIN_EVIDENCE if belief is None else defaults.REFINE_AGAIN
+            fit = fit_chain(start, record.samples, self.origins[self.pick], belief, evidence)
+        except ValueError:  # a singular step of the fit: no refinement, no crash
+            fit = None
+        self.fit = fit
+        if fit is None:  # the choice goes on as it would have
             return None
+        self.refined = self.settled = True
+        self.beliefs[self.pick] = fit.belief
         refined = copy.copy(start)
-        refined.J = tuple(a * f for a, f in zip(start.J, fit.J_factors))
-        refined.k = tuple(a * f for a, f in zip(start.k, fit.k_factors))
+        refined.J, refined.k = fit.J, fit.k
         refined._models = {}
         refined.noise = self.members[self.pick].noise
         for sample in record.samples:
@@ -240,7 +273,7 @@ class EstimatorBank:
         """
         if self.record is not None:
             self.record.step(h, tau_reac_hat, theta_m, heading)
-        if self.refined:  # the choice is over until the next move
+        if self.refined or self.settled:  # the choice is over (module doc)
             choose = False
         if not choose:  # the scores and open-loop models are restarted before they count
             for member in self.members:

@@ -5,8 +5,9 @@ factor and every k_i by another: errors that differ from mass to mass change the
 mode shapes, which no such pair reproduces, and on a four-mass chain with independent
 ±10 % errors the controller then settled up to 2 × slower than the same gains on the
 true states (docs/development.md). A move excites the chain enough to tell them apart:
-:class:`MoveRecord` keeps, from the move's start, what the bank's estimators take (τ̂_reac
-and the motor angle, each step), and :func:`fit_chain` finds the factors on every J_i
+:class:`~arcosim.fmu.flexchain.move_record.MoveRecord` keeps, from the move's start,
+what the bank's estimators take (τ̂_reac and the motor angle, each step), and
+:func:`fit_chain` finds the factors on every J_i
 and k_i whose model, run open loop from the estimator's state at the move's start,
 predicts that τ̂_reac best.
 
@@ -33,9 +34,14 @@ What it fits, and what it leaves out:
   the prior, fits reached factors of 0.2–2.2 for a cost below the truth's).
 
 The fit is Levenberg–Marquardt on these residuals with forward-difference Jacobians
-(2n open-loop runs per iteration; the common factors' columns are sums of the masses').
-It refuses (returns ``None``) a record with fewer than ``defaults.REFINE_MIN_TRUSTED``
-trusted samples and a fit that leaves a factor outside ``defaults.REFINE_FACTOR_RANGE``.
+(2n open-loop runs per iteration; the common factors' columns are sums of the masses'),
+each sample weighted by the time it stands for. What a fit learnt (its :class:`Belief`:
+the parameters and their precision) is the next fit's prior, and the factors count from
+the member's model as first built. It refuses (returns ``None``) what the data cannot
+support: trusted samples spanning less than ``defaults.REFINE_MIN_TRUSTED_TIME``, a
+model that already predicts the move within the noise (``defaults.REFINE_MIN_EVIDENCE``),
+factors outside ``defaults.REFINE_FACTOR_RANGE``, a fit that still misses the data
+(``defaults.REFINE_MAX_MISFIT``).
 """
 
 from __future__ import annotations
@@ -47,93 +53,42 @@ from operator import mul
 
 from . import defaults, linalg
 from .load_observer import LoadTorqueObserver, load_prediction, smoothing_filter
+from .move_record import MoveRecord, Sample
+
+__all__ = ["Belief", "ChainFit", "MoveRecord", "Sample", "fit_chain", "open_loop_errors"]
 
 
 @dataclass(frozen=True)
-class Sample:
-    """One step of a move as the bank's estimators took it.
+class Belief:
+    """What the fit knows of the parameters ``p = [c_J, c_k, δJ_1…δJ_n, δk_1…δk_n]``
+    (module doc): a Gaussian of this mean and precision.
+
+    Before any move it is the prior (mean 0, the spreads' inverse squares on the
+    diagonal); after a fit, the fit (its mean) and the data's information added to what
+    was known (``JᵀJ`` + the precision before), so that the next move's data move the
+    parameters only as far as they are less well known.
 
     Attributes
     ----------
-    h : float
-        The step (s).
-    tau_reac_hat : float
-        τ̂_reac at its end (N·m).
-    theta_m : float
-        The motor angle the estimators took there (rad).
-    trusted : bool
-        Whether the DOB's friction was known over the last
-        ``defaults.REFINE_TRUST_AFTER`` s (module doc).
+    mean : tuple of float
+        Shape ``(2n + 2,)`` (dimensionless, log factors).
+    precision : tuple of tuple of float
+        Shape ``(2n + 2, 2n + 2)`` (dimensionless).
     """
 
-    h: float
-    tau_reac_hat: float
-    theta_m: float
-    trusted: bool
+    mean: tuple[float, ...]
+    precision: tuple[tuple[float, ...], ...]
 
 
-class MoveRecord:
-    """What a move gives the bank's estimators, one step at a time (module doc).
-
-    Parameters
-    ----------
-    window : float
-        How far back the motor's advance along the heading is measured (s).
-    trust_after : float
-        How long that advance must have held for a sample to be trusted (s).
-
-    Attributes
-    ----------
-    samples : list of Sample
-        The move's steps so far.
-    elapsed : float
-        Their duration (s).
-
-    Examples
-    --------
-    >>> record = MoveRecord(window=2e-3, trust_after=0.0)
-    >>> for k in range(4):
-    ...     record.step(1e-3, 0.01, 1e-3 * k, heading=1.0)
-    >>> [s.trusted for s in record.samples]  # trusted once the motor advanced over 2 ms
-    [False, False, True, True]
-    """
-
-    def __init__(
-        self,
-        window: float = defaults.REFINE_MOTION_WINDOW,
-        trust_after: float = defaults.REFINE_TRUST_AFTER,
-    ) -> None:
-        self.window = window
-        self.trust_after = trust_after
-        self.samples: list[Sample] = []
-        self.elapsed = 0.0
-        self._trusted_for = 0.0
-        self._recent: list[tuple[float, float]] = []  # (time, motor angle) within the window
-
-    def step(self, h: float, tau_reac_hat: float, theta_m: float, heading: float) -> None:
-        """Keep the sample that ends a step.
-
-        Parameters
-        ----------
-        h : float
-            The step (s), > 0.
-        tau_reac_hat : float
-            τ̂_reac at its end (N·m).
-        theta_m : float
-            The motor angle the estimators take (rad).
-        heading : float
-            The direction the DOB was told the motor runs (−1, 0 or +1).
-        """
-        self.elapsed += h
-        recent = self._recent
-        recent.append((self.elapsed, theta_m))
-        while len(recent) > 1 and recent[1][0] <= self.elapsed - self.window + 1e-12:
-            recent.pop(0)
-        t0, theta0 = recent[0]
-        advanced = t0 <= self.elapsed - self.window + 1e-12 and (theta_m - theta0) * heading > 0.0
-        self._trusted_for = self._trusted_for + h if advanced else 0.0
-        trusted = advanced and self._trusted_for >= self.trust_after
-        self.samples.append(Sample(h, tau_reac_hat, theta_m, trusted))
+def prior_belief(n: int, mass_spread: float, common_spread: float) -> Belief:
+    """The belief before any move: mean 0, the spreads (in log, dimensionless) as
+    independent standard deviations of the common factors and of each mass's own."""
+    spreads = [common_spread] * 2 + [mass_spread] * (2 * n)
+    m = len(spreads)
+    precision = tuple(
+        tuple(1.0 / spreads[a] ** 2 if a == b else 0.0 for b in range(m)) for a in range(m)
+    )
+    return Belief((0.0,) * m, precision)
 
 
 @dataclass(frozen=True)
@@ -143,12 +98,20 @@ class ChainFit:
     Attributes
     ----------
     J_factors, k_factors : tuple of float
-        The factor on each J_i and each k_i (dimensionless), shape ``(n,)`` each.
+        The factor on each J_i and each k_i from the prior's centre (the ``origin`` of
+        :func:`fit_chain`; dimensionless), shape ``(n,)`` each.
     cost_before, cost_after : float
         The data's share of the cost (half the sum of squared residuals in units of the
-        noise on τ̂_reac, dimensionless) at the factors 1 and at the fit.
+        noise on τ̂_reac, each standing for ``defaults.REFINE_DATA_TIME`` of record;
+        dimensionless) with the model the fit started from, and at the fit.
     iterations : int
         Levenberg–Marquardt iterations taken.
+    J, k : tuple of float
+        The fitted inertias (kg·m²) and stiffnesses (N·m/rad), shape ``(n,)`` each.
+    trusted_time : float
+        The record's trusted time (s).
+    belief : Belief
+        What is known of the parameters after the fit (the next move's prior).
     """
 
     J_factors: tuple[float, ...]
@@ -156,6 +119,10 @@ class ChainFit:
     cost_before: float
     cost_after: float
     iterations: int
+    J: tuple[float, ...] = ()
+    k: tuple[float, ...] = ()
+    trusted_time: float = 0.0
+    belief: Belief | None = None
 
 
 def open_loop_errors(
@@ -188,7 +155,7 @@ def open_loop_errors(
     list of float
         The filtered error at each sample (N·m), shape ``(len(samples),)``.
     """
-    models: dict[float, tuple] = {}
+    models: dict[float, tuple] = {}  # math.fsum below: the same sums on every CPython
     s = list(start.s)
     u_prev = start.u_prev
     z0 = z1 = 0.0
@@ -203,7 +170,7 @@ def open_loop_errors(
         F, Gamma, ((p00, p01), (p10, p11)), (q0, q1) = found
         u = sample.theta_m - start.theta0
         w0, w1 = u_prev, (u - u_prev) / h
-        s = [sum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(F, Gamma)]
+        s = [math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(F, Gamma)]
         u_prev = u
         e = sample.tau_reac_hat - s[-1]
         z0, z1 = p00 * z0 + p01 * z1 + q0 * e, p10 * z0 + p11 * z1 + q1 * e
@@ -223,42 +190,68 @@ class _Problem:
         self,
         start: LoadTorqueObserver,
         samples: Sequence[Sample],
-        prior: Sequence[float],
+        origin: tuple[Sequence[float], Sequence[float]],
+        prior: Belief,
         lowpass: float,
     ) -> None:
         self.start, self.samples, self.prior, self.lowpass = start, samples, prior, lowpass
+        self.origin = origin
         self.n = len(start.J)
-        self.weights = [1.0 if s.trusted else 0.0 for s in samples]
+        # each trusted sample weighs as the time it stands for (the cost is an integral)
+        unit = defaults.REFINE_DATA_TIME
+        self.weights = [math.sqrt(s.h / unit) if s.trusted else 0.0 for s in samples]
+        self.trusted_time = math.fsum(s.h for s in samples if s.trusted)
         # how far (in log) a trial may go: twice the accepted range, so that a fit that
         # leaves it is seen to, and no trial's model overflows
         self.search = 2.0 * max(abs(math.log(x)) for x in defaults.REFINE_FACTOR_RANGE)
 
     def logs(self, p: Sequence[float]) -> list[float]:
-        """``[log J_i / J_i0 …, log k_i / k_i0 …]``, shape ``(2n,)``."""
+        """``[log J_i / J_i0 …, log k_i / k_i0 …]`` from the origin, shape ``(2n,)``."""
         n = self.n
         return [p[0] + p[2 + i] for i in range(n)] + [p[1] + p[2 + n + i] for i in range(n)]
+
+    def start_parameters(self) -> list[float]:
+        """``p`` of the start's model: its log factors from the origin, their means as the
+        common factors."""
+        n, (J0, k0) = self.n, self.origin
+        dJ = [math.log(a / b) for a, b in zip(self.start.J, J0)]
+        dk = [math.log(a / b) for a, b in zip(self.start.k, k0)]
+        cJ, ck = math.fsum(dJ) / n, math.fsum(dk) / n
+        return [cJ, ck, *(x - cJ for x in dJ), *(x - ck for x in dk)]
+
+    def chain(self, logs: Sequence[float]) -> tuple[list[float], list[float]]:
+        """The inertias (kg·m²) and stiffnesses (N·m/rad) at these log factors."""
+        n, (J0, k0) = self.n, self.origin
+        J = [a * math.exp(x) for a, x in zip(J0, logs[:n])]
+        k = [a * math.exp(x) for a, x in zip(k0, logs[n:])]
+        return J, k
 
     def residuals(self, logs: Sequence[float]) -> list[float] | None:
         """The weighted, filtered errors in units of the noise on τ̂_reac; None where
         the model diverges."""
-        n, start = self.n, self.start
-        J = [a * math.exp(x) for a, x in zip(start.J, logs[:n])]
-        k = [a * math.exp(x) for a, x in zip(start.k, logs[n:])]
+        J, k = self.chain(logs)
+        start = self.start
         errors = open_loop_errors(start, J, k, self.samples, self.lowpass)
         if not all(abs(e) < DIVERGED for e in errors):  # nan and inf fail too
             return None
         unit = start.noise.tau_noise_std
         return [w * e / unit for w, e in zip(self.weights, errors)]
 
+    def prior_gradient(self, p: Sequence[float]) -> list[float]:
+        """``Λ (p − μ)`` of the prior's Gaussian."""
+        d = [a - b for a, b in zip(p, self.prior.mean)]
+        return [math.fsum(map(mul, row, d)) for row in self.prior.precision]
+
     def cost(self, r: Sequence[float], p: Sequence[float]) -> float:
-        """Half the sum of squares of the residuals and of the prior's terms."""
-        prior = math.fsum((x / s) ** 2 for x, s in zip(p, self.prior))
+        """Half the sum of squares of the residuals, plus the prior's ``(p − μ)ᵀ Λ (p − μ)``."""
+        d = [a - b for a, b in zip(p, self.prior.mean)]
+        prior = math.fsum(map(mul, d, self.prior_gradient(p)))
         return 0.5 * (math.fsum(x * x for x in r) + prior)
 
     def normal_equations(
         self, p: Sequence[float], r: Sequence[float], step: float
     ) -> tuple[list[list[float]], list[float]] | None:
-        """``JᵀJ + P⁻¹`` and the cost's gradient at ``p`` by forward differences of
+        """``JᵀJ + Λ`` and the cost's gradient at ``p`` by forward differences of
         ``step`` in each log factor (the common factors' columns: their masses' sums);
         None where a bumped model diverges."""
         n, logs = self.n, self.logs(p)
@@ -277,23 +270,39 @@ class _Problem:
         ]
         m = len(cols)
         A = [[math.fsum(map(mul, cols[a], cols[b])) for b in range(m)] for a in range(m)]
-        g = [math.fsum(map(mul, cols[a], r)) + p[a] / self.prior[a] ** 2 for a in range(m)]
-        for a in range(m):
-            A[a][a] += 1.0 / self.prior[a] ** 2
+        A = [[x + y for x, y in zip(row, prow)] for row, prow in zip(A, self.prior.precision)]
+        g = [math.fsum(map(mul, c, r)) + q for c, q in zip(cols, self.prior_gradient(p))]
         return A, g
 
 
 def _levenberg_marquardt(
-    problem: _Problem, r: list[float], iterations: int, step: float
-) -> tuple[list[float], list[float], int]:
-    """Minimize ``problem``'s cost from p = 0 (its residuals there ``r``); return the
-    parameters, their residuals and the iterations taken."""
-    p = [0.0] * (2 * problem.n + 2)
+    problem: _Problem, p: list[float], r: list[float], iterations: int, step: float
+) -> tuple[list[float], list[float], int, list[list[float]] | None]:
+    """Minimize ``problem``'s cost.
+
+    Parameters
+    ----------
+    problem : _Problem
+        The residuals, cost and normal equations.
+    p, r : list of float
+        The parameters to start from (dimensionless, shape ``(2n + 2,)``) and their
+        residuals.
+    iterations : int
+        At most this many iterations.
+    step : float
+        The forward differences' step in each log factor (dimensionless).
+
+    Returns
+    -------
+    tuple
+        The parameters, their residuals, the iterations that lowered the cost and the
+        last ``JᵀJ + Λ`` (None if none was formed).
+    """
     current = problem.cost(r, p)
+    A = None
     mu = 1e-3
     taken = 0
-    while taken < iterations:
-        taken += 1
+    for _ in range(iterations):
         found = problem.normal_equations(p, r, step)
         if found is None:
             break
@@ -315,15 +324,19 @@ def _levenberg_marquardt(
         else:
             break
         gain, p, r, current = current - tc, trial, tr, tc
+        taken += 1
         mu = max(mu / 3.0, 1e-9)
         if gain <= 1e-4 * current:
             break
-    return p, r, taken
+    return p, r, taken, A
 
 
 def fit_chain(
     start: LoadTorqueObserver,
     samples: Sequence[Sample],
+    origin: tuple[Sequence[float], Sequence[float]] | None = None,
+    belief: Belief | None = None,
+    evidence: float = defaults.REFINE_MIN_EVIDENCE,
     mass_spread: float = defaults.REFINE_MASS_SPREAD,
     common_spread: float = defaults.REFINE_COMMON_SPREAD,
     lowpass: float = defaults.REFINE_LOWPASS,
@@ -334,10 +347,21 @@ def fit_chain(
     Parameters
     ----------
     start : LoadTorqueObserver
-        The estimator at the move's start: its model (J, k, B, g_dist, load mass), its
-        state and its noise on τ̂_reac (the residuals' unit). Not changed.
+        The estimator at the move's start: its model (J, k, B, g_dist, load mass), where
+        the fit starts, its state and its noise on τ̂_reac (the residuals' unit). Not
+        changed.
     samples : Sequence[Sample]
-        The move's steps (:class:`MoveRecord`).
+        The move's steps (:class:`~arcosim.fmu.flexchain.move_record.MoveRecord`).
+    origin : tuple of Sequence[float], optional
+        The chain the prior is centred on and the factors are counted from, ``(J, k)``
+        (kg·m², N·m/rad); default the start's own. The bank gives its member's model as
+        first built, so that moves after moves do not carry the model away from it.
+    belief : Belief, optional
+        What earlier moves told of the parameters (a :class:`ChainFit`'s ``belief``,
+        the start's model at its mean); default :func:`prior_belief` of the spreads.
+    evidence : float
+        The least data cost of the start's model that the fit takes as showing its
+        errors (dimensionless; ``ChainFit.cost_before``'s unit).
     mass_spread, common_spread : float
         The prior's standard deviations (in log, dimensionless) of each mass's own
         factor and of the common factors on every J_i and every k_i.
@@ -349,9 +373,12 @@ def fit_chain(
     Returns
     -------
     ChainFit or None
-        None when fewer than ``defaults.REFINE_MIN_TRUSTED`` samples are trusted, the
-        model as given diverges, or the fit leaves a factor outside
-        ``defaults.REFINE_FACTOR_RANGE``.
+        None (the data cannot support a fit) when the trusted samples span less than
+        ``defaults.REFINE_MIN_TRUSTED_TIME``, the start's model diverges, its error is
+        less than ``evidence`` (the move does not tell the model's errors from the
+        noise), the fit leaves a factor outside
+        ``defaults.REFINE_FACTOR_RANGE``, or the fitted model still misses the data by more
+        than ``defaults.REFINE_MAX_MISFIT`` (the chain model cannot explain them).
 
     Examples
     --------
@@ -362,18 +389,32 @@ def fit_chain(
     True
     """
     n = len(start.J)
-    prior = [common_spread] * 2 + [mass_spread] * (2 * n)
-    problem = _Problem(start, samples, prior, lowpass)
-    if sum(problem.weights) < defaults.REFINE_MIN_TRUSTED:
+    prior = belief or prior_belief(n, mass_spread, common_spread)
+    origin = origin or (start.J, start.k)
+    problem = _Problem(start, samples, origin, prior, lowpass)
+    if problem.trusted_time < defaults.REFINE_MIN_TRUSTED_TIME:
         return None
-    r = problem.residuals([0.0] * (2 * n))
+    p = list(belief.mean) if belief else problem.start_parameters()
+    r = problem.residuals(problem.logs(p))
     if r is None:
         return None
     before = 0.5 * math.fsum(x * x for x in r)
-    p, r, taken = _levenberg_marquardt(problem, r, iterations, defaults.REFINE_DIFFERENCE_STEP)
-    factors = [math.exp(x) for x in problem.logs(p)]
-    lo, hi = defaults.REFINE_FACTOR_RANGE
-    if not all(lo <= f <= hi for f in factors):
+    if before < evidence:
         return None
+    step = defaults.REFINE_DIFFERENCE_STEP
+    p, r, taken, A = _levenberg_marquardt(problem, p, r, iterations, step)
+    if A is None:
+        return None
+    logs = problem.logs(p)
+    factors = [math.exp(x) for x in logs]
+    lo, hi = defaults.REFINE_FACTOR_RANGE
     after = 0.5 * math.fsum(x * x for x in r)
-    return ChainFit(tuple(factors[:n]), tuple(factors[n:]), before, after, taken)
+    misfit = math.sqrt(2.0 * after * defaults.REFINE_DATA_TIME / problem.trusted_time)
+    if not all(lo <= f <= hi for f in factors) or misfit > defaults.REFINE_MAX_MISFIT:
+        return None
+    J, k = problem.chain(logs)
+    known = Belief(tuple(p), tuple(tuple(row) for row in A))
+    return ChainFit(
+        tuple(factors[:n]), tuple(factors[n:]), before, after, taken,
+        tuple(J), tuple(k), problem.trusted_time, known,
+    )  # fmt: skip
