@@ -35,7 +35,7 @@ start, and the choice rests for good: a later move starts from a hold's estimate
 from rest, and its data took a refined model away from the plant, so a refined member
 refits only where a move shows its model wrong well above the noise
 (``defaults.REFINE_AGAIN``). On `arcosim bench control`'s four-mass
-chain this took the runs meeting all four criteria from 23 to 36 of 42.
+chain this took the runs meeting all four criteria from 23 to 34 of 42.
 
 At rest, while the hold's dither runs and the controlled mass is still (:meth:`settle`;
 never without an encoder or with ``hold_dither`` 0), every member trusts its model more
@@ -69,7 +69,7 @@ class EstimatorBank:
     members : list of LoadTorqueObserver
         One per (J factor, k factor), J's factor the outer loop.
     factors : list of tuple of float
-        Each member's (J factor, k factor).
+        Each member's (J factor, k factor) as built (a refinement leaves them).
     score : list of float
         Each member's low-passed squared open-loop error of τ̂_reac (N²·m²).
     pick : int
