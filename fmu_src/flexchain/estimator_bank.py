@@ -26,7 +26,7 @@ alike: left to choose at rest, the bank took a load step on the bench's three-ma
 for a model error and moved to the wrong members (0.91 mrad left, 0.43 on the chain).
 
 The common factors cannot follow errors that differ from mass to mass. So the bank also
-records the move (:class:`~arcosim.fmu.flexchain.move_fit.MoveRecord`, from
+records the move (:class:`~arcosim.fmu.flexchain.move_record.MoveRecord`, from
 :meth:`restart`), and ``defaults.REFINE_AT`` move times after its start the controller
 calls :meth:`refine`: the chosen member's every J_i and k_i are fitted to the move's
 τ̂_reac (:func:`~arcosim.fmu.flexchain.move_fit.fit_chain`), the member is replaced by
@@ -92,7 +92,7 @@ class EstimatorBank:
     fit : ChainFit or None
         The last :meth:`refine`'s fit (None: none, or refused).
     refined : bool
-        Whether the chosen member was refined from this move (the choice then rests).
+        Whether the chosen member was refined from this move (``fit`` is not None).
     settled : bool
         Whether a member was ever refined: the choice then rests for good.
 
@@ -129,7 +129,6 @@ class EstimatorBank:
         self.record: MoveRecord | None = None  # from a move's start until refine()
         self.starts: list[LoadTorqueObserver] = []
         self.fit: ChainFit | None = None
-        self.refined = False
         self.quiet = False
         self.still = 0.0
         self.move_noise = estimator.noise
@@ -155,7 +154,11 @@ class EstimatorBank:
         # shared; the fit does not use it)
         self.starts = [copy.copy(m) for m in self.members]
         self.fit = None
-        self.refined = False
+
+    @property
+    def refined(self) -> bool:
+        """Whether the chosen member was refined from this move."""
+        return self.fit is not None
 
     def refine(self) -> ChainFit | None:
         """Refine the chosen member's every J_i and k_i from the move so far, and end the
@@ -164,8 +167,8 @@ class EstimatorBank:
         The member is replaced by the estimator on the refined chain, run over the move's
         samples from the chosen member's state at the move's start
         (:func:`~arcosim.fmu.flexchain.move_fit.fit_chain`, its prior centred on the
-        member's model as built), and the choice ends until the next move; where the fit
-        refuses, the member stays as it was and the choice goes on.
+        member's model as built), and the choice rests for good; where the fit refuses,
+        the member stays as it was and the choice goes on.
 
         Returns
         -------
@@ -173,22 +176,22 @@ class EstimatorBank:
             The factors taken, or None where the fit refused (kept in :attr:`fit`).
         """
         record, self.record = self.record, None
-        if record is None or self.refined:
+        if record is None:  # refine() ran on this move already
             return None
         start = self.starts[self.pick]
         self.starts = []
+        belief = self.beliefs[self.pick]
+        # once refined, a member refits only where a move shows its model wrong well
+        # above the noise (later moves start from a hold's estimates, not from rest)
+        evidence = defaults.REFINE_MIN_EVIDENCE if belief is None else defaults.REFINE_AGAIN
         try:
-            belief = self.beliefs[self.pick]
-            # once refined, a member refits only where a move shows its model wrong well
-            # above the noise (later moves start from a hold's estimates, not from rest)
-            evidence = defaults.REFINE_MIN_EVIDENCE if belief is None else defaults.REFINE_AGAIN
             fit = fit_chain(start, record.samples, self.origins[self.pick], belief, evidence)
         except ValueError:  # a singular step of the fit: no refinement, no crash
             fit = None
         self.fit = fit
         if fit is None:  # the choice goes on as it would have
             return None
-        self.refined = self.settled = True
+        self.settled = True
         self.beliefs[self.pick] = fit.belief
         refined = copy.copy(start)
         refined.J, refined.k = fit.J, fit.k
@@ -273,7 +276,7 @@ class EstimatorBank:
         """
         if self.record is not None:
             self.record.step(h, tau_reac_hat, theta_m, heading)
-        if self.refined or self.settled:  # the choice is over (module doc)
+        if self.settled:  # a member was refined: the choice is over (module doc)
             choose = False
         if not choose:  # the scores and open-loop models are restarted before they count
             for member in self.members:

@@ -154,6 +154,33 @@ def smoothing_filter(bandwidth: float, h: float) -> tuple[Matrix, list[float]]:
     return [X[0][:2], X[1][:2]], [X[0][2], X[1][2]]
 
 
+def smooth(Phi: Matrix, phi: Sequence[float], z: Sequence[float], u: float) -> list[float]:
+    """One step of :func:`smoothing_filter`'s low-pass: ``Φ z + φ u``.
+
+    Parameters
+    ----------
+    Phi, phi : Matrix, Sequence[float]
+        From :func:`smoothing_filter`, shapes ``(2, 2)`` and ``(2,)``.
+    z : Sequence[float]
+        The state [value, rate] at the previous sample, shape ``(2,)``.
+    u : float
+        The input held over the step.
+
+    Returns
+    -------
+    list of float
+        The state at this sample, shape ``(2,)``; its first entry the output.
+
+    Examples
+    --------
+    >>> smooth([[1.0, 0.0], [0.0, 1.0]], [0.5, 0.25], [0.0, 0.0], 2.0)
+    [1.0, 0.5]
+    """
+    (p00, p01), (p10, p11) = Phi
+    z0, z1 = z
+    return [p00 * z0 + p01 * z1 + phi[0] * u, p10 * z0 + p11 * z1 + phi[1] * u]
+
+
 def check_load_settings(n: int, load_mass: int, bandwidth: float) -> None:
     """Refuse a ``load_mass`` outside 1 … n or a bandwidth ω_L that is not > 0.
 
@@ -353,8 +380,5 @@ class LoadTorqueObserver(ModelObserver):
         """
         super().step(h, tau_reac_hat, theta_m)
         sm = self._models[h]
-        d = self.s[2 * self.n]
-        z0, z1 = self.smoothing
-        (p00, p01), (p10, p11) = sm.Phi
-        self.smoothing = [p00 * z0 + p01 * z1 + sm.phi[0] * d, p10 * z0 + p11 * z1 + sm.phi[1] * d]
+        self.smoothing = smooth(sm.Phi, sm.phi, self.smoothing, self.s[2 * self.n])
         self.tau_load = self.smoothing[0]

@@ -208,6 +208,38 @@ def step_model(
     return StepModel(F, Gamma, steady_state_gain(F, Q, measurement_noise(noise)))
 
 
+def advance(
+    F: Matrix, Gamma: Matrix, s: Sequence[float], u_prev: float, u: float, h: float
+) -> list[float]:
+    """One step of a step model, ``F s + Γ [u_prev, (u − u_prev) / h]``, the motor's
+    angle linear over the step (``math.fsum``: the same sums on every CPython).
+
+    Parameters
+    ----------
+    F, Gamma : Matrix
+        The step model, shapes ``(m, m)`` and ``(m, 2)``.
+    s : Sequence[float]
+        The state at the previous sample, shape ``(m,)``.
+    u_prev, u : float
+        The motor angle relative to the start at the previous sample and at this one
+        (rad).
+    h : float
+        Time between them (s), > 0.
+
+    Returns
+    -------
+    list of float
+        The state at this sample, shape ``(m,)``.
+
+    Examples
+    --------
+    >>> advance([[1.0, 0.0], [0.0, 0.5]], [[0.0, 0.0], [1.0, 0.0]], [2.0, 2.0], 1.0, 3.0, 0.5)
+    [2.0, 2.0]
+    """
+    w0, w1 = u_prev, (u - u_prev) / h
+    return [math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(F, Gamma)]
+
+
 class ModelObserver:
     """Angles and velocities of the n load masses from θ_m and τ̂_reac.
 
@@ -300,11 +332,7 @@ class ModelObserver:
         [0.0, 0.0, 0.0]
         """
         sm = self._models.get(h) or self.model(h)
-        u = theta_m - self.theta0
-        w0, w1 = self.u_prev, (u - self.u_prev) / h
-        return [
-            math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(sm.F, sm.Gamma)
-        ]
+        return advance(sm.F, sm.Gamma, s, self.u_prev, theta_m - self.theta0, h)
 
     def step(self, h: float, tau_reac_hat: float, theta_m: float) -> None:
         """Take the sample that ends a step.

@@ -52,7 +52,8 @@ from dataclasses import dataclass
 from operator import mul
 
 from . import defaults, linalg
-from .load_observer import LoadTorqueObserver, load_prediction, smoothing_filter
+from .load_observer import LoadTorqueObserver, load_prediction, smooth, smoothing_filter
+from .model_observer import advance
 from .move_record import MoveRecord, Sample
 
 __all__ = ["Belief", "ChainFit", "MoveRecord", "Sample", "fit_chain", "open_loop_errors"]
@@ -155,26 +156,23 @@ def open_loop_errors(
     list of float
         The filtered error at each sample (N·m), shape ``(len(samples),)``.
     """
-    models: dict[float, tuple] = {}  # math.fsum below: the same sums on every CPython
+    models: dict[float, tuple] = {}
     s = list(start.s)
     u_prev = start.u_prev
-    z0 = z1 = 0.0
+    z = [0.0, 0.0]
     out = []
     for sample in samples:
         h = sample.h
         found = models.get(h)
         if found is None:
             F, Gamma = load_prediction(J, k, start.B, start.g_dist, h, start.load_mass)
-            Phi, phi = smoothing_filter(lowpass, h)
-            found = models[h] = (F, Gamma, Phi, phi)
-        F, Gamma, ((p00, p01), (p10, p11)), (q0, q1) = found
+            found = models[h] = (F, Gamma, *smoothing_filter(lowpass, h))
+        F, Gamma, Phi, phi = found
         u = sample.theta_m - start.theta0
-        w0, w1 = u_prev, (u - u_prev) / h
-        s = [math.fsum(map(mul, row, s)) + g[0] * w0 + g[1] * w1 for row, g in zip(F, Gamma)]
+        s = advance(F, Gamma, s, u_prev, u, h)
         u_prev = u
-        e = sample.tau_reac_hat - s[-1]
-        z0, z1 = p00 * z0 + p01 * z1 + q0 * e, p10 * z0 + p11 * z1 + q1 * e
-        out.append(z0)
+        z = smooth(Phi, phi, z, sample.tau_reac_hat - s[-1])
+        out.append(z[0])
     return out
 
 
