@@ -46,3 +46,37 @@ def test_an_exact_angle_gives_the_backward_difference() -> None:
     angles = [0.0, 0.3e-3, 0.1e-3, 0.25e-3]
     v = _velocities(angles, half=0.0)
     assert v == pytest.approx(list(np.diff(angles) / H), rel=1e-12)
+
+
+def _slides(readings: list[int], within: float) -> list[float]:
+    edge = CrossedEdge(readings[0] * COUNT, COUNT / 2)
+    out = []
+    for r in readings[1:]:
+        edge.step(H, r * COUNT)
+        out.append(edge.sliding(within))
+    return out
+
+
+def test_a_motor_crossing_edges_one_way_slides_until_the_next_edge_is_due() -> None:
+    """Counts rising every 3 steps: sliding up from the second new edge on, and still
+    3 steps after the last one; the 4th step without a new edge is past it."""
+    counts = [0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 3, 3]
+    assert _slides(counts, within=5 * H) == [0.0] * 3 + [1.0] * 7 + [0.0]
+
+
+def test_falling_edges_slide_down() -> None:
+    assert _slides([5, 4, 3, 2], within=H)[1:] == [-1.0, -1.0]
+
+
+def test_edges_further_apart_than_within_do_not_slide() -> None:
+    """One new edge every 4 steps against a limit of 3 steps: too slow to be taken as
+    sliding (a motor that may be sticking between them)."""
+    counts = [0, 1, 1, 1, 1, 2, 2, 2, 2, 3]
+    assert _slides(counts, within=3 * H) == [0.0] * 9
+
+
+def test_a_dither_or_a_reversal_does_not_slide() -> None:
+    """Across one edge and back (the hold's dither): no new edge, no heading; a reversal
+    that crosses a new edge downwards after one upwards starts anew."""
+    assert _slides([5, 6, 5, 6, 5, 6], within=5 * H) == [0.0] * 5
+    assert _slides([5, 6, 7, 6, 5, 4], within=5 * H) == [0.0, 1.0, 1.0, 0.0, -1.0]

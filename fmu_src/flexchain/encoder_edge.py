@@ -17,6 +17,13 @@ the runs within the residual criterion from 23 to 34 of 36 and the motor's limit
 within one count from 0 to 8. The controller uses it only where it cancels Coulomb
 friction: on a frictionless motor the plain difference's kick at an edge is what holds
 the motor there.
+
+The edges also tell which way a slow motor slides (:meth:`CrossedEdge.sliding`): one that
+crosses new edges one way, each within ``defaults.SLIDING_INTERVAL`` of the last, is
+moving that way until the next edge is due. Below a count per step its velocity reads 0
+on most steps, and a DOB that took it as stuck knew the reaction torque only within the
+band ±f_c of static friction; told the heading, it removes the kinetic friction instead
+(docs/control.md).
 """
 
 from __future__ import annotations
@@ -42,6 +49,13 @@ class CrossedEdge:
     edge : float
         The last crossed edge (rad); the middle of the first count until the motor
         leaves it.
+    direction : float
+        The way the edge last moved: +1, −1, or 0 before it has.
+    interval : float
+        Time between the edge's last two moves when both went the same way (s); 0
+        otherwise.
+    since : float
+        Time since the edge last moved (s).
 
     Examples
     --------
@@ -55,6 +69,9 @@ class CrossedEdge:
         self.half_count = half_count
         self.reading = theta_m0
         self.edge = theta_m0 + half_count
+        self.direction = 0.0
+        self.interval = 0.0
+        self.since = 0.0
 
     def step(self, h: float, theta_m: float) -> float:
         """Take the encoder's reading at the sample; return the edge's velocity over the step.
@@ -77,5 +94,40 @@ class CrossedEdge:
         elif theta_m < self.reading:
             edge = theta_m + 2.0 * self.half_count
         velocity = (edge - self.edge) / h
+        self.since += h
+        # a new edge is at least half a count away; back over the same edge it may differ
+        # by rounding (a reading plus a count against the next reading)
+        if abs(edge - self.edge) > 0.5 * self.half_count and edge != self.edge:
+            direction = 1.0 if edge > self.edge else -1.0
+            self.interval = self.since if direction == self.direction else 0.0
+            self.direction, self.since = direction, 0.0
         self.reading, self.edge = theta_m, edge
         return velocity
+
+    def sliding(self, within: float) -> float:
+        """The way the motor slides (+1 or −1), or 0 when the edges do not show it.
+
+        It slides the way the edge last moved when that move followed one the same way
+        at most ``within`` earlier, until as long again has passed without another.
+
+        Parameters
+        ----------
+        within : float
+            The longest time between two edges of a slide (s); a count over it is the
+            slowest speed taken as sliding.
+
+        Returns
+        -------
+        float
+            −1, 0 or +1.
+
+        Examples
+        --------
+        >>> e = CrossedEdge(0.0, 0.5)
+        >>> [(e.step(1.0, reading), e.sliding(2.0)) for reading in (1.0, 2.0, 2.0, 2.0)]
+        [(0.5, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
+        """
+        # (a float sum of whole steps up to the limit counts as within it)
+        if 0.0 < self.interval <= within + 1e-9 and self.since <= self.interval:
+            return self.direction
+        return 0.0

@@ -277,8 +277,8 @@ class MotionController:
         if self.crossed is not None:
             omega_m = self.crossed.step(h, theta_m)
             motion = self.crossed.edge - self.offset
-        reference_heading = self._reference_heading()
-        dob.step(h, i_a, omega_m, motion, reference_heading)
+        heading = self._heading()
+        dob.step(h, i_a, omega_m, motion, heading)
         th_m = theta_m + self.offset - t0
         dither = self.dither
         if dither is None:
@@ -295,7 +295,7 @@ class MotionController:
             settle_sticking(dob, est, h, drive)
         choosing = self.t - self._moved < defaults.BANK_CHOICE_AFTER * self.design.move_time
         bank = self.bank
-        bank.step(h, dob.tau_reac_hat, drive, choosing, reference_heading)
+        bank.step(h, dob.tau_reac_hat, drive, choosing, heading)
         record = bank.record
         if record is not None and record.elapsed >= self._refine_after - 0.5 * h:
             bank.refine()  # every J_i and k_i from the move so far (move_fit)
@@ -336,6 +336,16 @@ class MotionController:
         self.friction = friction
         self.i_ref = clamp(self.i_ff + self.i_fb, design.i_max)
         return self.i_ref
+
+    def _heading(self) -> float:
+        """The motor's heading the DOB is told at this sample (−1, 0 or +1): the reference
+        model's while it moves (:meth:`_reference_heading`), else, until the hold's dither
+        starts, the way the encoder's edges show the motor sliding
+        (``defaults.SLIDING_INTERVAL``), else 0 (the DOB's own, from the samples)."""
+        heading = self._reference_heading()
+        if heading == 0.0 and self.dither is None and self.crossed is not None:
+            heading = self.crossed.sliding(defaults.SLIDING_INTERVAL)
+        return heading
 
     def _reference_heading(self) -> float:
         """The reference model's motor heading at this sample (−1, 0 or +1): its sign
