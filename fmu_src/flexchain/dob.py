@@ -18,14 +18,19 @@ for the fraction of the step on each side. Over a step that starts or ends with
 the motor standing still (``ω_{k−1} = 0`` or ``ω_k = 0``) static friction hides
 the reaction torque: it is only known to lie within ``±f_c`` of the drive torque, and the
 observer keeps the value in that interval closest to its previous estimate
-(a motor stuck at rest with the chain at rest gives exactly 0, not ``k_t i``).
+(a motor stuck at rest with the chain at rest gives exactly 0, not ``k_t i``); with a
+chain model at hand, :func:`settle_sticking` takes that model's prediction instead.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from .filters import lowpass_pole
+
+if TYPE_CHECKING:  # the chain's estimator, which only settle_sticking takes
+    from .load_observer import LoadTorqueObserver
 
 
 @dataclass(frozen=True)
@@ -196,3 +201,35 @@ class ReactionObserver:
         self.velocity = velocity
         self.omega = omega
         self.theta = theta
+
+
+def settle_sticking(
+    dob: ReactionObserver, est: LoadTorqueObserver, h: float, theta_m: float
+) -> None:
+    """Over a step where the motor stood still, take the reaction torque the chain model
+    predicts, as far as the friction band allows.
+
+    Static friction hides the reaction torque within ±f_c of the drive torque; the DOB
+    alone keeps the value closest to its previous one, which the load torque state
+    would then take for a load (a phantom of up to f_c that the controller would hold
+    against). The model's prediction, clamped into the band, is the value that does not
+    contradict the chain model: the DOB's torque of the step and its output are moved
+    there, in place.
+
+    Parameters
+    ----------
+    dob : ReactionObserver
+        The DOB, just stepped over a step with ``sticking`` set.
+    est : LoadTorqueObserver
+        The chain's estimator, not yet stepped.
+    h : float
+        The step (s).
+    theta_m : float
+        The motor angle the estimator takes at the sample (rad).
+    """
+    a = lowpass_pole(dob.g, h)
+    predicted = (est.predict(h, theta_m, est.s)[-1] - a * est.s[-1]) / (1.0 - a)
+    f_c = dob.actuator.f_c
+    torque = min(max(predicted, dob.drive - f_c), dob.drive + f_c)
+    dob.tau_reac_hat += (1.0 - a) * (torque - dob.torque)
+    dob.torque = torque

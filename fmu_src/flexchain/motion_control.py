@@ -46,12 +46,10 @@ from collections.abc import Sequence
 from . import defaults
 from .codes import Estimator, Mode
 from .control_design import ControllerDesign, design_controller
-from .dob import Actuator, ReactionObserver, clamp, sign
+from .dob import Actuator, clamp, settle_sticking, sign
 from .encoder_edge import CrossedEdge
 from .estimator_bank import EstimatorBank
-from .filters import lowpass_pole
 from .hold_dither import HoldDither
-from .load_observer import LoadTorqueObserver
 from .motor_observer import MotorObserver
 from .observer import Observer, ObserverSettings
 
@@ -131,38 +129,6 @@ class TargetPath:
             running.append((t0, size))
         self.moves = running
         return value, rate
-
-
-def settle_sticking(
-    dob: ReactionObserver, est: LoadTorqueObserver, h: float, theta_m: float
-) -> None:
-    """Over a step where the motor stood still, take the reaction torque the chain model
-    predicts, as far as the friction band allows.
-
-    Static friction hides the reaction torque within ±f_c of the drive torque; the DOB
-    alone keeps the value closest to its previous one, which the load torque state
-    would then take for a load (a phantom of up to f_c that the controller would hold
-    against). The model's prediction, clamped into the band, is the value that does not
-    contradict the chain model: the DOB's torque of the step and its output are moved
-    there, in place.
-
-    Parameters
-    ----------
-    dob : ReactionObserver
-        The DOB, just stepped over a step with ``sticking`` set.
-    est : LoadTorqueObserver
-        The chain's estimator, not yet stepped.
-    h : float
-        The step (s).
-    theta_m : float
-        The motor angle the estimator takes at the sample (rad).
-    """
-    a = lowpass_pole(dob.g, h)
-    predicted = (est.predict(h, theta_m, est.s)[-1] - a * est.s[-1]) / (1.0 - a)
-    f_c = dob.actuator.f_c
-    torque = min(max(predicted, dob.drive - f_c), dob.drive + f_c)
-    dob.tau_reac_hat += (1.0 - a) * (torque - dob.torque)
-    dob.torque = torque
 
 
 class MotionController:
