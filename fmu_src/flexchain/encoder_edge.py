@@ -97,7 +97,7 @@ class CrossedEdge:
         self.since += h
         # a new edge is at least half a count away; back over the same edge it may differ
         # by rounding (a reading plus a count against the next reading)
-        if abs(edge - self.edge) > 0.5 * self.half_count and edge != self.edge:
+        if abs(edge - self.edge) > 0.5 * self.half_count:
             direction = 1.0 if edge > self.edge else -1.0
             self.interval = self.since if direction == self.direction else 0.0
             self.direction, self.since = direction, 0.0

@@ -12,9 +12,12 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   mass L; the motor's angle enters as measured (the middle of its count), its velocity,
   where Coulomb friction is cancelled, as the backward difference of the encoder's last
   crossed edge (:class:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge`: 0 for a
-  dither across one edge), in the feedback and the DOB alike; a motor observer
-  (:class:`MotorObserver`) gives the friction d̂_m the friction model misses, from the
-  current and the encoder, with the first spring pulling towards the estimated mass 1;
+  dither across one edge), in the feedback and the DOB alike; the DOB is told the
+  motor's heading, the reference's during a move and, as the motor creeps to rest, the
+  one its encoder edges show (:meth:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge.sliding`);
+  a motor observer (:class:`MotorObserver`) gives the friction d̂_m the friction model
+  misses, from the current and the encoder, with the first spring pulling towards the
+  estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
   (:func:`shaped_step`, zero velocity, acceleration and jerk at both ends, lasting
   ``move_time``) whose sum is the target path s(t); a reference model, the design model
