@@ -77,6 +77,37 @@ def test_edges_further_apart_than_within_do_not_slide() -> None:
 
 def test_a_dither_or_a_reversal_does_not_slide() -> None:
     """Across one edge and back (the hold's dither): no new edge, no heading; a reversal
-    that crosses a new edge downwards after one upwards starts anew."""
+    ends the slide up as soon as the reading falls back, and one down starts at the
+    second new edge down."""
     assert _slides([5, 6, 5, 6, 5, 6], within=5 * H) == [0.0] * 5
-    assert _slides([5, 6, 7, 6, 5, 4], within=5 * H) == [0.0, 1.0, 1.0, 0.0, -1.0]
+    assert _slides([5, 6, 7, 6, 5, 4], within=5 * H) == [0.0, 1.0, 0.0, 0.0, -1.0]
+
+
+def _headings(readings: list[int], expected: float, within: float) -> list[float]:
+    edge = CrossedEdge(readings[0] * COUNT, COUNT / 2)
+    out = []
+    for r in readings[1:]:
+        edge.step(H, r * COUNT)
+        out.append(edge.heading(expected, within))
+    return out
+
+
+def test_the_expected_heading_holds_until_an_edge_goes_against_it() -> None:
+    """Expected +1 (the reference moving up): kept while the counts rise or stay; an edge
+    crossed downwards (the motor turned round) leaves it to the samples (0) for
+    ``within``, then +1 again."""
+    assert _headings([5, 5, 6, 6], 1.0, within=2 * H) == [1.0] * 3
+    assert _headings([5, 4, 4, 4, 4], 1.0, within=2 * H) == [0.0, 0.0, 0.0, 1.0]
+
+
+def test_edges_sliding_against_the_expected_heading_win() -> None:
+    """Counts falling a count a step against an expected +1: after the second new edge the
+    edges' −1; with nothing expected, the edges alone (``sliding``)."""
+    assert _headings([5, 4, 3, 2], 1.0, within=2 * H) == [0.0, -1.0, -1.0]
+    assert _headings([5, 6, 7, 7, 7, 7], 0.0, within=2 * H) == [0.0, 1.0, 1.0, 0.0, 0.0]
+
+
+def test_back_over_the_same_edge_ends_a_slide() -> None:
+    """Rising a count a step, then back into the count below the last edge: the motor
+    turned, so no slide, though no new edge was crossed."""
+    assert _slides([0, 1, 2, 3, 2, 2], within=5 * H) == [0.0, 1.0, 1.0, 0.0, 0.0]

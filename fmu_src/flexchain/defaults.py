@@ -103,14 +103,16 @@ CONTROL_TORQUE_NOISE_STD = 1e-3
 #: (five-mass chain: 1.74 × the full-state bound's settling time, 0.98 × with it; 0.05,
 #: 0.3 and 1 rad/s were also tried on `arcosim bench control`'s chains).
 CONTROL_MOVING_SPEED = 0.6
-#: Between moves, and before the hold's dither starts, the motor is taken as sliding (and
-#: its DOB told the heading) while it crosses new encoder edges one way at most this far
-#: apart (s; at 2000 counts a third of a rad/s), until as long again has passed
-#: (:meth:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge.sliding`). Taken as stuck there
-#: instead, the motor left the DOB's reaction torque the estimator's own prediction
-#: (within ±f_c) as the chain came to rest; the four-mass chain's corner J +10 %, k −10 %
-#: settled at 2.43 s against a full-state bound of 1.52 s (1.80 s at 10 ms, 1.83 s at
-#: 20 ms; docs/development.md).
+#: Until the hold's dither starts, the encoder's edges are weighed against the reference's
+#: heading (:meth:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge.heading`): a motor that
+#: crosses new edges one way at most this far apart (s; at 2000 counts a third of a rad/s)
+#: slides that way until as long again has passed, and for this long after an edge against
+#: the reference's heading the DOB decides from its samples. Taken as stuck while it crept
+#: to rest after a move, the motor left the DOB's reaction torque the estimator's own
+#: prediction (within ±f_c); told the reference's heading while it turned round within a
+#: move, the DOB removed friction the wrong way (1 mN·m off over 0.1 s). The four-mass
+#: chain's corners settled at 2.43 and 1.80 s against full-state bounds of 1.52 and 1.38 s;
+#: with the edges 1.47 and 1.73 s (docs/development.md).
 SLIDING_INTERVAL = 10e-3
 #: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`): every
 #: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;

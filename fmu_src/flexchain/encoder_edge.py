@@ -53,7 +53,7 @@ class CrossedEdge:
         The way the edge last moved: +1, −1, or 0 before it has.
     interval : float
         Time between the edge's last two moves when both went the same way (s); 0
-        otherwise.
+        otherwise, and once the reading has gone back over the last edge.
     since : float
         Time since the edge last moved (s).
 
@@ -101,6 +101,8 @@ class CrossedEdge:
             direction = 1.0 if edge > self.edge else -1.0
             self.interval = self.since if direction == self.direction else 0.0
             self.direction, self.since = direction, 0.0
+        elif (theta_m - self.reading) * self.direction < 0.0:
+            self.interval = 0.0  # back over the same edge: the motor turned, no longer a slide
         self.reading, self.edge = theta_m, edge
         return velocity
 
@@ -127,7 +129,44 @@ class CrossedEdge:
         >>> [(e.step(1.0, reading), e.sliding(2.0)) for reading in (1.0, 2.0, 2.0, 2.0)]
         [(0.5, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
         """
-        # (a float sum of whole steps up to the limit counts as within it)
-        if 0.0 < self.interval <= within + 1e-9 and self.since <= self.interval:
+        if 0.0 < self.interval and _within(self.interval, within) and self.since <= self.interval:
             return self.direction
         return 0.0
+
+    def heading(self, expected: float, within: float) -> float:
+        """The way the motor moves, the edges weighed against the heading ``expected``.
+
+        The edges' slide where they show one (:meth:`sliding`); else 0 for ``within``
+        after the edge moved against ``expected`` (the motor turned round: the samples
+        decide); else ``expected``.
+
+        Parameters
+        ----------
+        expected : float
+            The heading otherwise assumed (−1, 0 or +1), e.g. the reference's.
+        within : float
+            As in :meth:`sliding` (s).
+
+        Returns
+        -------
+        float
+            −1, 0 or +1.
+
+        Examples
+        --------
+        >>> e = CrossedEdge(0.0, 0.5)
+        >>> _ = e.step(1.0, -1.0)  # an edge against the expected +1: the motor turned round
+        >>> [e.heading(1.0, 2.0)] + [(e.step(1.0, -1.0), e.heading(1.0, 2.0))[1] for _ in range(3)]
+        [0.0, 0.0, 0.0, 1.0]
+        """
+        edges = self.sliding(within)
+        if edges != 0.0:
+            return edges
+        if expected != 0.0 and self.direction == -expected and _within(self.since, within):
+            return 0.0
+        return expected
+
+
+def _within(time: float, limit: float) -> bool:
+    """``time ≤ limit`` (s), a float sum of whole steps up to the limit counting as within."""
+    return time <= limit + 1e-9

@@ -308,12 +308,12 @@ class MotionController:
 
     def _heading(self) -> float:
         """The motor's heading the DOB is told at this sample (−1, 0 or +1): the reference
-        model's while it moves (:meth:`_reference_heading`), else, until the hold's dither
-        starts, the way the encoder's edges show the motor sliding
-        (``defaults.SLIDING_INTERVAL``), else 0 (the DOB's own, from the samples)."""
+        model's while it moves (:meth:`_reference_heading`), weighed against the encoder's
+        edges until the hold's dither starts (``CrossedEdge.heading``,
+        ``defaults.SLIDING_INTERVAL``); 0 leaves it to the DOB's samples."""
         heading = self._reference_heading()
-        if heading == 0.0 and self.dither is None and self.crossed is not None:
-            heading = self.crossed.sliding(defaults.SLIDING_INTERVAL)
+        if self.dither is None and self.crossed is not None:
+            heading = self.crossed.heading(heading, defaults.SLIDING_INTERVAL)
         return heading
 
     def _reference_heading(self) -> float:

@@ -4,8 +4,9 @@ of :mod:`~arcosim.fmu.flexchain.move_fit` may trust.
 A sample is trusted once the motor has advanced along the heading the DOB was told over
 ``defaults.REFINE_MOTION_WINDOW`` s, and has kept doing so for
 ``defaults.REFINE_TRUST_AFTER`` s: the controller tells the DOB the reference's heading
-during a move, so τ̂_reac is off by up to 2 f_c wherever the motor stands or runs the
-other way, and the DOB's filter and the fit's low-pass must forget it.
+during a move (weighed against the encoder's edges), so τ̂_reac is off by up to 2 f_c
+wherever the motor stands or runs the other way unseen, and the DOB's filter and the
+fit's low-pass must forget it.
 """
 
 from __future__ import annotations
