@@ -111,8 +111,8 @@ CONTROL_MOVING_SPEED = 0.6
 #: to rest after a move, the motor left the DOB's reaction torque the estimator's own
 #: prediction (within ±f_c); told the reference's heading while it turned round within a
 #: move, the DOB removed friction the wrong way (1 mN·m off over 0.1 s). The four-mass
-#: chain's corners settled at 2.43 and 1.80 s against full-state bounds of 1.52 and 1.38 s;
-#: with the edges 1.47 and 1.73 s (docs/development.md).
+#: chain's corners (`arcosim bench control`) settled at 2.45 and 1.81 s against full-state
+#: bounds of 1.52 and 1.38 s; with the edges at 1.45 and 1.73 s (docs/development.md).
 SLIDING_INTERVAL = 10e-3
 #: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`): every
 #: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;

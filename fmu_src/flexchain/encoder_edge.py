@@ -22,7 +22,9 @@ The edges also tell which way a slow motor slides (:meth:`CrossedEdge.sliding`):
 crosses new edges one way, each within ``defaults.SLIDING_INTERVAL`` of the last, is
 moving that way until the next edge is due. Below a count per step its velocity reads 0
 on most steps, and a DOB that took it as stuck knew the reaction torque only within the
-band ±f_c of static friction; told the heading, it removes the kinetic friction instead
+band ±f_c of static friction; told the heading, it removes the kinetic friction instead.
+:meth:`CrossedEdge.heading` weighs them against a heading assumed otherwise (the
+reference's during a move), which an edge crossed the other way overrules
 (docs/control.md).
 """
 
