@@ -111,3 +111,10 @@ def test_back_over_the_same_edge_ends_a_slide() -> None:
     """Rising a count a step, then back into the count below the last edge: the motor
     turned, so no slide, though no new edge was crossed."""
     assert _slides([0, 1, 2, 3, 2, 2], within=5 * H) == [0.0, 1.0, 1.0, 0.0, 0.0]
+
+
+def test_edges_exactly_within_apart_slide() -> None:
+    """Edges 10 steps of 1 ms apart against a limit of 10 ms: a slide, though ten steps of
+    1e-3 add up to a float just over 0.01."""
+    counts = [0, 1] + [1] * 9 + [2]
+    assert _slides(counts, within=10 * H)[-1] == 1.0
