@@ -21,6 +21,12 @@ and model; writes ``control.md`` and ``control.json`` into ``--out``.
 
 ``--encoder-cpr`` sets the encoder of the plant, of the identification's log and of the
 controller's design alike (default 2000); the limit cycle is counted in its counts.
+
+``--target-offset`` moves the target that many counts of that encoder past 1 rad
+(default 0). Where the target falls within a count decides much of the hold: the plant's
+encoder counts from the start, so 1 rad lies 318.31 counts on at 2000 counts, and the
+motor holds the last mass there with its dither across the nearer edge; an offset of
+−0.31 puts the target on an edge, +0.19 half way between two (docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -73,16 +79,22 @@ CRITERIA = ("settles", "residual", "near_bound", "no_limit_cycle")
 
 
 def score_seed(
-    chain: MotionChain, folder: Path, seed: int, corners: bool, encoder_cpr: int = ENCODER_CPR
+    chain: MotionChain,
+    folder: Path,
+    seed: int,
+    corners: bool,
+    encoder_cpr: int = ENCODER_CPR,
+    distance: float = DISTANCE,
 ) -> dict[str, dict]:
     """One seed on one chain: every model's sensorless and upper-bound moves, and the
-    criteria; the corners only when ``corners``; an encoder of ``encoder_cpr`` counts."""
+    criteria; the corners only when ``corners``; an encoder of ``encoder_cpr`` counts; a
+    move of ``distance`` (rad)."""
     result = identify_chain(folder, chain, False, seed, encoder_cpr)
     params = design_parameters(result, False, encoder_cpr)
-    runs = Runs(folder, chain, False, seed=seed, encoder_cpr=encoder_cpr)
+    runs = Runs(folder, chain, False, seed=seed, encoder_cpr=encoder_cpr, distance=distance)
 
     def _score(run) -> MoveScore:
-        return score(run, encoder_cpr)
+        return score(run, encoder_cpr, distance)
 
     cascade = _score(runs.run(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX)))
     out = {}
@@ -115,9 +127,38 @@ def seed_models(n: int, seed: int, corners: bool) -> dict[str, tuple[np.ndarray,
     return models
 
 
-def score(run: LoopRun, encoder_cpr: int = ENCODER_CPR) -> MoveScore:
-    """A 1 rad move's scores, the limit cycle in counts of an ``encoder_cpr`` encoder."""
-    return score_move(run, DISTANCE, DISTANCE, encoder_cpr)
+def score(run: LoopRun, encoder_cpr: int = ENCODER_CPR, distance: float = DISTANCE) -> MoveScore:
+    """A move's scores (``distance`` in rad, 1 by default), the limit cycle in counts of an
+    ``encoder_cpr`` encoder."""
+    return score_move(run, distance, distance, encoder_cpr)
+
+
+def target_distance(offset: float, encoder_cpr: int) -> float:
+    """The move (rad) whose target lies ``offset`` counts of an ``encoder_cpr`` encoder
+    past 1 rad.
+
+    Examples
+    --------
+    >>> round(target_distance(0.19, 2000) * 2000 / (2 * math.pi), 2)  # counts from the start
+    318.5
+    """
+    return DISTANCE + offset * 2.0 * math.pi / encoder_cpr
+
+
+def geometry(distance: float, encoder_cpr: int) -> str:
+    """Where the target lies in the plant's counts, for the report.
+
+    Examples
+    --------
+    >>> geometry(1.0, 2000)
+    'Move: 1 rad, 318.31 counts of the encoder from the start (0.31 count from the nearer edge).'
+    """
+    counts = distance * encoder_cpr / (2.0 * math.pi)
+    off = abs(counts - round(counts))
+    return (
+        f"Move: {distance:.9g} rad, {counts:.2f} counts of the encoder from the start "
+        f"({off:.2f} count from the nearer edge)."
+    )
 
 
 def run(
@@ -126,9 +167,10 @@ def run(
     chains: Sequence[MotionChain],
     progress: Callable[[str], None],
     encoder_cpr: int = ENCODER_CPR,
+    distance: float = DISTANCE,
 ) -> dict[str, object]:
-    """Every chain over ``seeds`` with an encoder of ``encoder_cpr`` counts; the table,
-    the per-seed results, the time (s)."""
+    """Every chain over ``seeds`` with an encoder of ``encoder_cpr`` counts and a move of
+    ``distance`` (rad); the table, the per-seed results, the time (s)."""
     started = time.perf_counter()
     results: dict[str, dict] = {}
     for chain in chains:
@@ -138,12 +180,14 @@ def run(
         for seed in seeds:
             progress(f"{chain.name}: seed {seed}")
             per_seed[str(seed)] = score_seed(
-                chain, folder, seed, corners=seed == seeds[0], encoder_cpr=encoder_cpr
+                chain, folder, seed, seed == seeds[0], encoder_cpr, distance
             )
         results[chain.name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
-    text = f"Encoder: {encoder_cpr} counts per revolution.\n\n" + markdown(results)
+    heading = f"Encoder: {encoder_cpr} counts per revolution. {geometry(distance, encoder_cpr)}"
+    text = heading + "\n\n" + markdown(results)
     summary = {
         "encoder_cpr": encoder_cpr,
+        "distance": distance,
         "results": results,
         "seconds": time.perf_counter() - started,
     }
@@ -219,6 +263,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"the encoder's counts per revolution, of the plant, the identification's log "
         f"and the controller's design (default {ENCODER_CPR})",
     )
+    p.add_argument(
+        "--target-offset",
+        type=float,
+        default=0.0,
+        metavar="COUNTS",
+        help="the target this many encoder counts past 1 rad, −1 … 1 (default 0: 1 rad, "
+        "0.31 count past an edge at 2000 counts)",
+    )
     p.set_defaults(execute=_execute)
 
 
@@ -230,9 +282,15 @@ def _execute(args: argparse.Namespace) -> int:
             f"--encoder-cpr must be 1 … {INT_MAX} counts per revolution, got "
             f"{args.encoder_cpr} (an exact encoder is not benchmarked; default {ENCODER_CPR})"
         )
+    if not -1.0 <= args.target_offset <= 1.0:  # NaN fails too
+        raise UserError(
+            f"--target-offset must be −1 … 1 counts past 1 rad, got {args.target_offset} "
+            "(default 0)"
+        )
     chains = CHAINS[:1] if args.quick else CHAINS
     seeds = range(1, args.seeds + 1)
-    result = run(args.out, seeds, chains, progress, args.encoder_cpr)
+    distance = target_distance(args.target_offset, args.encoder_cpr)
+    result = run(args.out, seeds, chains, progress, args.encoder_cpr, distance)
     print(result["table"])
     print(f"wrote {args.out / 'control.md'} and {args.out / 'control.json'} "
           f"({result['seconds']:.0f} s)")  # fmt: skip

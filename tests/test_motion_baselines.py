@@ -295,8 +295,8 @@ def test_bench_control_refuses_an_encoder_it_cannot_run(capsys, cpr: str) -> Non
 
 
 def test_a_bench_seed_identifies_designs_and_scores_with_its_encoder(monkeypatch) -> None:
-    """``score_seed(..., encoder_cpr=N)`` hands N to the identification's log, the design
-    and the runs (stopped there)."""
+    """``score_seed(..., encoder_cpr=N, distance=d)`` hands N to the identification's log,
+    the design and the runs, and d to the runs (stopped there)."""
     from benchmarks import control_accuracy as bench
 
     seen = {}
@@ -304,13 +304,40 @@ def test_a_bench_seed_identifies_designs_and_scores_with_its_encoder(monkeypatch
     class StoppedError(Exception):
         pass
 
-    def runs(folder, chain, ideal, seed, encoder_cpr):
-        seen["runs"] = encoder_cpr
+    def runs(folder, chain, ideal, seed, encoder_cpr, distance):
+        seen["runs"] = encoder_cpr, distance
         raise StoppedError
 
     monkeypatch.setattr(bench, "identify_chain", lambda *a: seen.setdefault("log", a[4]))
     monkeypatch.setattr(bench, "design_parameters", lambda r, i, c: seen.setdefault("design", c))
     monkeypatch.setattr(bench, "Runs", runs)
     with pytest.raises(StoppedError):
-        bench.score_seed(bench.CHAINS[0], None, 1, False, encoder_cpr=8192)
-    assert seen == {"log": 8192, "design": 8192, "runs": 8192}
+        bench.score_seed(bench.CHAINS[0], None, 1, False, encoder_cpr=8192, distance=1.5)
+    assert seen == {"log": 8192, "design": 8192, "runs": (8192, 1.5)}
+
+
+@pytest.mark.parametrize("offset", ["1.5", "-2", "nan"])
+def test_bench_control_refuses_a_target_offset_past_a_count(capsys, offset: str) -> None:
+    """``arcosim bench control --target-offset`` outside −1 … 1 counts (or not a number):
+    one line naming the option, the range and the default."""
+    from arcosim.cli import main
+
+    assert main(["bench", "control", "--target-offset", offset]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--target-offset must be −1 … 1 counts past 1 rad" in err and "default 0" in err
+    assert len(err.splitlines()) == 1
+
+
+def test_the_target_offset_puts_the_target_where_it_says() -> None:
+    """``--target-offset`` 0.19 at 2000 counts puts the target half way between two of the
+    plant's edges (318.5 counts from the start), and the report says so."""
+    from benchmarks import control_accuracy as bench
+
+    distance = bench.target_distance(0.19, 2000)
+    assert distance * 2000 / (2 * math.pi) == pytest.approx(318.5, abs=1e-3)
+    assert "318.50 counts of the encoder from the start (0.50 count" in bench.geometry(
+        distance, 2000
+    )
+    assert "(0.00 count from the nearer edge)" in bench.geometry(
+        bench.target_distance(-0.31, 2000), 2000
+    )

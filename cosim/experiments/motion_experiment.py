@@ -197,7 +197,8 @@ def motion_steps() -> int:
 class Runs:
     """The runs of one chain: its plant's FMUs, sensors and the load step, and what to
     call with the steps done after each run; the plant's encoder has ``encoder_cpr``
-    counts (exact if ``ideal``), and limit cycles are counted in them either way."""
+    counts (exact if ``ideal``), and limit cycles are counted in them either way; each
+    run moves the last mass by ``distance`` (rad) from rest."""
 
     def __init__(
         self,
@@ -207,16 +208,18 @@ class Runs:
         progress: Callable[[int], object] = lambda _steps: None,
         seed: int = SEED,
         encoder_cpr: int = ENCODER_CPR,
+        distance: float = DISTANCE,
     ) -> None:
         self.folder, self.chain, self.ideal, self.progress = folder, chain, ideal, progress
         self.seed = seed
         self.cpr = encoder_cpr
+        self.distance = distance
 
     def run(self, controller: object, full_state: bool = False, load: bool = False) -> LoopRun:
-        """A 1 rad move from rest; with ``load``, the load-torque step during the hold."""
+        """A move of ``distance`` from rest; with ``load``, the load-torque step during the hold."""
         step = LoadStep(self.chain.n, LOAD_TIME, LOAD_TORQUE) if load else None
         run = run_closed_loop(
-            self.folder, self.chain.n, controller, DISTANCE, DURATION,
+            self.folder, self.chain.n, controller, self.distance, DURATION,
             plant=plant_settings(self.chain, self.ideal, self.seed, self.cpr), load=step,
             full_state=full_state,
         )  # fmt: skip
