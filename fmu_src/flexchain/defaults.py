@@ -206,6 +206,19 @@ HOLD_QUIET_ANGLE = 5e-3
 HOLD_QUIET_TIME = 0.3
 #: … and how far off it gives the move's gain back (rad).
 HOLD_QUIET_LEAVE = 20e-3
+#: Where the hold keeps the motor's mean (:mod:`~arcosim.fmu.flexchain.hold_edge`): within
+#: HOLD_EDGE_NEAR counts of an encoder edge, so that the dither crosses that edge alone;
+#: the hold's target moves by the least that takes it there, up to 0.5 + HOLD_EDGE_SWITCH
+#: − HOLD_EDGE_NEAR counts (0 = the mean on an edge, 0.5 = off). With the target half way
+#: between two edges (`arcosim bench control --target-offset 0.19`) it took the two-mass
+#: chain from 53 to 80 of 80 runs within one count at rest, the three-mass chain from 67
+#: to 76 (docs/development.md). Counts:
+HOLD_EDGE_NEAR = 0.3
+#: … how far past the middle of a count the needed angle goes before the other edge is
+#: taken (counts): the edge is not traded back and forth on the load estimate's noise,
+HOLD_EDGE_SWITCH = 0.1
+#: … and the low-pass on that angle (rad/s).
+HOLD_EDGE_BANDWIDTH = 2.0
 #: Bandwidth of the motor-alone observer that averages the de-dithered reading (rad/s):
 #: at 150, with its velocity and the DOB fed from it too, two chains diverged at the J
 #: +10 %, k −10 % corner (docs/development.md).

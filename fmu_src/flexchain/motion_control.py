@@ -53,6 +53,7 @@ from .dob import Actuator, clamp, settle_sticking, sign
 from .encoder_edge import CrossedEdge
 from .estimator_bank import EstimatorBank
 from .hold_dither import HoldDither
+from .hold_edge import hold_edge
 from .motor_observer import MotorObserver
 from .observer import Observer, ObserverSettings
 
@@ -209,6 +210,9 @@ class MotionController:
         self.i_ff = self.i_fb = self.i_ref = 0.0
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
         self.dither: HoldDither | None = None  # while the hold's dither runs
+        # the shift of the hold's target that keeps the motor near an edge (hold_edge)
+        self.edge = hold_edge(d.encoder_cpr)
+        self._needed = self._any_edge = 0.0  # where the hold needs the motor; an edge (rad)
         self._moved = 0.0  # when the target path last moved (s)
         self._first_move = True
         self._refine_after = defaults.REFINE_AT * d.move_time  # after a move's start (s)
@@ -249,6 +253,7 @@ class MotionController:
         heading = self._heading()
         dob.step(h, i_a, omega_m, motion, heading)
         th_m = theta_m + self.offset - t0
+        self._any_edge = theta_m - t0  # the encoder's reading is its count's lower edge
         dither = self.dither
         if dither is None:
             self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
@@ -299,6 +304,10 @@ class MotionController:
             self.dither = HoldDither(design)
             self.dither.start(x[0], x[design.n + 1])
         self.bank.settle(h, abs(self.theta_hat_ctrl - self.path.target))
+        if self.bank.quiet and self.edge is not None:  # near an edge, once mass L is still
+            self.edge.step(h, self._needed, self._any_edge)
+        elif self.edge is not None:
+            self.edge.reset()
         current, friction = self.dither.command(h)
         # the friction cancelled along the dither's velocity, which the motor follows
         self.i_fb += current + (friction - self.friction) / design.k_t
@@ -400,6 +409,9 @@ class MotionController:
         rigid = (design.inertia * (v1 - v0) + design.D_m * (s1 - s0)) / (h * design.k_t)
         i_ff = clamp(rigid - _dot(K, deviation), REFERENCE_SHARE * design.i_max)
         offset, i_hold = design.load_offset(d)
+        self._needed = xr[0] + offset[0]
+        if self.dither is not None and self.edge is not None:  # the hold near an edge
+            offset = [c + self.edge.shift if j < n1 else c for j, c in enumerate(offset)]
         error = [a - b - c for a, b, c in zip(x, xr, offset)]
         i_linear = i_ff - _dot(K, error) + i_hold + d_m / design.k_t
         self.friction = design.f_c * heading(design, x, i_linear, h)
