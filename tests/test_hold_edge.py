@@ -26,10 +26,10 @@ def test_the_module_examples_run() -> None:
     assert doctest.testmod(hold_edge).failed == 0
 
 
-@pytest.mark.parametrize("past", [0.0, 0.2, 0.3, 0.7, 0.8, 1.0])
+@pytest.mark.parametrize("past", [0.0, 0.2, 0.29, 0.71, 0.8, 1.0])
 def test_near_an_edge_the_target_stays(past: float) -> None:
     """Within 0.3 count of either edge of count 318: no shift."""
-    assert keeper().step(1e-3, (318 + past) * Q, 0.0) == pytest.approx(0.0, abs=1e-15)
+    assert keeper().step(1e-3, (318 + past) * Q, 0.0) == 0.0
 
 
 @pytest.mark.parametrize(("past", "shift"), [(0.4, -0.1), (0.45, -0.15), (0.55, 0.15), (0.6, 0.1)])
@@ -81,8 +81,15 @@ def test_reset_forgets_the_edge() -> None:
 def test_the_controller_takes_its_settings_from_defaults(monkeypatch) -> None:
     """``hold_edge(cpr)`` reads the defaults when called (a test or a user may change
     them); no encoder, no edge."""
-    monkeypatch.setattr(defaults, "HOLD_EDGE_NEAR", 0.5)
+    monkeypatch.setattr(defaults, "HOLD_EDGE_NEAR", 0.4)
     made = hold_edge.hold_edge(4096)
-    assert made.near == 0.5 and made.count == pytest.approx(2 * math.pi / 4096)
+    assert made.near == 0.4 and made.count == pytest.approx(2 * math.pi / 4096)
     assert hold_edge.hold_edge(0) is None
-    assert made.step(1e-3, 318.5 * made.count, 0.0) == 0.0  # 0.5: never a shift
+
+
+def test_near_half_a_count_or_more_turns_it_off() -> None:
+    """``near`` 0.5: never a shift, past the middle of the count too (the edge kept up to
+    0.6 count would otherwise shift by up to 0.1)."""
+    edge = HoldEdge(Q, near=0.5, switch=0.1, bandwidth=1e9)
+    shifts = [edge.step(1e-3, p * Q, 0.0) for p in (318.45, 318.55, 318.58, 318.5)]
+    assert shifts == [0.0] * 4 and edge.edge is None

@@ -39,7 +39,8 @@ AFTER_MOVE = 0.6
 #: With ``hold``: the target, which the step compares with ``theta_ref`` to start a move
 #: (a switch, not a state), is left alone too, and so is the dither's own path (a signal
 #: generator: its floats follow the step count, whatever the loop does), all but its
-#: observer.
+#: observer, and the hold's edge keeper (``hold_edge``: a switch between edges of the
+#: encoder, which the exact angle here does not have; its low-pass would show as a pole).
 HOLD_UNPERTURBED = frozenset({"target"})
 #: With ``hold``: how much longer the run may go on for the estimators to take the hold's
 #: gain (s; the controller switches once the controlled mass is still).
@@ -218,6 +219,7 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     paths = _leaves(loop, skip=UNPERTURBED | (HOLD_UNPERTURBED if loop.hold else frozenset()))
     if loop.hold:
         paths = [p for p in paths if p[:2] != ("controller", "dither") or p[2] == "observer"]
+        paths = [p for p in paths if p[:2] != ("controller", "edge")]
     # of the estimator bank, the member the feedback takes: the others feed nothing back
     pick = ("controller", "bank", "members", loop.controller.bank.pick)
     paths = [p for p in paths if p[:3] != pick[:3] or p[:4] == pick]

@@ -7,7 +7,8 @@ count); half way between two edges it reaches both on its peaks, the more so as 
 angle wanders with the load estimate, and the reading takes three (two counts: the
 limit cycle the controller must not hold). Measured on `arcosim bench control` with the
 target half way between two edges (``--target-offset 0.19``): the two-mass chain within
-one count at rest on 26 of 42 runs (docs/development.md).
+one count at rest on 28 of 42 runs, and with the shift below on all 42
+(docs/benchmarks.md).
 
 :class:`HoldEdge` moves the hold's target by the least that brings the motor's mean
 within ``near`` counts of an edge, the edge kept until the needed angle is more than
@@ -33,8 +34,8 @@ class HoldEdge:
     count : float
         One encoder count (rad), > 0.
     near : float
-        How near an edge the motor's mean is kept (counts), in [0, 0.5]
-        (``defaults.HOLD_EDGE_NEAR``).
+        How near an edge the motor's mean is kept (counts), in [0, 0.5]; 0.5 or more
+        turns the shift off (``defaults.HOLD_EDGE_NEAR``).
     switch : float
         How far past the middle of the count the needed angle goes before the other edge
         is taken (counts), ≥ 0 (``defaults.HOLD_EDGE_SWITCH``).
@@ -73,6 +74,7 @@ class HoldEdge:
         self.shift = 0.0
         self.edge: float | None = None
         self.needed = 0.0
+        self.started = False  # whether the needed angle's low-pass has its first value
 
     def step(self, h: float, needed: float, any_edge: float) -> float:
         """The shift for the next step (rad).
@@ -90,13 +92,15 @@ class HoldEdge:
         Returns
         -------
         float
-            The shift (rad), also kept as :attr:`shift`.
+            The shift (rad), also kept as :attr:`shift`; always 0 with ``near`` ≥ 0.5.
         """
         q = self.count
-        if self.edge is None:
-            self.needed = needed
-        else:
+        if self.started:
             self.needed += (needed - self.needed) * (1.0 - math.exp(-self.bandwidth * h))
+        else:
+            self.needed, self.started = needed, True
+        if self.near >= 0.5:  # off: the mean is never further from an edge
+            return self.shift
         if self.edge is None or abs(self.needed - self.edge) > (0.5 + self.switch) * q:
             self.edge = any_edge + q * round((self.needed - any_edge) / q)
         off = self.needed - self.edge

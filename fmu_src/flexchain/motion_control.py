@@ -304,9 +304,9 @@ class MotionController:
             self.dither = HoldDither(design)
             self.dither.start(x[0], x[design.n + 1])
         self.bank.settle(h, abs(self.theta_hat_ctrl - self.path.target))
-        if self.bank.quiet and self.edge is not None:  # near an edge, once mass L is still
+        if self.edge is not None and self.bank.quiet:  # near an edge once mass L is still
             self.edge.step(h, self._needed, self._any_edge)
-        elif self.edge is not None:
+        elif self.edge is not None:  # the edge and the low-pass start when it is
             self.edge.reset()
         current, friction = self.dither.command(h)
         # the friction cancelled along the dither's velocity, which the motor follows
