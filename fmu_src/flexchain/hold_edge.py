@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 from . import defaults
+from .filters import lowpass_pole
 
 
 class HoldEdge:
@@ -49,6 +50,8 @@ class HoldEdge:
         The last shift (rad): add it to every angle of the hold's target.
     edge : float or None
         The edge kept (rad, in the angles given), None before :meth:`step`.
+    needed : float
+        The needed angle, low-passed (rad).
 
     Examples
     --------
@@ -74,7 +77,6 @@ class HoldEdge:
         self.shift = 0.0
         self.edge: float | None = None
         self.needed = 0.0
-        self.started = False  # whether the needed angle's low-pass has its first value
 
     def step(self, h: float, needed: float, any_edge: float) -> float:
         """The shift for the next step (rad).
@@ -94,13 +96,13 @@ class HoldEdge:
         float
             The shift (rad), also kept as :attr:`shift`; always 0 with ``near`` ≥ 0.5.
         """
-        q = self.count
-        if self.started:
-            self.needed += (needed - self.needed) * (1.0 - math.exp(-self.bandwidth * h))
-        else:
-            self.needed, self.started = needed, True
         if self.near >= 0.5:  # off: the mean is never further from an edge
             return self.shift
+        q = self.count
+        if self.edge is None:  # the low-pass starts at the first value
+            self.needed = needed
+        else:
+            self.needed += (needed - self.needed) * (1.0 - lowpass_pole(self.bandwidth, h))
         if self.edge is None or abs(self.needed - self.edge) > (0.5 + self.switch) * q:
             self.edge = any_edge + q * round((self.needed - any_edge) / q)
         off = self.needed - self.edge
