@@ -23,6 +23,7 @@ BENCHMARKS = {
     "control": "control_accuracy",
     "public": "public_records",
     "thirdparty": "thirdparty_chain",
+    "verdict": "verdict_accuracy",
 }
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from arcosim.cli.identify_options import masses_option
+from arcosim.cli.identify_options import EXIT_UNTRUSTED, masses_option
 from arcosim.cli.options import add_command, log_options
 from arcosim.cli.parameters import defaults_note, known_parameters, set_names
 from arcosim.identification.log_check import check_log
@@ -97,4 +97,6 @@ def _execute(args: argparse.Namespace) -> int:
         print(report.text())
         if note:
             print(f"assumption: {note}")
-    return 0 if report.ok else 1
+    if not report.ok:
+        return 1
+    return EXIT_UNTRUSTED if report.doubts else 0

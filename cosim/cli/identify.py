@@ -47,7 +47,11 @@ Contract (scripts rely on it)::
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s); it refuses
   exactly when ``arcosim check`` says not ok (one set of decisions).
   ``--plot FILE.png [--reference COLUMN]``: the measured response torque → motor speed
-  under the model's, and ``FILE.csv`` (``arcosim.cli.identify_plot``).
+  under the model's, and ``FILE.csv`` (``arcosim.cli.identify_plot``). The report
+  starts with the verdict (``"verdict": "trusted" | "untrusted"`` and ``"reasons"`` in
+  the JSON; :mod:`arcosim.identification.verdict`); exit status 0 when trusted, 3 when
+  the fit was made but is not trusted (printed and written all the same), 2 when it
+  refuses. ``--verbose`` adds the structure choice's evidence to the text.
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
   time, from the motor alone (``arcosim.identification.load_torque``: the observer FMU's estimator 1
   with ``load_mass``, run offline). The chain (``J[i]``, ``k[i]``, ``B[i]``) and the
@@ -195,6 +199,12 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         metavar="COLUMN",
         help="whole-chain with --plot: a logged reference or added excitation (a closed "
         "loop's): the measured response estimated indirectly through it",
+    )
+    p.add_argument(
+        "--verbose",
+        action="store_true",
+        help="whole-chain: also print the structure choice's evidence (modes seen, the "
+        "candidates and their scores)",
     )
     add_fmus_option(p)
     p.set_defaults(execute=_execute)

@@ -21,6 +21,8 @@ from arcosim.outputs import check_output, write_text
 
 #: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
 OFFLINE = ("output-error", "whole-chain")
+#: Exit status of a fit that was made but is not trusted (its verdict's reasons printed).
+EXIT_UNTRUSTED = 3
 
 
 def check_method_options(args: argparse.Namespace) -> None:

@@ -9,7 +9,7 @@ import argparse
 import json
 import sys
 
-from arcosim.cli.identify_options import write_report
+from arcosim.cli.identify_options import EXIT_UNTRUSTED, write_report
 from arcosim.cli.identify_plot import write_plot
 from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
 from arcosim.identification.band import search_band
@@ -34,7 +34,9 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     Returns
     -------
     int
-        The exit status, 0.
+        The exit status: 0 when the fit is trusted, :data:`EXIT_UNTRUSTED` (3) when it
+        was made but is not (the result is printed and written all the same, marked
+        untrusted, with the reasons).
 
     Raises
     ------
@@ -77,8 +79,8 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
     if args.json:
         print(json.dumps(tool_keys(report) if args.tool_names else report, indent=2))
     else:
-        _print_report(result, report, len(log))
-    return 0
+        _print_report(result, report, len(log), verbose=getattr(args, "verbose", False))
+    return 0 if result.verdict.trusted else EXIT_UNTRUSTED
 
 
 def _status(masses: int | str, samples: int) -> str:
@@ -93,8 +95,16 @@ def _status(masses: int | str, samples: int) -> str:
     return f"arcosim identify: fitting the whole chain to {samples} samples, {tried} (seconds)…"
 
 
-def _print_report(result: DriveIdentification, report: dict, samples: int) -> None:
-    """The report as text, ending with the ``--set`` line for the observer."""
+def _print_report(
+    result: DriveIdentification, report: dict, samples: int, verbose: bool = False
+) -> None:
+    """The report as text: the verdict first, the parameters with their standard errors,
+    the reasons, what the result rests on; the selection's evidence with ``verbose``;
+    last the ``--set`` line for the observer."""
+    verdict = result.verdict
+    print(f"verdict: {verdict.word}" + ("" if verdict.trusted else " (exit status 3)"))
+    for reason in verdict.reasons:
+        print(f"  reason: {reason}")
     print(f"{samples} samples, whole-chain fit ({result.masses} masses):")
     bounds = report.get("bounds", {})
     for key, value in result.parameters.items():
@@ -106,17 +116,50 @@ def _print_report(result: DriveIdentification, report: dict, samples: int) -> No
             print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
     for key in set(bounds) - set(result.parameters):
         print(f"  {key:8s} ≤ {bounds[key]:.2g}  (left out by the selection rule)")
-    for key in ("start", "modes_rad_s", "residue_t_values", "weak_modes", "refused"):
-        print(f"  {key}: {report[key]}")
+    for key, text in result.assumptions.items():
+        print(f"  assumption, {key}: {text}")
+    for text in result.warnings:
+        if text not in verdict.reasons:
+            print(f"  warning: {text}")
+    if verbose:
+        _print_selection(report)
+    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.observer_parameters().items())
+    print(f"every load angle, the observer with this chain: --masses {result.masses} {settings}")
+
+
+def _print_selection(report: dict) -> None:
+    """The structure choice's evidence (``--verbose``): modes, candidates, scores."""
+    modes = ", ".join(f"{w:.4g}" for w in report["modes_rad_s"])
+    t_values = ", ".join(f"{t:.3g}" for t in report["residue_t_values"])
+    print(f"  start: {report['start']}")
+    print(f"  modes seen (rad/s): {modes or 'none'}; their residue t values: {t_values or '-'}")
+    for mode in report["weak_modes"]:
+        print(f"  weak mode: {mode['rad_s']:.4g} rad/s (t = {mode['t']:.3g})")
+    for n, why in report["refused"].items():
+        print(f"  {n} masses refused: {why}")
     selection = report.get("selection", {})
     if selection:
         print(f"  selection rule: {selection['rule']}")
         for what in ("masses", "friction", "load"):
-            if what in selection:
-                print(f"  selection, {what}: {selection[what]}")
-    for key, text in result.assumptions.items():
-        print(f"  assumption, {key}: {text}")
-    for text in result.warnings:
-        print(f"  warning: {text}")
-    settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.observer_parameters().items())
-    print(f"every load angle, the observer with this chain: --masses {result.masses} {settings}")
+            scores = selection.get(what) or {}
+            chosen = scores.get("chosen") if isinstance(scores, dict) else None
+            for name, score in scores.get("candidates", scores).items():
+                taken = " (chosen)" if name == chosen else ""
+                print(f"  selection, {what}, {name}{taken}: {_score_text(score)}")
+
+
+def _score_text(score: object) -> str:
+    """One candidate's score as text (a number, or its named figures).
+
+    Examples
+    --------
+    >>> _score_text({"parameters": 7, "rms_innovation": 1.02, "bic": -3.5})
+    'parameters 7, rms_innovation 1.02, bic -3.5'
+    >>> _score_text(12.5)
+    '12.5'
+    """
+    if isinstance(score, dict):
+        return ", ".join(
+            f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in score.items()
+        )
+    return f"{score:.4g}" if isinstance(score, float) else str(score)

@@ -18,9 +18,10 @@ import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.blas import single_threaded
+from arcosim.identification.chain_modes import driving_point_modes
 from arcosim.identification.encoder_fit import RIGID_LOAD
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.log_decision import decide_log
+from arcosim.identification.log_decision import LogDecision, decide_log
 from arcosim.identification.motor_friction import without_friction
 from arcosim.identification.noise_floor import (
     floor_warning,
@@ -29,6 +30,7 @@ from arcosim.identification.noise_floor import (
     weak_mode_floor_warning,
 )
 from arcosim.identification.records import LOADS, MotorRecord
+from arcosim.identification.verdict import Verdict, judge
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
 
@@ -65,6 +67,11 @@ class DriveIdentification:
         The motor friction the result rests on, given or fitted: ``D_m``
         (N·m·s/rad) and ``f_c`` (N·m); a term the selection rule left out is 0 (its
         bound is in the report).
+    verdict : Verdict
+        Whether the result is trusted, and the reasons when not, each naming what to
+        check (:func:`~arcosim.identification.verdict.judge`: the log's plausibility,
+        the final model's residual against the noise floor, its modes against the
+        excited band, the excitation against the band the fit searches).
 
     Examples
     --------
@@ -83,6 +90,7 @@ class DriveIdentification:
     choice: ChainChoice | None = None
     record: MotorRecord | None = None
     friction: dict[str, float] = field(default_factory=dict)
+    verdict: Verdict = field(default_factory=Verdict)
 
     def chain(self) -> dict[str, float]:
         """``J[i]``, ``k[i]``, ``B[i]`` only: the chain's parameters, by the observer's names."""
@@ -114,7 +122,12 @@ class DriveIdentification:
         fit = self.choice.fit
         record = self.record
         extra = fit.extra
-        out: dict[str, object] = {"method": "whole-chain", "masses": self.masses}
+        out: dict[str, object] = {
+            "method": "whole-chain",
+            "verdict": self.verdict.word,
+            "reasons": list(self.verdict.reasons),
+            "masses": self.masses,
+        }
         out.update(self.parameters)
         out.update({k: v for k, v in self.friction.items() if k not in out})  # given
         out["std"] = dict(self.std)
@@ -269,36 +282,67 @@ def identify_drive(
         raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
     fit = choice.fit
     parameters = fit.as_dict()
-    above = None
-    # a modelled load's torque (given or chosen by the rule) is in the τ̂ residual, not the noise
-    if fit.extra.get("load", "none") == "none":
-        chain = split(fit.values, choice.n)
-        rigid = parameters.get(RIGID_LOAD, 0.0)
-        floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid)
-        motor = record
-        if not friction_given and encoder is not None:
-            friction = (parameters.get("D_m", 0.0), parameters.get("f_c", 0.0))
-            motor = without_friction(record, encoder, *friction)
-        rms = tau_residual(motor, i_a, k_t, chain, rigid)
-        above = floor_warning(rms, floor, sigma_i)
-        if above is None and choice.leaner is not None:
-            # a weak mode kept may take up what a wrong k_t or J_m leaves: the fit without
-            dropped = choice.leaner.extra["dropped_weak_modes_rad_s"]
-            leaner = split(choice.leaner.values, choice.n - len(dropped))
-            rms = tau_residual(motor, i_a, k_t, leaner)
-            above = weak_mode_floor_warning(dropped, rms, floor, sigma_i)
+    floor_findings = _against_floor(time, i_a, choice, decision, k_t, J_m, encoder_cpr, g_dist)
+    chain = split(fit.values, choice.n)
+    verdict = judge(
+        plausibility,
+        floor_findings,
+        driving_point_modes(chain[0], chain[1])[0] if choice.n else [],
+        decision.spectrum,
+        g_dist,
+    )
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
         std={k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})},
         assumptions=_load_said(dict(fit.extra["assumptions"]), load),
-        warnings=decision.warnings + list(fit.extra["warnings"]) + ([above] if above else []),
+        warnings=decision.warnings + list(fit.extra["warnings"]) + floor_findings,
         choice=choice,
         record=record,
         friction={"D_m": D_m, "f_c": f_c}
         if friction_given
         else {k: parameters.get(k, 0.0) for k in ("D_m", "f_c")},  # left out: 0
+        verdict=verdict,
     )
+
+
+def _against_floor(
+    time: np.ndarray,
+    i_a: np.ndarray,
+    choice: ChainChoice,
+    decision: LogDecision,
+    k_t: float,
+    J_m: float,
+    encoder_cpr: int,
+    g_dist: float,
+) -> list[str]:
+    """The final model's residual against the noise floor, whatever the model: with a
+    load torque modelled, both without their content below half the lowest excited line
+    (the load's, :func:`~arcosim.identification.noise_floor.load_removed`); then, when
+    the fit keeps weakly determined modes, the fit without them. Each finding one
+    sentence naming what to check; empty at the floor."""
+    fit, record, encoder = choice.fit, decision.record, decision.encoder
+    parameters = fit.as_dict()
+    below = 0.0
+    if fit.extra.get("load", "none") != "none":
+        lowest = decision.spectrum.lowest if decision.spectrum is not None else None
+        below = 0.5 * lowest if lowest else 1e-9  # the mean at least
+    chain = split(fit.values, choice.n)
+    rigid = parameters.get(RIGID_LOAD, 0.0)
+    floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid, below)
+    motor = record
+    if fit.extra.get("friction") == "fitted" and encoder is not None:
+        friction = (parameters.get("D_m", 0.0), parameters.get("f_c", 0.0))
+        motor = without_friction(motor, encoder, *friction)
+    rms = tau_residual(motor, i_a, k_t, chain, rigid, below)
+    above = floor_warning(rms, floor, sigma_i)
+    if above is None and choice.leaner is not None:
+        # a weak mode kept may take up what a wrong k_t or J_m leaves: the fit without
+        dropped = choice.leaner.extra["dropped_weak_modes_rad_s"]
+        leaner = split(choice.leaner.values, choice.n - len(dropped))
+        rms = tau_residual(motor, i_a, k_t, leaner, 0.0, below)
+        above = weak_mode_floor_warning(dropped, rms, floor, sigma_i)
+    return [above] if above else []
 
 
 def _load_said(assumptions: dict[str, str], load: str | None) -> dict[str, str]:

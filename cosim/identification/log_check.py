@@ -35,6 +35,10 @@ class CheckReport:
         Nothing stands in the way of a fit.
     problems : list of str
         What stands in the way, each with what to do.
+    doubts : list of str
+        The warnings that leave any fit of the log untrusted (the log's implausible
+        units or length, an excitation above the band): ``check`` then says
+        "doubtful" and exits with status 3, as ``identify`` would.
     warnings : list of str
         What may limit the fit, each one ``identify`` gives too.
     step : float
@@ -70,6 +74,7 @@ class CheckReport:
 
     ok: bool
     problems: list[str] = field(default_factory=list)
+    doubts: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     step: float = 0.0
     step_spread: float = 0.0
@@ -106,7 +111,15 @@ class CheckReport:
         ]
         out += [f"problem: {p}" for p in self.problems]
         out += [f"warning: {w}" for w in self.warnings]
-        out.append("ok: the log can support identification" if self.ok else "not ok")
+        if not self.ok:
+            out.append("not ok")
+        elif self.doubts:
+            out.append(
+                "doubtful: a fit of this log would be untrusted until the warnings above "
+                "are answered"
+            )
+        else:
+            out.append("ok: the log can support identification")
         return "\n".join(out)
 
     def _blind_text(self) -> str:
@@ -218,6 +231,7 @@ def report_of(decision: LogDecision, theta: np.ndarray, encoder_cpr: int) -> Che
     report = CheckReport(
         ok=decision.ok,
         problems=list(decision.problems),
+        doubts=list(decision.doubts),
         warnings=list(decision.warnings),
         step=decision.step,
         step_spread=decision.step_spread,

@@ -47,6 +47,7 @@ from arcosim.identification.records import (
     smooth_velocity,
 )
 from arcosim.identification.spectrum import ExcitationSpectrum, excitation_spectrum
+from arcosim.identification.verdict import excitation_above_band
 from arcosim.identification.whole_chain import first_reading, refusal
 
 #: Largest relative spread of the sample step the fits accept.
@@ -76,6 +77,10 @@ class LogDecision:
         What both ``check`` and ``identify`` warn of, one sentence each.
     plausibility : list of str
         The plausibility findings among the warnings (a refusal names them first).
+    doubts : list of str
+        The findings among the warnings that leave any fit of the log untrusted (the
+        plausibility findings, an excitation above the band the fit searches:
+        :mod:`~arcosim.identification.verdict`).
     step : float
         Mean sample step (s).
     step_spread : float
@@ -105,6 +110,7 @@ class LogDecision:
     problems: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     plausibility: list[str] = field(default_factory=list)
+    doubts: list[str] = field(default_factory=list)
     step: float = 0.0
     step_spread: float = 0.0
     range_counts: float = 0.0
@@ -193,7 +199,9 @@ def decide_log(
     decision.plausibility = plausibility_warnings(
         time, i_a, omega_m, theta_m, k_t, J_m, decision.spectrum.lowest
     )
-    decision.warnings += decision.plausibility
+    above = excitation_above_band(decision.spectrum, g_dist)
+    decision.doubts = decision.plausibility + ([above] if above else [])
+    decision.warnings += decision.doubts
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0
     _motion(decision, theta_m, h, count, g_dist)
     _nyquist(decision, h)

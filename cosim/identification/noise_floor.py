@@ -12,7 +12,8 @@ floor and the residual compare like with like. σ_i is estimated from the record
 and control leave little). A residual above :data:`FLOOR_FACTOR` times the floor is
 more than noise (:func:`floor_warning` names the likely causes). With a load torque
 modelled (``load`` "constant" or "slow") the τ̂ residual holds that torque, which the
-chain's prediction leaves out: no comparison then.
+chain's prediction leaves out: it lies below the excitation, and the residual and the
+floor are compared without their content there (:func:`load_removed`).
 """
 
 from __future__ import annotations
@@ -82,6 +83,7 @@ def noise_floor(
     encoder_cpr: int,
     g_dist: float,
     J_load: float = 0.0,
+    below: float = 0.0,
 ) -> tuple[float, float]:
     """The RMS τ̂ residual (N·m) the encoder's counts and the current's noise alone leave.
 
@@ -104,6 +106,9 @@ def noise_floor(
         Bandwidth of the disturbance observer (rad/s).
     J_load : float
         A rigid drive's load inertia J_total − J_m (kg·m²), used when ``chain`` is empty.
+    below : float
+        With a load torque modelled: the residual's content below this frequency
+        (rad/s) is the load's and is left out (:func:`load_removed`); 0: none modelled.
 
     Returns
     -------
@@ -120,7 +125,7 @@ def noise_floor(
     record = motor_record(time, current, omega, theta, Actuator(J_m, k_t), g_dist)
     model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
     residual = model - record.tau_hat + smoothing_error(record, current, k_t, model)
-    return float(np.sqrt(np.mean(residual**2))), sigma_i
+    return _rms(load_removed(residual, record.h, below)), sigma_i
 
 
 def smoothing_error(
@@ -182,6 +187,7 @@ def tau_residual(
     k_t: float,
     chain: tuple[Sequence[float], Sequence[float], Sequence[float]],
     J_load: float = 0.0,
+    below: float = 0.0,
 ) -> float:
     """The fit's RMS τ̂ residual (N·m) as the floor is taken: the model's τ̂ less the
     record's, the velocity smoothing's error (:func:`smoothing_error`) taken out.
@@ -198,6 +204,9 @@ def tau_residual(
         The fitted J_i (kg·m²), k_i (N·m/rad), B_i (N·m·s/rad); empty for n = 0.
     J_load : float
         A rigid drive's load inertia (kg·m²), used when ``chain`` is empty.
+    below : float
+        With a load torque modelled: leave out the residual's content below this
+        frequency (rad/s, :func:`load_removed`); 0: none modelled.
 
     Returns
     -------
@@ -206,7 +215,33 @@ def tau_residual(
     """
     model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
     residual = model - record.tau_hat + smoothing_error(record, i_a, k_t, model)
-    return float(np.sqrt(np.mean(residual**2)))
+    return _rms(load_removed(residual, record.h, below))
+
+
+def load_removed(residual: np.ndarray, h: float, below: float) -> np.ndarray:
+    """``residual`` (N·m, shape ``(N,)``, step ``h`` in s) without what a modelled load
+    torque puts in it: its mean and its content below ``below`` (rad/s; 0: none taken).
+
+    A load on the last mass slower than the chain's first mode reaches the motor whole,
+    so it sits in the τ̂ residual below the excitation, where the chain's prediction has
+    nothing; the floor is taken through the same filter, so the two still compare.
+
+    Examples
+    --------
+    >>> t = np.arange(20000) * 1e-3
+    >>> slow_and_fast = 0.5 + np.sin(0.7 * t) + 0.01 * np.sin(50 * t)
+    >>> round(float(np.std(load_removed(slow_and_fast, 1e-3, 1.5))), 4)
+    0.0071
+    """
+    if below <= 0:
+        return residual
+    residual = residual - np.mean(residual)
+    return residual - low_passed(residual, h, below)
+
+
+def _rms(x: np.ndarray) -> float:
+    """Root mean square of ``x`` (its unit)."""
+    return float(np.sqrt(np.mean(np.asarray(x) ** 2)))
 
 
 def floor_warning(rms_residual: float, floor: float, sigma_i: float) -> str | None:
