@@ -24,6 +24,7 @@ from arcosim.identification.verdict import (
     judge,
     modes_outside,
     resolved_band,
+    unresolved,
 )
 from benchmarks import field_sim
 
@@ -61,10 +62,18 @@ def test_an_excitation_above_the_observers_band_names_g_dist():
 
 def test_judge_collects_every_reason_once():
     floor = ["the residual is 6 × the noise floor"]
-    verdict = judge(["check the current's scale"], floor + floor, [248.0], LINES, 40.0)
+    weak = unresolved({"J[1]": 1e-9, "k[1]": 0.3}, {"J[1]": 1e-9, "k[1]": 0.01})
+    verdict = judge(["check the current's scale"], floor + floor, weak, [248.0], LINES, 40.0)
     assert not verdict.trusted and verdict.word == "untrusted"
-    assert len(verdict.reasons) == 4  # plausibility, floor (once), mode, band
-    assert judge([], [], [11.7], LINES, 100.0) == Verdict(())
+    assert len(verdict.reasons) == 5  # plausibility, floor (once), J[1], mode, band
+    assert judge([], [], None, [11.7], LINES, 100.0) == Verdict(())
+
+
+def test_an_inertia_or_stiffness_within_three_sigma_of_zero_is_unresolved():
+    assert unresolved({"J[1]": 3e-4, "B[1]": 1e-6}, {"J[1]": 0.9e-4, "B[1]": 1e-5}) is None
+    assert "J[1]" in unresolved({"J[1]": 3e-4}, {"J[1]": 1.1e-4})
+    assert "J_load" in unresolved({"J_load": 1.8e-18}, {"J_load": 0.0})  # σ 0: not moved
+    assert "k[2]" in unresolved({"k[2]": 0.4}, {})  # no σ: at a bound
 
 
 @functools.cache

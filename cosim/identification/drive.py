@@ -30,7 +30,7 @@ from arcosim.identification.noise_floor import (
     weak_mode_floor_warning,
 )
 from arcosim.identification.records import LOADS, MotorRecord
-from arcosim.identification.verdict import Verdict, judge
+from arcosim.identification.verdict import Verdict, judge, unresolved
 from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain, split
 
 
@@ -284,9 +284,11 @@ def identify_drive(
     parameters = fit.as_dict()
     floor_findings = _against_floor(time, i_a, choice, decision, k_t, J_m, encoder_cpr, g_dist)
     chain = split(fit.values, choice.n)
+    std = {k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})}
     verdict = judge(
         plausibility,
         floor_findings,
+        unresolved(parameters, std),
         driving_point_modes(chain[0], chain[1])[0] if choice.n else [],
         decision.spectrum,
         g_dist,
@@ -294,7 +296,7 @@ def identify_drive(
     return DriveIdentification(
         masses=choice.n,
         parameters=parameters,
-        std={k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})},
+        std=std,
         assumptions=_load_said(dict(fit.extra["assumptions"]), load),
         warnings=decision.warnings + list(fit.extra["warnings"]) + floor_findings,
         choice=choice,

@@ -23,6 +23,9 @@ noise:
   describe is left over: a k_t 10 % high or J_m 10 % low (an inertia on the motor, which
   a stiff extra mass above the band imitates: measured 248 rad/s under 150 rad/s of
   excitation), or a mode above the band;
+* **every inertia and stiffness resolved**: a J_i or k_i (or a rigid drive's load
+  inertia) within :data:`LEAST_T` standard errors of 0, or with a standard error of 0
+  (the record does not move it), is not determined by the record;
 * **the excitation against the disturbance observer's band**: an excitation reaching
   above 3·g_dist drives modes that τ̂_reac, and so the fit, cannot see (a motor bench's
   mode at 339 rad/s under the default g_dist of 100 rad/s).
@@ -44,6 +47,10 @@ from arcosim.identification.spectrum import ExcitationSpectrum
 
 #: The verdict's two words.
 TRUSTED, UNTRUSTED = "trusted", "untrusted"
+#: An inertia or stiffness is resolved by the record when it lies at least this many of
+#: its standard errors from 0 (dimensionless; the three-sigma rule: under Gaussian
+#: errors a parameter that is 0 reads so by chance 0.3 % of the time).
+LEAST_T = 3.0
 
 
 @dataclass(frozen=True)
@@ -103,9 +110,9 @@ def resolved_band(spectrum: ExcitationSpectrum | None) -> tuple[float, float] | 
     low, high = float(spectrum.band[0]), float(spectrum.band[1])
     lines = np.sort(np.asarray(spectrum.lines, dtype=float))
     if spectrum.kind != "broadband" and len(lines) >= 2 and lines[0] > 0:
-        return low / (lines[1] / lines[0]), high * (lines[-1] / lines[-2])
+        return float(low / (lines[1] / lines[0])), float(high * (lines[-1] / lines[-2]))
     step = float(spectrum.resolution)
-    return max(low - step, 0.0), high + step
+    return float(max(low - step, 0.0)), float(high + step)
 
 
 def modes_outside(modes: Sequence[float], spectrum: ExcitationSpectrum | None) -> str | None:
@@ -134,6 +141,38 @@ def modes_outside(modes: Sequence[float], spectrum: ExcitationSpectrum | None) -
         "A fit puts one there to take up what the chain cannot describe: check k_t and J_m "
         "(--set k_to=…, --set J_mo=…), or excite the drive where the mode lies; "
         "--masses N fits a given number of masses"
+    )
+
+
+def unresolved(parameters: dict[str, float], std: dict[str, float]) -> str | None:
+    """A reason when an inertia or stiffness of the fit is not resolved by the record:
+    within :data:`LEAST_T` standard errors of 0, or with a standard error of 0 or none
+    (``parameters`` and ``std`` by the observer's names, each in its own unit). The
+    dampers are not judged: they are often unresolved on good records, and the report
+    gives their bounds.
+
+    Examples
+    --------
+    >>> unresolved({"J[1]": 4e-4, "k[1]": 0.3}, {"J[1]": 1e-7, "k[1]": 3e-5}) is None
+    True
+    >>> unresolved({"J[1]": 7e-11, "k[1]": 0.3}, {"J[1]": 2e-6, "k[1]": 3e-5})[:42]
+    'the record does not resolve J[1] = 7e-11 ±'
+    """
+    weak = [
+        name
+        for name, value in parameters.items()
+        if name[:2] in ("J[", "k[") or name == "J_load"
+        if not (std.get(name, 0.0) > 0 and abs(value) >= LEAST_T * std[name])
+    ]
+    if not weak:
+        return None
+    listed = ", ".join(
+        f"{name} = {parameters[name]:.3g} ± {std.get(name, float('nan')):.2g}" for name in weak
+    )
+    return (
+        f"the record does not resolve {listed} (within {LEAST_T:g} standard errors of 0): "
+        "excite the drive more (a larger current, lines around every mode, a longer "
+        "record), or fit fewer masses (--masses N)"
     )
 
 
@@ -170,6 +209,7 @@ def excitation_above_band(spectrum: ExcitationSpectrum | None, g_dist: float) ->
 def judge(
     plausibility: Sequence[str],
     floor: Sequence[str],
+    resolution: str | None,
     modes: Sequence[float],
     spectrum: ExcitationSpectrum | None,
     g_dist: float,
@@ -185,6 +225,8 @@ def judge(
         The residual's findings against the noise floor on the final model
         (:func:`~arcosim.identification.noise_floor.floor_warning`,
         :func:`~arcosim.identification.noise_floor.weak_mode_floor_warning`).
+    resolution : str or None
+        The parameters the record does not resolve (:func:`unresolved`).
     modes : sequence of float
         The final chain's clamped modes (rad/s); empty for a rigid drive.
     spectrum : ExcitationSpectrum or None
@@ -199,13 +241,17 @@ def judge(
 
     Examples
     --------
-    >>> judge([], [], [], None, 100.0).word
+    >>> judge([], [], None, [], None, 100.0).word
     'trusted'
-    >>> judge(["check the current's scale (--scale i_a=…)"], [], [], None, 100.0).reasons
+    >>> judge(["check the current's scale (--scale i_a=…)"], [], None, [], None, 100.0).reasons
     ("check the current's scale (--scale i_a=…)",)
     """
     found = [*plausibility, *floor]
-    for reason in (modes_outside(modes, spectrum), excitation_above_band(spectrum, g_dist)):
+    for reason in (
+        resolution,
+        modes_outside(modes, spectrum),
+        excitation_above_band(spectrum, g_dist),
+    ):
         if reason is not None:
             found.append(reason)
     return Verdict(tuple(dict.fromkeys(found)))
