@@ -168,3 +168,27 @@ def test_a_chain_in_grams_is_named_a_unit_mistake(capsys) -> None:
     needs = float(verdict.split(" needs ")[1].split(" A")[0])
     assert 180.0 < needs < 200.0
     assert "check the units" in verdict and "kg·m²" in verdict and "move_time" in verdict
+
+
+@pytest.mark.parametrize(
+    ("content", "named"),
+    [
+        (
+            {"masses": 0, "J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3},
+            "masses = 0 (a rigid drive) but it holds J[1]",
+        ),
+        ({"masses": 25}, "masses = 25: the number of load masses must be 1 to 20"),
+        ({"masses": 1, "J[1]": -1e-4, "k[1]": 50.0, "B[1]": 1e-3}, "J[1] = -0.0001 must be > 0"),
+        ({"masses": 1, "J[1]": 1e-4, "k[1]": 50.0, "B[1]": -1e-3}, "B[1] = -0.001 must be >= 0"),
+    ],
+)
+def test_a_chain_file_mistake_names_the_file_and_its_field(
+    capsys, tmp_path: Path, content: dict, named: str
+) -> None:
+    """The message names what the user gave: the file and its field, never an option
+    (``--masses 25``) the user did not type, nor a J[1] the file does hold."""
+    path = tmp_path / "chain.json"
+    path.write_text(json.dumps(content), encoding="utf-8")
+    line = refusal(capsys, "control", "--chain", path)
+    assert f"--chain {path}: {named}" in line
+    assert "--masses 25" not in line and "no J[1]" not in line
