@@ -290,6 +290,34 @@ def test_an_ssp_with_a_truncated_fmu_inside(capsys, fmus, tmp_path) -> None:
     assert "component observer (ReactionTorqueObserver.fmu): not a complete FMU" in line
 
 
+def test_an_ssp_without_its_system_structure_or_a_folder_is_named(capsys, tmp_path) -> None:
+    """Not a raw OS error with a temporary path, not "no such file" for a folder."""
+    empty = tmp_path / "other.ssp"
+    with zipfile.ZipFile(empty, "w") as z:
+        z.writestr("readme.txt", "no system here")
+    line = refused(capsys, "ssp", empty)
+    assert f"{empty} is not an SSP: no SystemStructure.ssd" in line
+    assert "arcosim_ssp_" not in line and "Errno" not in line
+    folder = tmp_path / "unpacked.ssp"
+    folder.mkdir()
+    line = refused(capsys, "ssp", folder)
+    assert "is a folder" in line and "no such file" not in line
+    text = tmp_path / "notes.ssp"
+    text.write_text("time,i_a\n0,1\n")
+    assert "not an SSP (not a zip file)" in refused(capsys, "ssp", text)
+
+
+def test_validate_calls_a_csv_named_ssp_what_it_is(capsys, tmp_path) -> None:
+    """The zip's magic decides, not the name: a CSV named .ssp is no SSP system."""
+    text = tmp_path / "run.ssp"
+    text.write_text("time,i_a\n0,1\n")
+    line = refused(capsys, "validate", text)
+    assert "not an FMU (not a zip file)" in line and "SSP system" not in line
+    folder = tmp_path / "model.fmu"
+    folder.mkdir()
+    assert "is a folder" in refused(capsys, "validate", folder)
+
+
 # -- files that are not what they should be ---------------------------------------------
 
 
