@@ -249,3 +249,27 @@ def test_build_replaces_its_own_files_and_with_force_a_users(tmp_path: Path) -> 
     forced = arcosim("build", "--masses", "1", "--out", str(out), "--force")
     assert forced.returncode == 0, forced.stderr
     assert made_by_arcosim(out / "MotionControl.ssp")
+
+
+def test_simulate_says_the_recursions_later_masses_diverge_by_design(fmus, capsys) -> None:
+    """The paper's recursion (the default estimator) reports theta_hat[3] in the
+    thousands: the report says that is the method, and what does not diverge."""
+    argv = ["simulate", "--fmus", str(fmus), "--duration", "0.5"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "theta_hat[3]" in out
+    note = [line for line in out.splitlines() if line.startswith("note:")]
+    assert len(note) == 1 and "diverges from the second mass on by design" in note[0]
+    assert "--set observer.estimator=1" in note[0]
+    assert main([*argv, "--set", "observer.estimator=1"]) == 0
+    assert "note:" not in capsys.readouterr().out
+
+
+def test_simulate_warns_of_a_step_too_coarse_for_its_excitation(fmus, capsys) -> None:
+    """The flexible maneuver's top line is 120 rad/s; at --step 0.01 s that is 5 steps a
+    period, under the 10 a zero-order hold needs to follow a sine."""
+    assert main(["simulate", "--fmus", str(fmus), "--duration", "1", "--step", "0.01"]) == 0
+    err = capsys.readouterr().err
+    assert "arcosim: warning: --step 0.01 s" in err and "120 rad/s" in err
+    assert main(["simulate", "--fmus", str(fmus), "--duration", "0.2"]) == 0
+    assert "warning" not in capsys.readouterr().err
