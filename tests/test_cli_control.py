@@ -192,3 +192,21 @@ def test_a_chain_file_mistake_names_the_file_and_its_field(
     line = refusal(capsys, "control", "--chain", path)
     assert f"--chain {path}: {named}" in line
     assert "--masses 25" not in line and "no J[1]" not in line
+
+
+def test_a_robust_verdict_prints_the_measured_rate_beside_the_threshold() -> None:
+    """ "decays at 0.1 1/s or faster" is the pass mark, not a finding: the verdict names the
+    slowest decay measured over the cases it checked, and the case."""
+    import arcosim
+    from arcosim.control.margins import MIN_DECAY
+
+    chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3}
+    chain.update({"J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5})
+    found = arcosim.controller_margins(chain, h=1e-3, random_models=0)
+    assert found.robust
+    fs = found.full_state
+    decays = [found.sensorless, found.sensorless_late, found.worst, *found.hold]
+    slowest = min([d.decay for d in decays] + [fs["slowest_decay"], fs["decay_one_step_late"]])
+    verdict = found.verdict()
+    assert f"the slowest loop checked decays at {slowest:.3g} 1/s (" in verdict, verdict
+    assert f"pass: {MIN_DECAY:g} 1/s or faster" in verdict
