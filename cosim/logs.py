@@ -12,7 +12,8 @@ that any reader takes. Asked for tool-safe names (``tool_names=True``, the CLI's
 ``--tool-names``), the columns are written as ``theta_hat_1`` for ``theta_hat[1]`` and
 ``plant_i_noise_std`` for ``plant.i_noise_std``, names MATLAB, R or a spreadsheet keep as
 they are (``tool_name``); the log columns are such names already, so ``read_log`` reads
-either form, and files without a sidecar as before.
+either form, and files without a sidecar as before. ``read_log`` reads a log's sidecar
+back and refuses scales it contradicts.
 """
 
 from __future__ import annotations
@@ -129,8 +130,10 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     ------
     UserError
         Naming the row or column at fault: no such file, an empty file, a missing
-        column, a cell that is not a finite number, time that does not increase,
-        fewer than two rows, a file that is not UTF-8 text.
+        column, a column twice, columns separated by ``;`` or tabs, a cell that is not
+        a finite number, time that does not increase, fewer than two rows, a file that
+        is not UTF-8 text; or a scale the log's units sidecar contradicts
+        (:func:`check_scales_against_units`).
 
     Examples
     --------
@@ -189,7 +192,7 @@ def _column_index(path: Path, header: list[str] | None) -> dict[str, int]:
     header = [h.strip() for h in header]
     missing = [c for c in LOG_COLUMNS if c not in header]
     for sep in (";", "\t"):
-        if missing and all(c in "".join(header).split(sep) for c in missing):
+        if missing and all(c in [h.strip() for h in sep.join(header).split(sep)] for c in missing):
             raise UserError(
                 f"{path}: the columns are separated by {sep!r}: give a comma-separated CSV"
             )
