@@ -135,7 +135,7 @@ def test_load_torque_never_writes_over_its_chain(capsys, fmus, log, tmp_path) ->
     for text, phrase in (
         (b'{"J[1]": "heavy", "k[1]": 1, "B[1]": 0}', "J[1] = 'heavy' is not a number"),
         (b'{"masses": 2.5}', "masses = 2.5 is not a whole number"),
-        (b'{"masses": 99}', "--masses 99"),
+        (b'{"masses": 99}', "masses = 99: the number of load masses must be 1 to 20"),
         (b'\xef\xbb\xbf{"masses": 1, "J[1]": 1}', "missing k[1], B[1]"),
         (b"\xff{}", "byte 0xff is not UTF-8"),
     ):

@@ -161,14 +161,8 @@ class ControllerMargins:
 
     @property
     def failing(self) -> list[LoopDecay]:
-        """The cases (:attr:`cases`) whose loop decays slower than ``MIN_DECAY`` (or
-        grows), in their order."""
+        """The :attr:`cases` decaying slower than ``MIN_DECAY`` (or growing), in order."""
         return [c for c in self.cases if not c.decay >= MIN_DECAY]
-
-    @property
-    def slowest(self) -> LoopDecay:
-        """The case checked whose loop decays slowest: the measured margin to ``MIN_DECAY``."""
-        return min(self.cases, key=lambda c: c.decay)
 
     @property
     def robust(self) -> bool:
@@ -207,7 +201,7 @@ class ControllerMargins:
         """One line: robust or not, and what to do."""
         pct = f"±{100 * self.error:g} %"
         if self.robust:
-            slowest = self.slowest
+            slowest = min(self.cases, key=lambda c: c.decay)  # the margin measured
             return (
                 f"verdict: robust: the slowest loop checked decays at {slowest.decay:.3g} 1/s "
                 f"({slowest.model}; pass: {MIN_DECAY:g} 1/s or faster); checked: the "
