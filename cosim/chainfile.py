@@ -15,7 +15,7 @@ import math
 import re
 from pathlib import Path
 
-from arcosim.build.recipes import check_masses
+from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.errors import UserError
 from arcosim.logs import read_text_file
 
@@ -51,15 +51,16 @@ def read_chain(path: str | Path) -> dict[str, float]:
     ------
     ChainFileError
         When the file is not JSON, not an object, a value is not a finite number, or
-        ``masses`` is not a whole number, or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing,
-        or the report is a rigid drive's (masses = 0: the message gives the ``--set``
+        ``masses`` is not a whole number or not a supported number of masses (1 to
+        20), or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing, or a ``J[i]`` or ``k[i]`` is
+        not positive or a ``B[i]``, ``D_m`` or ``f_c`` negative, or ``masses = 0`` beside
+        ``J[i]``, or the report is a rigid drive's (masses = 0: the message gives the ``--set``
         for the observer instead), or it holds no ``J[i]`` at all (an output-error
         report: the message names the whole-chain fit that writes a chain); the message
         starts with the file's name.
     UserError
         When the file is missing, a folder or not UTF-8 text
-        (:func:`arcosim.logs.read_text_file`), or n is not a supported number of masses
-        (:func:`arcosim.build.recipes.check_masses`).
+        (:func:`arcosim.logs.read_text_file`).
 
     Examples
     --------
@@ -83,9 +84,16 @@ def read_chain(path: str | Path) -> dict[str, float]:
     chain = {k: v for k, v in data.items() if _is_chain_value(k)}
     for key, value in chain.items():
         _check_number(path, key, value)
-    masses = chain.get("masses", sum(k.startswith("J[") for k in chain))
+    inertias = sum(k.startswith("J[") for k in chain)
+    masses = chain.get("masses", inertias)
     if masses != int(masses):
         raise ChainFileError(f"{path}: masses = {masses} is not a whole number")
+    if masses == 0 and inertias:
+        raise ChainFileError(
+            f"{path}: masses = 0 (a rigid drive) but it holds J[1]"
+            + (f" … J[{inertias}]" if inertias > 1 else "")
+            + f": write masses = {inertias} to read its chain, or remove the J[i], k[i], B[i]"
+        )
     if masses == 0 and isinstance(data.get("J_load"), (int, float)):
         raise ChainFileError(
             f"{path}: a rigid drive (masses = 0) has no chain: give the observer its load "
@@ -95,12 +103,19 @@ def read_chain(path: str | Path) -> dict[str, float]:
         )
     if masses == 0:
         raise ChainFileError(f"{path}: {_no_chain(data)}")
-    n = check_masses(int(masses))
+    if not MIN_MASSES <= masses <= MAX_MASSES:
+        raise ChainFileError(
+            f"{path}: masses = {int(masses)}: the number of load masses must be "
+            f"{MIN_MASSES} to {MAX_MASSES}"
+        )
+    n = int(masses)
     missing = [
         f"{p}[{i}]" for p in CHAIN_PARAMETERS for i in range(1, n + 1) if f"{p}[{i}]" not in chain
     ]
     if missing:
         raise ChainFileError(f"{path}: missing {', '.join(missing)}")
+    for key, value in chain.items():
+        _check_sign(path, key, value)
     return {**{k: float(v) for k, v in chain.items()}, "masses": n}
 
 
@@ -128,3 +143,13 @@ def _check_number(path: Path, key: str, value: object) -> None:
         raise ChainFileError(f"{path}: {key} = {value!r:.40} is not a number")
     if not math.isfinite(value):
         raise ChainFileError(f"{path}: {key} = {value} is not a finite number")
+
+
+def _check_sign(path: Path, key: str, value: float) -> None:
+    """Refuse a value no physical chain has: an inertia or stiffness not above zero, a
+    damping or friction below zero."""
+    name = key.split("[")[0]
+    if name in ("J", "k") and not value > 0:
+        raise ChainFileError(f"{path}: {key} = {value:g} must be > 0")
+    if name in ("B", "D_m", "f_c") and not value >= 0:
+        raise ChainFileError(f"{path}: {key} = {value:g} must be >= 0")

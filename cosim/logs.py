@@ -12,7 +12,8 @@ that any reader takes. Asked for tool-safe names (``tool_names=True``, the CLI's
 ``--tool-names``), the columns are written as ``theta_hat_1`` for ``theta_hat[1]`` and
 ``plant_i_noise_std`` for ``plant.i_noise_std``, names MATLAB, R or a spreadsheet keep as
 they are (``tool_name``); the log columns are such names already, so ``read_log`` reads
-either form, and files without a sidecar as before.
+either form, and files without a sidecar as before. ``read_log`` reads a log's sidecar
+back and refuses scales it contradicts.
 """
 
 from __future__ import annotations
@@ -129,8 +130,10 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
     ------
     UserError
         Naming the row or column at fault: no such file, an empty file, a missing
-        column, a cell that is not a finite number, time that does not increase,
-        fewer than two rows, a file that is not UTF-8 text.
+        column, a column twice, columns separated by ``;`` or tabs, a cell that is not
+        a finite number, time that does not increase, fewer than two rows, a file that
+        is not UTF-8 text; or a scale the log's units sidecar contradicts
+        (:func:`check_scales_against_units`).
 
     Examples
     --------
@@ -156,6 +159,7 @@ def read_log(path: str | Path, scales: Mapping[str, float] | None = None) -> Dri
         raise UserError(f"{path}, row {reader.line_num}: not CSV text ({error})") from None
     if len(rows) < 2:
         raise UserError(f"{path}: needs at least two data rows (has {len(rows)})")
+    check_scales_against_units(path, scales or {})  # the sidecar counts too
     data = np.array([v for _, v in rows])
     with np.errstate(over="ignore", invalid="ignore"):
         for c, factor in (scales or {}).items():
@@ -187,10 +191,48 @@ def _column_index(path: Path, header: list[str] | None) -> dict[str, int]:
         )
     header = [h.strip() for h in header]
     missing = [c for c in LOG_COLUMNS if c not in header]
+    for sep in (";", "\t"):
+        if missing and all(c in [h.strip() for h in sep.join(header).split(sep)] for c in missing):
+            raise UserError(
+                f"{path}: the columns are separated by {sep!r}: give a comma-separated CSV"
+            )
+    twice = [c for c in LOG_COLUMNS if header.count(c) > 1]
+    if twice:
+        raise UserError(
+            f"{path}: column {', '.join(twice)} appears twice in the header; "
+            "keep one (which to read is not for arcosim to guess)"
+        )
     if missing:
         shown = ", ".join(repr(h) if not h.isprintable() else h for h in header[:20])
         raise UserError(f"{path}: missing column {', '.join(missing)} (the header has: {shown})")
     return {c: header.index(c) for c in LOG_COLUMNS}
+
+
+def check_scales_against_units(path: Path, scales: Mapping[str, float]) -> None:
+    """Refuse ``--scale`` factors the log's units sidecar (:func:`read_units`) contradicts:
+    a factor other than 1 for a column it says is in SI units already, and no factor for
+    a column it says is in another unit.
+
+    Raises
+    ------
+    UserError
+        Naming the factor, the sidecar and the unit it states; or a sidecar that is not
+        a JSON object.
+    """
+    units = read_units(path)
+    for column in LOG_COLUMNS:
+        unit, si, factor = units.get(column, ""), COLUMN_UNITS[column], scales.get(column)
+        if unit == si and factor not in (None, 1.0):
+            raise UserError(
+                f"--scale {column}={factor:g} contradicts {units_path(path)}, which says "
+                f"{column} is in {unit!r} (SI) already: drop --scale {column}, or fix the "
+                "units file if it is wrong"
+            )
+        if unit not in ("", si) and factor is None:
+            raise UserError(
+                f"{units_path(path)} says {column} is in {unit!r}: give --scale "
+                f"{column}=FACTOR that converts it to {si!r}"
+            )
 
 
 def _row_values(path: Path, line: int, row: list[str], index: dict[str, int]) -> list[float]:
@@ -373,5 +415,10 @@ def read_units(path: str | Path) -> dict[str, str]:
     sidecar = units_path(path)
     if not sidecar.is_file():
         return {}
-    units = json.loads(read_text_file(sidecar, "units file"))
+    try:
+        units = json.loads(read_text_file(sidecar, "units file"))
+    except ValueError as error:
+        raise UserError(f"{sidecar}: the units file is not JSON ({error})") from None
+    if not isinstance(units, dict):
+        raise UserError(f'{sidecar}: the units file must be one JSON object {{"column": "unit"}}')
     return {str(k): str(v) for k, v in units.items()}

@@ -192,3 +192,84 @@ def test_check_says_whether_a_log_supports_identification(build_fmus, tmp_path, 
     fits = main(["identify", str(poor), "--method", "whole-chain", "--masses", "auto"])
     assert (status == 0) == (fits == 0), text
     assert "paper bench's value was used" in text  # nothing of the drive given
+
+
+@pytest.mark.parametrize("name", ["MotorChainPlant.fmu", "ActionReaction.ssp", "FlexLinkPlant.fmu"])
+def test_build_never_replaces_a_file_it_did_not_make(tmp_path: Path, capsys, name) -> None:
+    """docs/cli.md promises no file is replaced without --force: a user's own file of one of
+    the names build writes stays, and the refusal names it and --force."""
+    mine = tmp_path / name
+    mine.write_bytes(b"my own model, not arcosim's")
+    assert main(["build", "--masses", "1", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert str(mine) in err and "--force" in err
+    assert "Traceback" not in err
+    assert mine.read_bytes() == b"my own model, not arcosim's"
+
+
+def test_build_knows_its_own_files_by_their_model_description(tmp_path: Path) -> None:
+    """Its own FMUs and SSPs it may replace (a rebuild); one of another tool, of another
+    model, or no zip at all it may not."""
+    import zipfile
+
+    from arcosim.build.cache import made_by_arcosim
+
+    def fmu(name: str, model: str, tool: str) -> Path:
+        path = tmp_path / name
+        with zipfile.ZipFile(path, "w") as z:
+            z.writestr(
+                "modelDescription.xml",
+                f'<fmiModelDescription fmiVersion="2.0" modelName="{model}" '
+                f'generationTool="{tool}"/>',
+            )
+        return path
+
+    assert made_by_arcosim(fmu("MotorChainPlant.fmu", "MotorChainPlant_n3", "arcosim 0.1.0"))
+    assert made_by_arcosim(fmu("FlexLinkPlant.fmu", "FlexLinkPlant_e6", "arcosim 0.2.0"))
+    assert not made_by_arcosim(fmu("MotorChainPlant.fmu", "MotorChainPlant", "Dymola 2024"))
+    assert not made_by_arcosim(fmu("ExcitationSource.fmu", "MotorChainPlant_n3", "arcosim 0.1"))
+    (tmp_path / "ActionReaction.ssp").write_text("text")
+    assert not made_by_arcosim(tmp_path / "ActionReaction.ssp")
+    assert not made_by_arcosim(tmp_path / "MotionControl.ssp")  # missing: nothing to replace
+
+
+@pytest.mark.system
+@pytest.mark.slow
+def test_build_replaces_its_own_files_and_with_force_a_users(tmp_path: Path) -> None:
+    out = tmp_path / "fmus"
+    assert arcosim("build", "--masses", "1", "--out", str(out)).returncode == 0
+    from arcosim.build.cache import made_by_arcosim
+
+    assert all(made_by_arcosim(p) for p in out.iterdir() if not p.name.startswith("."))
+    again = arcosim("build", "--masses", "1", "--out", str(out))
+    assert again.returncode == 0, again.stderr  # its own files: a rebuild
+    (out / "MotionControl.ssp").write_text("mine")
+    refused = arcosim("build", "--masses", "1", "--out", str(out))
+    assert refused.returncode == 2 and "--force" in refused.stderr
+    forced = arcosim("build", "--masses", "1", "--out", str(out), "--force")
+    assert forced.returncode == 0, forced.stderr
+    assert made_by_arcosim(out / "MotionControl.ssp")
+
+
+def test_simulate_says_the_recursions_later_masses_diverge_by_design(fmus, capsys) -> None:
+    """The paper's recursion (the default estimator) reports theta_hat[3] in the
+    thousands: the report says that is the method, and what does not diverge."""
+    argv = ["simulate", "--fmus", str(fmus), "--duration", "0.5"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "theta_hat[3]" in out
+    note = [line for line in out.splitlines() if line.startswith("note:")]
+    assert len(note) == 1 and "diverges from the second mass on by design" in note[0]
+    assert "--set observer.estimator=1" in note[0]
+    assert main([*argv, "--set", "observer.estimator=1"]) == 0
+    assert "note:" not in capsys.readouterr().out
+
+
+def test_simulate_warns_of_a_step_too_coarse_for_its_excitation(fmus, capsys) -> None:
+    """The flexible maneuver's top line is 120 rad/s; at --step 0.01 s that is 5 steps a
+    period, under the 10 a zero-order hold needs to follow a sine."""
+    assert main(["simulate", "--fmus", str(fmus), "--duration", "1", "--step", "0.01"]) == 0
+    err = capsys.readouterr().err
+    assert "arcosim: warning: --step 0.01 s" in err and "120 rad/s" in err
+    assert main(["simulate", "--fmus", str(fmus), "--duration", "0.2"]) == 0
+    assert "warning" not in capsys.readouterr().err

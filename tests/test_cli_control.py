@@ -168,3 +168,45 @@ def test_a_chain_in_grams_is_named_a_unit_mistake(capsys) -> None:
     needs = float(verdict.split(" needs ")[1].split(" A")[0])
     assert 180.0 < needs < 200.0
     assert "check the units" in verdict and "kg·m²" in verdict and "move_time" in verdict
+
+
+@pytest.mark.parametrize(
+    ("content", "named"),
+    [
+        (
+            {"masses": 0, "J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3},
+            "masses = 0 (a rigid drive) but it holds J[1]",
+        ),
+        ({"masses": 25}, "masses = 25: the number of load masses must be 1 to 20"),
+        ({"masses": 1, "J[1]": -1e-4, "k[1]": 50.0, "B[1]": 1e-3}, "J[1] = -0.0001 must be > 0"),
+        ({"masses": 1, "J[1]": 1e-4, "k[1]": 50.0, "B[1]": -1e-3}, "B[1] = -0.001 must be >= 0"),
+    ],
+)
+def test_a_chain_file_mistake_names_the_file_and_its_field(
+    capsys, tmp_path: Path, content: dict, named: str
+) -> None:
+    """The message names what the user gave: the file and its field, never an option
+    (``--masses 25``) the user did not type, nor a J[1] the file does hold."""
+    path = tmp_path / "chain.json"
+    path.write_text(json.dumps(content), encoding="utf-8")
+    line = refusal(capsys, "control", "--chain", path)
+    assert f"--chain {path}: {named}" in line
+    assert "--masses 25" not in line and "no J[1]" not in line
+
+
+def test_a_robust_verdict_prints_the_measured_rate_beside_the_threshold() -> None:
+    """ "decays at 0.1 1/s or faster" is the pass mark, not a finding: the verdict names the
+    slowest decay measured over the cases it checked, and the case."""
+    import arcosim
+    from arcosim.control.margins import MIN_DECAY
+
+    chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3}
+    chain.update({"J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5})
+    found = arcosim.controller_margins(chain, h=1e-3, random_models=0)
+    assert found.robust
+    fs = found.full_state
+    decays = [found.sensorless, found.sensorless_late, found.worst, *found.hold]
+    slowest = min([d.decay for d in decays] + [fs["slowest_decay"], fs["decay_one_step_late"]])
+    verdict = found.verdict()
+    assert f"the slowest loop checked decays at {slowest:.3g} 1/s (" in verdict, verdict
+    assert f"pass: {MIN_DECAY:g} 1/s or faster" in verdict

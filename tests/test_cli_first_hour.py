@@ -134,8 +134,10 @@ def test_chain_feeds_the_observer_replay_as_the_pasted_values(
     """Quick start 2, step 3: ``--chain chain.json`` gives the same estimates as the nine
     values pasted with ``--set``, and ``--set`` wins over the file."""
     common = ["identify", log, "--fmus", fmus, "--set", "estimator=1", "--json"]
-    code, by_file, _ = run(capsys, *common, "--chain", chain_file, "--masses", "2")
-    assert code == 0  # --masses 2 overruled by the file's 3 masses
+    code, by_file, _ = run(capsys, *common, "--chain", chain_file, "--masses", "3")
+    assert code == 0  # --masses that agrees with the file's 3 masses
+    code, _, err = run(capsys, *common, "--chain", chain_file, "--masses", "2")
+    assert code == 2 and "--masses 2 but --chain" in err and "holds 3" in err
     code, pasted, _ = run(capsys, *common, *as_sets(CHAIN))
     assert code == 0
     assert json.loads(by_file) == json.loads(pasted)

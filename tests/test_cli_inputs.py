@@ -135,7 +135,7 @@ def test_load_torque_never_writes_over_its_chain(capsys, fmus, log, tmp_path) ->
     for text, phrase in (
         (b'{"J[1]": "heavy", "k[1]": 1, "B[1]": 0}', "J[1] = 'heavy' is not a number"),
         (b'{"masses": 2.5}', "masses = 2.5 is not a whole number"),
-        (b'{"masses": 99}', "--masses 99"),
+        (b'{"masses": 99}', "masses = 99: the number of load masses must be 1 to 20"),
         (b'\xef\xbb\xbf{"masses": 1, "J[1]": 1}', "missing k[1], B[1]"),
         (b"\xff{}", "byte 0xff is not UTF-8"),
     ):
@@ -288,6 +288,34 @@ def test_an_ssp_with_a_truncated_fmu_inside(capsys, fmus, tmp_path) -> None:
             out.writestr(item, data)
     line = refused(capsys, "ssp", broken, "--stop", "0.1")
     assert "component observer (ReactionTorqueObserver.fmu): not a complete FMU" in line
+
+
+def test_an_ssp_without_its_system_structure_or_a_folder_is_named(capsys, tmp_path) -> None:
+    """Not a raw OS error with a temporary path, not "no such file" for a folder."""
+    empty = tmp_path / "other.ssp"
+    with zipfile.ZipFile(empty, "w") as z:
+        z.writestr("readme.txt", "no system here")
+    line = refused(capsys, "ssp", empty)
+    assert f"{empty} is not an SSP: no SystemStructure.ssd" in line
+    assert "arcosim_ssp_" not in line and "Errno" not in line
+    folder = tmp_path / "unpacked.ssp"
+    folder.mkdir()
+    line = refused(capsys, "ssp", folder)
+    assert "is a folder" in line and "no such file" not in line
+    text = tmp_path / "notes.ssp"
+    text.write_text("time,i_a\n0,1\n")
+    assert "not an SSP (not a zip file)" in refused(capsys, "ssp", text)
+
+
+def test_validate_calls_a_csv_named_ssp_what_it_is(capsys, tmp_path) -> None:
+    """The zip's magic decides, not the name: a CSV named .ssp is no SSP system."""
+    text = tmp_path / "run.ssp"
+    text.write_text("time,i_a\n0,1\n")
+    line = refused(capsys, "validate", text)
+    assert "not an FMU (not a zip file)" in line and "SSP system" not in line
+    folder = tmp_path / "model.fmu"
+    folder.mkdir()
+    assert "is a folder" in refused(capsys, "validate", folder)
 
 
 # -- files that are not what they should be ---------------------------------------------
@@ -495,3 +523,72 @@ def test_no_message_shows_a_numpy_repr(log) -> None:
         replay_log(Refusing(), read_log(log), outputs=["d_hat"])
     assert "sample at t = 0.001 s: the observer refused it" in str(refusal.value)
     assert "np.float64" not in str(refusal.value)
+
+
+# -- every input counts ----------------------------------------------------------------
+
+ROWS = "".join(f"{k * 1e-3},{0.1 * (k % 7)},{0.01 * k},{1e-5 * k * k}\n" for k in range(50))
+
+
+def small_log(folder: Path, header: str = "time,i_a,omega_m,theta_m", sep: str = ",") -> Path:
+    path = folder / "drive.csv"
+    path.write_text(header + "\n" + ROWS.replace(",", sep), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("command", ["identify", "check"])
+def test_a_scale_the_units_sidecar_contradicts_is_refused(capsys, tmp_path, command) -> None:
+    """The sidecar says i_a is in A already: --scale i_a=0.001 (mA to A) cannot both hold."""
+    log = small_log(tmp_path)
+    sidecar = tmp_path / "drive.units.json"
+    sidecar.write_text(json.dumps({"time": "s", "i_a": "A", "omega_m": "rad/s", "theta_m": "rad"}))
+    line = refused(capsys, command, log, "--scale", "i_a=0.001")
+    assert "--scale i_a=0.001" in line and str(sidecar) in line and "'A'" in line
+
+
+def test_a_scale_of_one_or_on_a_log_without_a_sidecar_is_taken(tmp_path) -> None:
+    from arcosim.logs import read_log
+
+    log = small_log(tmp_path)
+    assert read_log(log, {"i_a": 1e-3}).columns["i_a"][1] == pytest.approx(1e-4)
+    (tmp_path / "drive.units.json").write_text(json.dumps({"i_a": "A"}))
+    assert read_log(log, {"i_a": 1.0}).columns["i_a"][1] == pytest.approx(0.1)
+    assert read_log(log, {"theta_m": 2.0}).columns["theta_m"][1] == pytest.approx(2e-5)
+
+
+def test_a_sidecar_that_is_not_json_is_named(capsys, tmp_path) -> None:
+    log = small_log(tmp_path)
+    (tmp_path / "drive.units.json").write_text("{not json")
+    assert "drive.units.json" in refused(capsys, "check", log)
+
+
+def test_a_log_with_a_column_twice_is_refused_naming_it(capsys, tmp_path) -> None:
+    log = tmp_path / "drive.csv"
+    log.write_text("time,i_a,omega_m,i_a,theta_m\n" + ROWS.replace("\n", ",0\n"))
+    line = refused(capsys, "check", log)
+    assert "i_a" in line and "twice" in line
+
+
+@pytest.mark.parametrize("sep", [";", "\t"])
+def test_a_log_separated_by_semicolons_names_the_separator(capsys, tmp_path, sep) -> None:
+    line = refused(
+        capsys,
+        "identify",
+        small_log(tmp_path, sep.join(["time", "i_a", "omega_m", "theta_m"]), sep),
+    )
+    assert f"separated by {sep!r}" in line and "give a comma-separated CSV" in line
+
+
+def test_chain_and_masses_that_disagree_are_refused(capsys, tmp_path) -> None:
+    chain = tmp_path / "chain.json"
+    chain.write_text(json.dumps({"masses": 1, "J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3}))
+    log = small_log(tmp_path)
+    line = refused(capsys, "identify", log, "--chain", chain, "--masses", "2")
+    assert "--masses 2" in line and f"--chain {chain} holds 1" in line
+
+
+def test_a_sidecar_unit_that_is_not_si_asks_for_its_scale(capsys, tmp_path) -> None:
+    log = small_log(tmp_path)
+    (tmp_path / "drive.units.json").write_text(json.dumps({"i_a": "mA"}))
+    line = refused(capsys, "check", log)
+    assert "says i_a is in 'mA'" in line and "--scale i_a=" in line

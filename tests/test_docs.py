@@ -148,3 +148,61 @@ def test_a_broken_link_fails_the_check(tmp_path: Path) -> None:
     result = build(folder)
     assert result.returncode != 0
     assert "no-such-page.md" in result.stderr, result.stderr[-3000:]
+
+
+# -- docs/cli.md and the README say what the commands do ---------------------------------
+
+NUMBERS = {"three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8}
+
+
+def _parser(command: str):
+    """The argparse parser of ``arcosim COMMAND``."""
+    import argparse
+
+    from arcosim.cli import make_parser
+
+    parser = make_parser()
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return action.choices[command]
+
+
+def test_reproduce_counts_its_experiments_alike_everywhere() -> None:
+    """The experiments ``reproduce`` runs (its module's numbered list): the help's
+    "three … and four beyond", the README's sentence and table, and docs/cli.md agree."""
+    import arcosim.experiments.reproduce as module
+
+    count = len(re.findall(r"^\d+\. ", module.__doc__, re.MULTILINE))
+    helped = re.search(r"paper's (\w+) experiments .* and (\w+) beyond", _parser("reproduce")
+                       .description.replace("\n", " "))  # fmt: skip
+    assert NUMBERS[helped[1]] + NUMBERS[helped[2]] == count
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    quick = readme[readme.index("## Quick start 1") : readme.index("## Quick start 2")]
+    said = re.search(r"(\w+) experiments on the paper's bench .* and (\w+) on a flexible", quick,
+                     re.DOTALL)  # fmt: skip
+    assert NUMBERS[said[1].lower()] + {"one": 1}[said[2]] == count, said[0]
+    assert len(re.findall(r"^\| \d+ \|", quick, re.MULTILINE)) == count
+    cli = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    assert re.search(r"Runs the (\w+) experiments", cli)[1] == next(
+        w for w, n in NUMBERS.items() if n == count
+    )
+
+
+def test_the_cli_page_lists_every_method_and_scenario_the_help_offers() -> None:
+    """identify's --method choices and simulate's scenarios, each in docs/cli.md's tables;
+    the rigid scenario's current as its help states it."""
+    from arcosim.experiments.control_scenarios import CONTROL_SCENARIOS
+    from arcosim.experiments.scenarios import SCENARIOS
+
+    cli = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    method = next(a for a in _parser("identify")._actions if a.dest == "method")
+    row = next(line for line in cli.splitlines() if line.startswith("| `--method` |"))
+    for choice in method.choices:
+        assert f"`{choice}`" in row, choice
+    for name in [*SCENARIOS, *CONTROL_SCENARIOS]:
+        assert f"\n| `{name}` |" in cli, name
+    current = re.search(r"(\d+(\.\d+)?) A", SCENARIOS["rigid"].description)[0]
+    assert f"| `rigid` | rigid maneuver, {current} " in cli
+    simulate = cli[cli.index("## `arcosim simulate`") : cli.index("## `arcosim excite`")]
+    assert not re.search(r"(?<![\d.])2 A\b", simulate)  # the rigid current was once "2 A"
+    build = cli[cli.index("## `arcosim build`") : cli.index("## `arcosim simulate`")]
+    assert "`ActionReactionController.fmu`" in build and "`MotionControl.ssp`" in build

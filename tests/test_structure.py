@@ -155,3 +155,28 @@ def test_a_report_without_a_chain_names_the_whole_chain_fit(tmp_path, report, na
     message = str(caught.value)
     assert "--method whole-chain --out" in message
     assert "--masses 0" not in message
+
+
+@pytest.mark.slow
+def test_the_rigid_drives_printed_next_step_runs(rigid_log, fmus, tmp_path, capsys) -> None:
+    """identify prints the observer's settings for the drive it found as the next step; for
+    a rigid drive (n = 0) that step must run as printed, not be refused."""
+    import shlex
+
+    from arcosim.cli import main
+    from arcosim.logs import write_csv
+
+    d, log = rigid_log
+    path = write_csv(
+        tmp_path / "rigid.csv",
+        {"time": log.time, "i_a": log.i_a, "omega_m": log.omega_m, "theta_m": log.theta_m},
+    )
+    motor = ["--set", f"k_to={d.k_t!r}", "--set", f"J_mo={defaults.J_M!r}"]
+    motor += ["--set", f"encoder_cpr={d.counts}"]
+    assert main(["identify", str(path), "--method", "whole-chain", *motor]) == 0
+    out = capsys.readouterr().out
+    assert "(0 masses)" in out
+    step = out.strip().splitlines()[-1].split(": ", 1)[1]
+    assert "dJm=" in step
+    code = main(["identify", str(path), "--fmus", str(fmus), *motor, *shlex.split(step)])
+    assert code == 0, capsys.readouterr().err

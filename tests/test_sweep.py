@@ -221,3 +221,48 @@ def test_summary_plots_carry_units_and_leave_the_seed_out(fmus, tmp_path, monkey
     assert "observer.g_dist (rad/s)" in labels and "runtime (s)" in labels
     assert not any("seed" in label for label in labels)
     assert "| plant.seed" not in text and "plant.seed draws a new noise" in text
+
+
+@pytest.mark.parametrize("text", ["", "\n# nothing here yet\n"])
+def test_an_empty_spec_is_refused_not_run_as_a_default_sweep(tmp_path, capsys, text) -> None:
+    path = spec_file(tmp_path, text)
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: the spec is empty" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def _sweep_with_errors(monkeypatch, errors: list[str]) -> None:
+    """Stand in for the runs: ``results.csv`` with one row per entry of ``errors``."""
+    import arcosim.cli.sweep as command
+
+    def fake(spec, out, *args, **kwargs) -> Path:
+        out.mkdir(parents=True, exist_ok=True)
+        rows = "".join(f"{i},1.0,{e}\n" for i, e in enumerate(errors))
+        (out / "results.csv").write_text("run,runtime,error\n" + rows)
+        return out / "results.csv"
+
+    monkeypatch.setattr(command, "sweep", fake)
+
+
+@pytest.mark.parametrize(
+    ("errors", "code", "phrase"),
+    [
+        (["", "", ""], 0, None),
+        (["", "g_dist = -5.0 must be > 0", ""], 1, "1 of 3 runs failed"),
+        (["boom", "boom"], 3, "all 2 runs failed"),
+    ],
+)
+def test_a_sweep_with_failed_runs_exits_non_zero(
+    tmp_path, capsys, monkeypatch, errors, code, phrase
+) -> None:
+    """A sweep whose runs failed does not report success: 1 when some failed, 3 when all
+    did, with the count on stderr."""
+    _sweep_with_errors(monkeypatch, errors)
+    path = spec_file(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--no-progress"]) == code
+    err = capsys.readouterr().err
+    if phrase is None:
+        assert "failed" not in err
+    else:
+        assert phrase in err and "results.csv" in err

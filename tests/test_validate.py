@@ -50,3 +50,27 @@ def test_validate_without_fmus_checks_the_cached_ones(build_fmus, capsys) -> Non
     assert (
         out.count(": OK") == 5 and str(build_fmus(3)) in out
     )  # the link and the controller included
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "MotorChainPlant",
+        "ReactionTorqueObserver",
+        "ExcitationSource",
+        "ActionReactionController",
+        "FlexLinkPlant",
+    ],
+)
+def test_every_fmu_declares_its_default_tolerance(build_fmus, name) -> None:
+    """A host that takes the DefaultExperiment gets a relative tolerance too, not only a
+    start, stop and step."""
+    from xml.etree import ElementTree
+
+    from arcosim.fmu.fmukit.model_description import DEFAULT_TOLERANCE
+
+    with zipfile.ZipFile(build_fmus(3) / f"{name}.fmu") as z:
+        root = ElementTree.fromstring(z.read("modelDescription.xml"))
+    experiment = root.find("DefaultExperiment")
+    assert float(experiment.get("tolerance")) == DEFAULT_TOLERANCE
+    assert float(experiment.get("stepSize")) > 0

@@ -25,6 +25,7 @@ from arcosim.build.cache import (
     default_folder,
     fmu_package_dir,
     fmu_problem,
+    foreign_files,
     is_current,
     lock_folder,
     source_digest,
@@ -39,7 +40,7 @@ from arcosim.build.recipes import (
     check_elements,
     check_masses,
 )
-from arcosim.errors import BuildError
+from arcosim.errors import BuildError, UserError
 from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
 from arcosim.version import __version__
 
@@ -111,8 +112,13 @@ def _build_python_fmu(recipe: FmuRecipe, n: int, out: Path) -> Path:
     return target
 
 
-def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS) -> list[Path]:
+def build_all(
+    n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS, *, force: bool = False
+) -> list[Path]:
     """Build every FMU of the project for ``n`` load masses, and their SSP system.
+
+    A file of one of the names it writes that a build did not write itself
+    (:func:`~arcosim.build.cache.made_by_arcosim`) is replaced only with ``force``.
 
     Parameters
     ----------
@@ -123,12 +129,19 @@ def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS
         (:func:`arcosim.build.cache.default_folder`).
     elements : int, optional
         Hermite elements of the flexible-link plant (``FlexLinkPlant.fmu``), 1 to 16.
+    force : bool, optional
+        Replace such files too.
 
     Returns
     -------
     list of Path
         The chain plant, observer, source and controller FMUs, ``ActionReaction.ssp``,
         ``MotionControl.ssp`` and ``FlexLinkPlant.fmu``.
+
+    Raises
+    ------
+    UserError
+        When ``out`` holds such a file and ``force`` is not given.
 
     Examples
     --------
@@ -144,6 +157,12 @@ def build_all(n: int = 3, out: Path | None = None, elements: int = LINK_ELEMENTS
     check_elements(elements)
     target = Path(out) if out is not None else default_folder(n, elements)
     with lock_folder(target):
+        foreign = [] if force else foreign_files(target)
+        if foreign:
+            raise UserError(
+                f"{foreign[0]} exists and was not written by arcosim build: move it away, "
+                "or give --force to replace it"
+            )
         return build_locked(n, target, elements)
 
 

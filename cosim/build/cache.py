@@ -18,6 +18,7 @@ import contextlib
 import fcntl
 import functools
 import hashlib
+import io
 import os
 import zipfile
 import zlib
@@ -164,3 +165,46 @@ def is_current(folder: Path, n: int, elements: int = LINK_ELEMENTS) -> bool:
     wanted = [folder / r.file_name for r in (*RECIPES, LINK)] + [folder / SSP_NAME]
     wanted.append(folder / CONTROL_SSP_NAME)
     return all(fmu_problem(path) is None for path in wanted)
+
+
+def built_names() -> list[str]:
+    """The names of the files a build writes into its folder (FMUs and SSPs)."""
+    return [r.file_name for r in (*RECIPES, LINK)] + [SSP_NAME, CONTROL_SSP_NAME]
+
+
+def made_by_arcosim(path: Path) -> bool:
+    """True if ``path`` is a file a build of this project wrote, so a rebuild may replace it.
+
+    An FMU is ours when its modelDescription.xml names arcosim as its ``generationTool``
+    and its model is the one of its file name (``MotorChainPlant_n3`` in
+    ``MotorChainPlant.fmu``); an SSP when its system has the file's name and every FMU
+    it packs is ours. Anything else (another tool's file, no zip, a missing file) is not.
+    """
+    try:
+        with zipfile.ZipFile(path) as z:
+            return _zip_is_ours(z, path.stem, path.suffix)
+    except (OSError, zipfile.BadZipFile, KeyError, ElementTree.ParseError, ValueError):
+        return False
+
+
+def _zip_is_ours(z: zipfile.ZipFile, stem: str, suffix: str) -> bool:
+    if suffix == ".fmu":
+        root = ElementTree.fromstring(z.read("modelDescription.xml"))
+        return root.get("generationTool", "").startswith("arcosim ") and root.get(
+            "modelName", ""
+        ).startswith(f"{stem}_")
+    root = ElementTree.fromstring(z.read("SystemStructure.ssd"))
+    fmus = [m for m in z.namelist() if m.startswith("resources/") and m.endswith(".fmu")]
+    if root.get("name") != stem or not fmus:
+        return False
+    for member in fmus:
+        with zipfile.ZipFile(io.BytesIO(z.read(member))) as inner:
+            if not _zip_is_ours(inner, Path(member).stem, ".fmu"):
+                return False
+    return True
+
+
+def foreign_files(folder: Path) -> list[Path]:
+    """The files in ``folder`` a build would replace but did not write itself."""
+    paths = [folder / name for name in built_names()]
+    return [p for p in paths if (p.exists() or p.is_symlink()) and not made_by_arcosim(p)]

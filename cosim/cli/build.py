@@ -40,7 +40,8 @@ first use anyway, so this is only needed to get the files themselves).""",
         examples="""
 arcosim build --out fmus
 arcosim build --masses 2 --out fmus2
-arcosim build --elements 8 --out fmus""",
+arcosim build --elements 8 --out fmus
+arcosim build --out fmus --force    # replace a MotorChainPlant.fmu of your own there""",
     )
     p.add_argument(
         "--masses",
@@ -64,11 +65,17 @@ arcosim build --elements 8 --out fmus""",
         metavar="DIR",
         help="output folder (default: the per-user cache, ~/.cache/arcosim/fmus/...)",
     )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace files of the names it writes that an earlier build did not write "
+        "(its own FMUs and SSPs it replaces anyway)",
+    )
     p.set_defaults(execute=_execute)
 
 
 def _execute(args: argparse.Namespace) -> int:
     elements = check_elements(args.elements)
-    for path in build_all(check_masses(args.masses), args.out, elements):
+    for path in build_all(check_masses(args.masses), args.out, elements, force=args.force):
         print(f"built {path}")
     return 0

@@ -37,7 +37,8 @@ def check_method_options(args: argparse.Namespace) -> None:
     ------
     UserError
         When ``--start-k`` or ``--fit-inertia-scale`` comes without ``--method
-        output-error``, or ``--mode`` without ``--method observer``.
+        output-error``, ``--mode`` without ``--method observer``, or ``--masses``
+        that disagrees with the masses of the ``--chain`` file.
     """
     for given, option in (
         (args.start_k is not None, "--start-k"),
@@ -47,6 +48,12 @@ def check_method_options(args: argparse.Namespace) -> None:
             raise UserError(f"{option} is for --method output-error (not {args.method})")
     if args.mode is not None and args.method != "observer":
         raise UserError(f"--mode is for --method observer (not {args.method})")
+    if args.chain and args.masses is not None and args.method not in ("whole-chain", "beam"):
+        n = chain_option(args.chain)["masses"]
+        if masses_option(args.masses) != n:
+            raise UserError(
+                f"--masses {args.masses} but --chain {args.chain} holds {n}: give one of them"
+            )
 
 
 def masses_option(text: str) -> int:

@@ -124,7 +124,12 @@ def _print_report(
     if verbose:
         _print_selection(report)
     settings = " ".join(f'--set "{k}={v:.6g}"' for k, v in result.observer_parameters().items())
-    print(f"every load angle, the observer with this chain: --masses {result.masses} {settings}")
+    if result.masses == 0:  # no chain, no --masses 0 (the observer needs 1 to 20)
+        print(f"the load torque (tau_reac_hat), the observer with this rigid drive: {settings}")
+    else:
+        print(
+            f"every load angle, the observer with this chain: --masses {result.masses} {settings}"
+        )
 
 
 def _print_selection(report: dict) -> None:

@@ -6,12 +6,13 @@ Without ``--scheduler`` a ``dask.distributed.LocalCluster`` of ``--workers`` pro
 runs here; with it the same tasks go to that cluster. Rows are appended to
 ``results.csv`` as runs finish; ``--resume`` runs only the missing ones. While it
 runs the sweep holds the folder's lock: a second sweep into it is refused, naming the
-pid and start time of the first.
+pid and start time of the first. Exits 1 when some runs failed, 3 when all did.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -21,6 +22,9 @@ from arcosim.outputs import same_file
 from arcosim.sweeps.runner import RESULTS, SUMMARY, sweep
 from arcosim.sweeps.spec import load_spec
 from arcosim.sweeps.summary import read_results
+
+#: Exit statuses of a sweep that ran: some runs failed, every run failed.
+SOME_FAILED, ALL_FAILED = 1, 3
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -33,7 +37,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 Run a Monte Carlo or grid sweep of co-simulations described by a TOML spec, on a
 local Dask cluster of --workers processes or on the cluster at --scheduler. Rows are
 appended to results.csv in --out as runs finish; --resume runs only the missing
-ones. A second sweep into the same folder is refused while the first runs.""",
+ones. A second sweep into the same folder is refused while the first runs.
+
+Exit status: 0 when every run succeeded, 1 when some runs failed, 3 when all
+failed (the count on stderr, each run's error in results.csv), 2 for a refusal.""",
         examples="""
 arcosim sweep examples/sweep_noise_encoder_gdist.toml --workers 2 --out sweeps/noise
 arcosim sweep spec.toml --out sweeps/noise --resume""",
@@ -80,4 +87,17 @@ def _execute(args: argparse.Namespace) -> int:
         f"{len(rows)} runs ({failed} failed) in {time.perf_counter() - start:.1f} s; "
         f"wrote {results} and {out / SUMMARY}"
     )
-    return 0
+    return _exit_status(failed, len(rows), results)
+
+
+def _exit_status(failed: int, runs: int, results: Path) -> int:
+    """0 when every run succeeded, :data:`SOME_FAILED` when some failed and
+    :data:`ALL_FAILED` when all did, the count said on stderr."""
+    if not failed:
+        return 0
+    count = f"all {runs} runs failed" if failed == runs else f"{failed} of {runs} runs failed"
+    print(
+        f"arcosim sweep: {count}; their errors are in {results} (column error) and summary.md",
+        file=sys.stderr,
+    )
+    return ALL_FAILED if failed == runs else SOME_FAILED

@@ -62,6 +62,9 @@ class Scenario:
         The plant's other inputs: step times (s, shape ``(N,)``) → values by name
         (``tau_ext[i]``, N·m, shape ``(N,)`` each), each held over its step like the
         current; None: none.
+    top_frequency : float, optional
+        The highest frequency in the current command and the other inputs (rad/s), for
+        the check that the step can follow it; None: not stated.
 
     Examples
     --------
@@ -78,6 +81,7 @@ class Scenario:
     plant: Mapping[str, float | int | bool] = field(default_factory=dict)
     observer: Mapping[str, float | int | bool] = field(default_factory=dict)
     inputs: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None
+    top_frequency: float | None = None
 
 
 def _self_identification_current(t: np.ndarray) -> np.ndarray:
@@ -200,6 +204,7 @@ class LoadProfile:
             {},
             {"mode": 2, "estimator": 1, "load_mass": self.mass},
             self.inputs,
+            float(max(BROADBAND_LINES.max(), self.frequency)),
         )
 
 
@@ -216,6 +221,7 @@ SCENARIOS: dict[str, Scenario] = {
             10.0,
             {"attached": False},
             {"mode": 0},
+            top_frequency=29.0,
         ),
         Scenario(
             "rigid",
@@ -224,6 +230,7 @@ SCENARIOS: dict[str, Scenario] = {
             RIGID_DURATION,
             {},
             {"mode": 1},
+            top_frequency=2.1 * (1.0 + 1.0 / 3.0),  # the sine times its 3-period ramps
         ),
         Scenario(
             "flexible",
@@ -232,6 +239,7 @@ SCENARIOS: dict[str, Scenario] = {
             10.0,
             {},
             {"mode": 2},
+            top_frequency=120.0,
         ),
         Scenario(
             "identification",
@@ -240,6 +248,7 @@ SCENARIOS: dict[str, Scenario] = {
             IDENTIFICATION_DURATION,
             {},
             {"mode": 2},
+            top_frequency=float(IDENTIFICATION_LINES.max()),
         ),
         LOAD_PROFILE.scenario(),
         Scenario(
@@ -249,6 +258,7 @@ SCENARIOS: dict[str, Scenario] = {
             10.0,
             {},
             {"mode": 2},
+            top_frequency=150.0,
         ),
         Scenario(
             "random",
@@ -257,6 +267,7 @@ SCENARIOS: dict[str, Scenario] = {
             10.0,
             {},
             {"mode": 2},
+            top_frequency=150.0,  # the low-pass's corner
         ),
     )
 }

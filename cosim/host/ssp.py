@@ -70,15 +70,25 @@ def read_ssp(path: Path) -> SspSystem:
     Raises
     ------
     UserError
-        A missing file, or one that is not a readable SSP (the reason named).
+        A missing file, a folder, or one that is not a readable SSP (the reason named:
+        no zip, no ``SystemStructure.ssd``).
     """
+    if Path(path).is_dir():
+        raise UserError(f"{path}: is a folder, not an SSP file (give the .ssp zip itself)")
     if not Path(path).is_file():
         raise UserError(f"{path}: no such file")
+    if not zipfile.is_zipfile(path):
+        raise UserError(f"{path}: not an SSP (not a zip file)")
     folder = tempfile.TemporaryDirectory(prefix="arcosim_ssp_")
     try:
         with zipfile.ZipFile(path) as z:
+            if "SystemStructure.ssd" not in z.namelist():
+                raise UserError(f"{path} is not an SSP: no SystemStructure.ssd")
             z.extractall(folder.name)
         root = ElementTree.parse(Path(folder.name) / "SystemStructure.ssd").getroot()
+    except UserError:
+        folder.cleanup()
+        raise
     except (zipfile.BadZipFile, ElementTree.ParseError, OSError, EOFError, zlib.error) as error:
         folder.cleanup()
         raise UserError(f"{path}: not a readable SSP ({error})") from None

@@ -133,15 +133,17 @@ def not_an_fmu(path: Path) -> str | None:
     an SSP), or None."""
     if not path.exists():
         return "no such file"
+    if path.is_dir():
+        return "is a folder, not an FMU (give the .fmu zip itself)"
     if not path.is_file():
         return "not a file"
-    if path.suffix.lower() == ".ssp":
-        return "an SSP system, not an FMU (run it with `arcosim ssp`; validate its FMUs)"
-    if not zipfile.is_zipfile(path):
+    if not zipfile.is_zipfile(path):  # the zip's magic decides, not the name
         size = path.stat().st_size
         return "an empty file, not an FMU" if size == 0 else "not an FMU (not a zip file)"
     try:
         with zipfile.ZipFile(path) as z:
+            if "SystemStructure.ssd" in z.namelist():
+                return "an SSP system, not an FMU (run it with `arcosim ssp`; validate its FMUs)"
             if "modelDescription.xml" not in z.namelist():
                 return "a zip file without modelDescription.xml, not an FMU"
             bad = z.testzip()

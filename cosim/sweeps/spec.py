@@ -154,13 +154,19 @@ def load_spec(path: Path) -> SweepSpec:
     Raises
     ------
     UserError
-        The first mistake found, naming the file and the key.
+        The first mistake found, naming the file and the key; an empty spec (no key at
+        all) too.
     """
     from arcosim.experiments.scenarios import SCENARIOS
 
     path = Path(path)
     raw = _read_toml(path)
     where = f"{path}:"
+    if not raw:  # the defaults alone would run a sweep nobody asked for
+        raise UserError(
+            f"{where} the spec is empty; write at least its scenario, runs and a [vary] "
+            "table (the format: the docs' Sweeps page)"
+        )
     _check_keys(where, raw)
     name = _name(where, raw.get("name", path.stem))
     scenario = text_value(where, "scenario", raw.get("scenario", "rigid"))
