@@ -206,3 +206,30 @@ def test_the_cli_page_lists_every_method_and_scenario_the_help_offers() -> None:
     assert not re.search(r"(?<![\d.])2 A\b", simulate)  # the rigid current was once "2 A"
     build = cli[cli.index("## `arcosim build`") : cli.index("## `arcosim simulate`")]
     assert "`ActionReactionController.fmu`" in build and "`MotionControl.ssp`" in build
+
+
+def test_the_cli_page_names_every_command_and_option_the_parsers_take() -> None:
+    """Every subcommand has a ``## `arcosim NAME` `` section in docs/cli.md, and every
+    long option its parser takes appears in that section, or in the page's opening
+    (options every command shares, ``--tool-names``): a new option left undocumented
+    fails here."""
+    import argparse
+
+    from arcosim.cli import make_parser
+
+    cli = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    parser = make_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    headings = re.findall(r"^## `arcosim (\w+)", cli, re.MULTILINE)
+    assert set(commands.choices) <= set(headings), set(commands.choices) - set(headings)
+    shared = cli[: cli.index("\n## ")]
+    missing = {}
+    for name, sub in commands.choices.items():
+        start = cli.index(f"## `arcosim {name}")
+        end = cli.find("\n## ", start + 1)
+        section = cli[start : end if end > 0 else len(cli)]
+        options = [o for a in sub._actions for o in a.option_strings if o.startswith("--")]
+        absent = [o for o in options if o != "--help" and o not in section + shared]
+        if absent:
+            missing[name] = absent
+    assert not missing, missing

@@ -131,3 +131,36 @@ def test_identify_exits_3_when_untrusted_and_still_writes(tmp_path, capsys):
     assert printed.startswith("verdict: untrusted")
     assert "reason: the chain has a mode at" in printed
     assert '"verdict": "untrusted"' in out.read_text()
+
+
+def _write(path, log, current=None, time_scale=1.0):
+    rows = np.column_stack(
+        [log.time * time_scale, log.i_a if current is None else current, log.omega_m / time_scale,
+         log.theta_m]
+    )  # fmt: skip
+    np.savetxt(path, rows, delimiter=",", header="time,i_a,omega_m,theta_m", comments="")
+    return str(path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("noise", [0.0, 5e-3])
+def test_a_current_without_excitation_is_refused_naming_it(tmp_path, capsys, noise):
+    """A constant current (or one that holds only its sensor's noise) was read as a
+    broadband excitation and fitted to a rigid drive with J_load 1.8e-18 ± 0, exit 0."""
+    log = _log()
+    current = 0.5 + noise * np.random.default_rng(1).standard_normal(len(log.time))
+    path = _write(tmp_path / "constant.csv", log, current)
+    assert main(["check", path]) == 1
+    assert "the current i_a " in capsys.readouterr().out
+    assert main(["identify", path, "--method", "whole-chain"]) == 2
+    assert "the current i_a " in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_time_column_in_ms_is_untrusted_naming_the_time_scale(tmp_path, capsys):
+    path = _write(tmp_path / "ms.csv", _log(), time_scale=1e3)
+    assert main(["check", path]) == 3
+    assert "doubtful" in capsys.readouterr().out
+    assert main(["identify", path, "--method", "whole-chain"]) == 3
+    printed = capsys.readouterr().out
+    assert printed.startswith("verdict: untrusted") and "--scale time=" in printed
