@@ -276,7 +276,9 @@ def run_record(record: Record, data: Path, work: Path, fmus: Path | None) -> dic
     for run in record.runs:
         fmu_args = ["--fmus", str(fmus)] if fmus and run.args == MODE0 else []
         status, out, err = arcosim(["identify", str(log), *sets, *run.args, *fmu_args, "--json"])
-        body = json.loads(out) if status == 0 and out.strip().startswith("{") else {}
+        # 3: a fit made but not trusted (whole chain); its figures are read all the same
+        fitted = status in (0, 3) and out.strip().startswith("{")
+        body = json.loads(out) if fitted else {}
         result["runs"].append(
             {
                 "label": run.label,
@@ -284,6 +286,8 @@ def run_record(record: Record, data: Path, work: Path, fmus: Path | None) -> dic
                 "status": status,
                 "refusal": refusal(err),
                 "quantities": run.read(body, values) if body else {},
+                "verdict": body.get("verdict", ""),
+                "reasons": body.get("reasons", []),
                 "warnings": body.get("warnings", []),
                 "std": body.get("std", {}),
                 "json": body,
@@ -318,14 +322,17 @@ def report(results: dict[str, dict]) -> str:
     lines = []
     for name, result in results.items():
         check = result["check"]
-        verdict = "ok" if check.get("ok") else "not ok"
+        verdict = "not ok" if not check.get("ok") else ("doubtful" if check.get("doubts") else "ok")
         lines.append(f"- {name}: check exit {check['status']} ({verdict})")
         lines += [f"  - problem: {p}" for p in check.get("problems", [])]
         lines += [f"  - warning: {w}" for w in check.get("warnings", [])]
         for run in result["runs"]:
-            lines.append(f"  - identify {run['label']}: exit {run['status']}")
+            said = f" ({run['verdict']})" if run.get("verdict") else ""
+            lines.append(f"  - identify {run['label']}: exit {run['status']}{said}")
             lines += [f"    - refusal: {run['refusal']}"] if run["refusal"] else []
-            lines += [f"    - warning: {w}" for w in run["warnings"]]
+            lines += [f"    - reason: {r}" for r in run.get("reasons", [])]
+            reasons = set(run.get("reasons", []))
+            lines += [f"    - warning: {w}" for w in run["warnings"] if w not in reasons]
     rows = [row for name, result in results.items() for row in comparison(name, result)]
     header = ["record", "run", "quantity", "published / reference", "identified", "error"]
     return "\n".join(lines) + "\n\n" + markdown_table(header, rows)
