@@ -295,7 +295,7 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     out["seconds"] = time.perf_counter() - wall
     out["cpu_seconds"] = time.process_time() - cpu
     if row.expect:
-        said = [out["error"]] if result is None else result.warnings
+        said = [out["error"]] if result is None else [*result.warnings, *result.verdict.reasons]
         out["cause_named"] = any(re.search(row.expect, text) for text in said)
         out["said"] = said
         out["extend_the_lines"] = any("extend the lines" in text for text in said)
@@ -304,6 +304,7 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     choice = result.choice
     n = choice.n
     out["warnings"] = list(result.warnings)
+    out["verdict"], out["reasons"] = result.verdict.word, list(result.verdict.reasons)
     out.update(n=n, modes=choice.fit.extra["modes_rad_s"], weak=choice.fit.extra["weak_modes"])
     if n != d.n:
         return out
@@ -374,9 +375,11 @@ def summary(results: list[dict], row: Row) -> dict:
     def worst(key: str) -> float:
         return max((abs(e) for r in right for e in r.get(key, ())), default=float("nan"))
 
+    trusted = sum(r.get("verdict") == "trusted" for r in results)
     if row.expect:
         return {
             "seeds": len(results),
+            "trusted": trusted,
             "cause_named": sum(bool(r.get("cause_named")) for r in results),
             "refused": sum("error" in r for r in results),
             "extend_the_lines": sum(bool(r.get("extend_the_lines")) for r in results),
@@ -392,6 +395,7 @@ def summary(results: list[dict], row: Row) -> dict:
         errors = [abs(r["J_load_error_percent"]) for r in right]
         return {
             "seeds": len(results),
+            "trusted": trusted,
             "n_right": len(right),
             "n_chosen": [r.get("n") for r in results],
             "max_abs_J_load_error_percent": max(errors, default=float("nan")),
@@ -402,6 +406,7 @@ def summary(results: list[dict], row: Row) -> dict:
 
     return {
         "seeds": len(results),
+        "trusted": trusted,
         "n_right": len(right),
         "n_chosen": [r.get("n") for r in results],
         "max_abs_J_error_percent": worst("J"),
@@ -431,6 +436,7 @@ def markdown(summaries: dict[str, dict]) -> str:
     """The table."""
     header = [
         "row",
+        "trusted",
         "n right",
         "max abs J_i err %",
         "max abs k_i err %",
@@ -450,6 +456,7 @@ def markdown(summaries: dict[str, dict]) -> str:
         rows.append(
             [
                 name,
+                f"{s['trusted']} of {s['seeds']}",
                 f"{s['n_right']} of {s['seeds']}",
                 f"{s['max_abs_J_error_percent']:.2f}",
                 f"{s['max_abs_k_error_percent']:.2f}",
@@ -470,7 +477,8 @@ def _other_line(name: str, s: dict) -> str:
     """One line for a row scored on its cause named, or the rigid drive."""
     if "cause_named" in s:
         return (
-            f"- {name}: cause named on {s['cause_named']} of {s['seeds']} (refused "
+            f"- {name}: cause named on {s['cause_named']} of {s['seeds']}, trusted on "
+            f"{s['trusted']} (refused "
             f"{s['refused']}, 'extend the lines' {s['extend_the_lines']}, n {s['n_chosen']}; "
             f"J_i, k_i, B_i within 2σ {s['JkB_inside_2_sigma'][0]} of "
             f"{s['JkB_inside_2_sigma'][1]}, B_i {s['B_inside_2_sigma'][0]} of "
@@ -478,7 +486,8 @@ def _other_line(name: str, s: dict) -> str:
             f"{s['max_abs_J_error_percent']:.2f}, {s['max_abs_k_error_percent']:.2f} %)"
         )
     return (
-        f"- {name}: n = 0 on {s['n_right']} of {s['seeds']}, max |J_load err| "
+        f"- {name}: n = 0 on {s['n_right']} of {s['seeds']}, trusted on {s['trusted']}, "
+        f"max |J_load err| "
         f"{s['max_abs_J_load_error_percent']:.2f} %, D_m covered {s['D_m_covered']}, "
         f"f_c covered {s['f_c_covered']} of {s['n_right']}"
     )
