@@ -20,6 +20,7 @@ Identifying the drive from a log (numpy/scipy, no FMU needed)
 -------------------------------------------------------------
 identify_drive      -- every J_i, k_i, B_i (and n) from a log, k_t and J_m known
 DriveIdentification -- its result: the chain, standard errors, assumptions, evidence
+Verdict             -- whether a fit is trusted, and the reasons when not (its .verdict)
 check_log           -- can a log support identification? (before any fit)
 design_excitation   -- the multi-sine to play on the drive for identification
 Actuator            -- the motor's terms: J_mo, k_to, Δk_t, ΔJ, D_m, f_c
@@ -117,6 +118,7 @@ _API = {
     "read_chain": "arcosim.chainfile",
     "identify_drive": "arcosim.identification.drive",
     "DriveIdentification": "arcosim.identification.drive",
+    "Verdict": "arcosim.identification.verdict",
     "check_log": "arcosim.identification.log_check",
     "design_excitation": "arcosim.identification.excitation_design",
     "estimate_load_torque": "arcosim.identification.load_torque",

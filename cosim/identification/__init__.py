@@ -67,6 +67,8 @@ plausibility      -- are the log's units and length plausible? (the step against
 log_decision      -- the one set of decisions check reports and identify refuses by
                      (decide_log, LogDecision)
 log_check         -- can a log support identification? (check_log, CheckReport)
+verdict           -- is a fit trusted? the reasons when not, each naming what to check
+                     (Verdict, judge)
 
 View
 ----
