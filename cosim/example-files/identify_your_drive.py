@@ -51,11 +51,17 @@ def main() -> None:
     result = arcosim.identify_drive(
         log.time, *signals, k_t=K_T, J_m=J_M, encoder_cpr=COUNTS, masses="auto"
     )
-    print(f"3. identified {result.masses} load masses:")
+    print(f"3. identified {result.masses} load masses, verdict: {result.verdict.word}")
+    for reason in result.verdict.reasons:  # each names what to check
+        print(f"   reason: {reason}")
     for name, value in result.parameters.items():
         print(f"   {name:8s} {value:.5g} ± {result.std[name]:.2g}")
     for key, text in result.assumptions.items():
         print(f"   assumption, {key}: {text}")
+    if not result.verdict.trusted:
+        raise SystemExit("the fit is not trusted: answer the reasons above first")
+    if not result.verdict.trusted:
+        raise SystemExit("the fit is not trusted: answer the reasons above first")
 
     # 4. Estimate every load angle from the motor alone: the observer FMU in mode 2,
     #    model-based estimator, with the chain just identified.
