@@ -325,10 +325,10 @@ def _against_floor(
     sentence naming what to check; empty at the floor."""
     fit, record, encoder = choice.fit, decision.record, decision.encoder
     parameters = fit.as_dict()
-    below = 0.0
+    below = None  # no load modelled: the whole residual
     if fit.extra.get("load", "none") != "none":
         lowest = decision.spectrum.lowest if decision.spectrum is not None else None
-        below = 0.5 * lowest if lowest else 1e-9  # the mean at least
+        below = 0.5 * lowest if lowest else 0.0  # 0: its mean only
     chain = split(fit.values, choice.n)
     rigid = parameters.get(RIGID_LOAD, 0.0)
     floor, sigma_i = noise_floor(time, i_a, chain, k_t, J_m, encoder_cpr, g_dist, rigid, below)

@@ -83,7 +83,7 @@ def noise_floor(
     encoder_cpr: int,
     g_dist: float,
     J_load: float = 0.0,
-    below: float = 0.0,
+    below: float | None = None,
 ) -> tuple[float, float]:
     """The RMS τ̂ residual (N·m) the encoder's counts and the current's noise alone leave.
 
@@ -106,9 +106,10 @@ def noise_floor(
         Bandwidth of the disturbance observer (rad/s).
     J_load : float
         A rigid drive's load inertia J_total − J_m (kg·m²), used when ``chain`` is empty.
-    below : float
-        With a load torque modelled: the residual's content below this frequency
-        (rad/s) is the load's and is left out (:func:`load_removed`); 0: none modelled.
+    below : float or None
+        With a load torque modelled: the residual's mean and its content below this
+        frequency (rad/s; 0: the mean only) are the load's and are left out
+        (:func:`load_removed`); None: no load modelled.
 
     Returns
     -------
@@ -187,7 +188,7 @@ def tau_residual(
     k_t: float,
     chain: tuple[Sequence[float], Sequence[float], Sequence[float]],
     J_load: float = 0.0,
-    below: float = 0.0,
+    below: float | None = None,
 ) -> float:
     """The fit's RMS τ̂ residual (N·m) as the floor is taken: the model's τ̂ less the
     record's, the velocity smoothing's error (:func:`smoothing_error`) taken out.
@@ -204,9 +205,10 @@ def tau_residual(
         The fitted J_i (kg·m²), k_i (N·m/rad), B_i (N·m·s/rad); empty for n = 0.
     J_load : float
         A rigid drive's load inertia (kg·m²), used when ``chain`` is empty.
-    below : float
-        With a load torque modelled: leave out the residual's content below this
-        frequency (rad/s, :func:`load_removed`); 0: none modelled.
+    below : float or None
+        With a load torque modelled: leave out the residual's mean and its content below
+        this frequency (rad/s; 0: the mean only; :func:`load_removed`); None: no load
+        modelled.
 
     Returns
     -------
@@ -218,9 +220,10 @@ def tau_residual(
     return _rms(load_removed(residual, record.h, below))
 
 
-def load_removed(residual: np.ndarray, h: float, below: float) -> np.ndarray:
+def load_removed(residual: np.ndarray, h: float, below: float | None) -> np.ndarray:
     """``residual`` (N·m, shape ``(N,)``, step ``h`` in s) without what a modelled load
-    torque puts in it: its mean and its content below ``below`` (rad/s; 0: none taken).
+    torque puts in it: its mean and its content below ``below`` (rad/s; 0: the mean
+    only); ``residual`` itself when ``below`` is None (no load modelled).
 
     A load on the last mass slower than the chain's first mode reaches the motor whole,
     so it sits in the τ̂ residual below the excitation, where the chain's prediction has
@@ -234,10 +237,10 @@ def load_removed(residual: np.ndarray, h: float, below: float) -> np.ndarray:
     >>> bool(np.abs(left[5000:-5000]).max() < 1e-3)  # the slow part gone, the fast kept
     True
     """
-    if below <= 0:
+    if below is None:
         return residual
     residual = residual - np.mean(residual)
-    return residual - low_passed(residual, h, below)
+    return residual - low_passed(residual, h, below) if below > 0 else residual
 
 
 def _rms(x: np.ndarray) -> float:
