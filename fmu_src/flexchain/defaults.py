@@ -62,7 +62,7 @@ def inertias(n: int) -> list[float]:
     return list(J) if n == 3 else [J[0]] * n
 
 
-# -- the flexible link (the FlexLinkPlant FMU, plant_models/flexlink_c; issue 28) ---------
+# -- the flexible link (the FlexLinkPlant FMU, plant_models/flexlink_c) ------------------
 #: A 0.4 m aluminium strip (about 20 mm × 2.4 mm) with a 20 g tip mass on the bench's
 #: motor: first clamped mode 39.8 rad/s with the tip mass (69.5 rad/s without).
 #: Hermite cubic elements of the built FMU (``arcosim build --elements``): the first three
@@ -225,7 +225,7 @@ HOLD_EDGE_BANDWIDTH = 2.0
 HOLD_OBSERVER_BANDWIDTH = 300.0
 
 
-# -- the observer on a flexible link (star of modes, ReactionTorqueObserver; issue 28) ----
+# -- the observer on a flexible link (star of modes, ReactionTorqueObserver) -------------
 #: The most link modes the observer FMU declares parameters for (a count).
 LINK_MODES_MAX = 4
 LINK_MODES = 0  #: link modes the observer runs on (0 = the chain of J, k, B)
