@@ -1,4 +1,4 @@
-"""Where the output-error damping estimate's bias comes from (issue 5, diagnosis).
+"""Where the output-error damping estimate's bias comes from (a diagnosis).
 
 On the bench (n = 3), a 20 s record with the motor kept turning one way (0.15 A
 offset plus a 40-line multi-sine from 2 to 300 rad/s), the uniform chain's k and B are

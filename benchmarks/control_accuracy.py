@@ -1,4 +1,4 @@
-"""Sensorless motion control against issue 29's Done-when criteria (``arcosim bench control``).
+"""Sensorless motion control against its four Done-when criteria (``arcosim bench control``).
 
 Three chains of our own whose lowest mode is at least 10 rad/s (none of them the bench
 or the five-mass chain of ``arcosim reproduce``), realistic sensors (2000-count encoder,

@@ -1,6 +1,6 @@
 """Outputs that a refactor must not change: record them, then compare two records.
 
-A behaviour-preserving change (issue 24) must leave every file `arcosim reproduce` writes,
+A behaviour-preserving change must leave every file `arcosim reproduce` writes,
 the CLI's outputs on the sample log and the field rows byte-identical, and the figures
 pixel-identical. This script records them into a folder and compares two such folders.
 

@@ -19,7 +19,7 @@ motor the bench's (J_m, k_t, D_m = 2e-5 N·m·s/rad, no Coulomb friction).
    sensorless controller (``MotionController``) and its full-state upper bound, designed
    on the identified chain, on it with every J_i, k_i scaled by uniform factors in
    [0.9, 1.1] (seeded with the seed) and, on the first seed, the two corners. Scored by
-   :func:`arcosim.experiments.motion_findings.score_move` and ``done_when`` (issue 29's
+   :func:`arcosim.experiments.motion_findings.score_move` and ``done_when`` (the controller's four
    criteria), as :mod:`benchmarks.control_accuracy` does.
 
 The FMU is not in the repository: ``--fmus DIR`` names the folder that holds

@@ -66,4 +66,4 @@ def test_counts_within_the_bound():
     ]  # fmt: skip
     text = markdown(rows)
     assert "of 2: as shipped 1, the best fixed member 2, without d̂ 1." in text
-    assert UPPER_BOUND_FACTOR == 1.3  # issue 29's criterion
+    assert UPPER_BOUND_FACTOR == 1.3  # the controller's criterion

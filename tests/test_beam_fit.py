@@ -3,7 +3,7 @@ noise, encoder counts, Coulomb friction with sticking; benchmarks.field_sim with
 link's modes), EI, ρA and the first two clamped modes recovered, the tip angle
 estimated; and ``arcosim identify --method beam`` end to end.
 
-Tolerances from the physics and the issue: the first two clamped modes within 1 %, EI
+Tolerances from the physics and the targets: the first two clamped modes within 1 %, EI
 and ρA within 5 %, rms(α̂ − α) ≤ 0.1 rms(α) after the first second."""
 
 from __future__ import annotations

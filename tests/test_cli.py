@@ -92,7 +92,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
         "fig9_flexible_link.png",
     ):
         assert (out / name).stat().st_size > 20_000, name
-    # by default one log per maneuver (issue 27: ~7 MB, not 99 MB; --all-csv: every run)
+    # by default one log per maneuver (~7 MB, not 99 MB; --all-csv: every run)
     runs = ("selfid.csv", "rigid_seed1.csv", "flexible.csv", "identification.csv")
     for name in (*runs, "load_true_chain.csv", "flexible_link.csv"):
         assert (out / name).stat().st_size > 100_000, name
@@ -119,7 +119,7 @@ def test_reproduce_writes_the_report_figures_and_runs(build_fmus, tmp_path: Path
     ]
     assert len(errors) == 6 and max(abs(e) for e in errors) < 2.0
     # experiment 5: the load torque's settled error, true chain within 5 % of the step and
-    # the identified chain within 10 % (issue 20's targets; measured 0.89 % and 0.77 %)
+    # the identified chain within 10 % (the targets; measured 0.89 % and 0.77 %)
     assert (out / "fig8_load_torque.png").stat().st_size > 20_000
     rows = {
         line.split()[0]: line.split()

@@ -1,4 +1,4 @@
-"""Issue 27: an engineer's first hour with the command line.
+"""An engineer's first hour with the command line.
 
 Help written for a terminal (no raw markup, examples), ``--chain`` for every method that
 uses a chain, status lines on stderr (never on stdout, so ``--json`` stays JSON), and

@@ -1,6 +1,6 @@
-"""Issue 18: the CLI never loses a file and never answers with a traceback.
+"""The CLI never loses a file and never answers with a traceback.
 
-One test per case of the issue: every refusal is one line on stderr, ``arcosim:
+One test per case: every refusal is one line on stderr, ``arcosim:
 error: …`` naming the input, with exit status 2; no input file is ever changed.
 """
 

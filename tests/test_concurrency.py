@@ -1,4 +1,4 @@
-"""Builds and sweeps are safe to run twice at once (issue 18).
+"""Builds and sweeps are safe to run twice at once.
 
 Two ``arcosim build`` into one folder with an ``arcosim simulate`` of that folder
 beside them: every process succeeds and every FMU afterwards is complete and

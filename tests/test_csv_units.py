@@ -1,4 +1,4 @@
-"""Outputs for other tools (issue 27): every CSV has its units beside it, and names other
+"""Outputs for other tools: every CSV has its units beside it, and names other
 tools keep on request; the files read back either way, old files too."""
 
 from __future__ import annotations

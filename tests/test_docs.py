@@ -1,4 +1,4 @@
-"""The docs check fails on a broken link (issue 27), and the docs pass it; the API pages
+"""The docs check fails on a broken link, and the docs pass it; the API pages
 show no raw Sphinx role and no docstring section left as a paragraph.
 
 ``make test`` and ``make docs`` run ``$(MKDOCS)`` from the Makefile; these tests run that

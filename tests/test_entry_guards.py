@@ -1,4 +1,4 @@
-"""NULL and state guards at every C entry point (issue 26), as Reference-FMUs' framework
+"""NULL and state guards at every C entry point, as Reference-FMUs' framework
 has: the plant's binary answers fmi2Error to a NULL instance (without touching it), to
 a NULL array or result pointer, and to a call its FMI 2.0 co-simulation state does not
 allow (logged); the Python FMUs' trampoline answers fmi2Error to a NULL instance.

@@ -1,4 +1,4 @@
-"""No output is ever NaN or infinite with status OK (issue 17).
+"""No output is ever NaN or infinite with status OK.
 
 Every FMU refuses the numbers that would make its model not finite where they enter:
 Real parameters beyond ±1e15 at initialization (named), a chain whose fastest mode or
@@ -71,7 +71,7 @@ def test_the_bound_on_the_chain_follows_its_stated_rate(fmus) -> None:
 
 @pytest.mark.parametrize("name", ["ReactionTorqueObserver", "MotorChainPlant"])
 def test_a_step_below_a_nanosecond_is_taken_and_inputs_beyond_the_range_are_refused(fmus, name):
-    """A step below SMALLEST_STEP takes no new sample (issue 26: tests/test_small_steps.py)
+    """A step below SMALLEST_STEP takes no new sample (see tests/test_small_steps.py)
     and leaves every output finite; an input beyond ±LARGEST is refused."""
     first_input = {"ReactionTorqueObserver": "i_a", "MotorChainPlant": "i_ref"}[name]
     with FmuInstance(fmus / f"{name}.fmu", "x") as fmu:

@@ -1,5 +1,5 @@
 """``arcosim reproduce``'s experiment 6 (cosim/experiments/flexible_link.py): the link
-plant FMU identified from its hub alone, within the issue's targets (the first two
+plant FMU identified from its hub alone, within the link's targets (the first two
 clamped modes within 1 %, EI and ρA within 5 %, rms(α̂ − α) ≤ 0.1 rms(α) after the
 first second), and its table in report.md."""
 
@@ -42,7 +42,7 @@ def test_the_link_from_its_hub_is_within_the_targets(build_fmus) -> None:
     assert abs(errors["mode[1]"]) < 1.0 and abs(errors["mode[2]"]) < 1.0, errors
     assert abs(errors["EI"]) < 5.0 and abs(errors["rhoA"]) < 5.0, errors
     assert found.alpha_ratio <= 0.1, found.alpha_ratio
-    # eq. 7 against the plant's root moment (no target in the issue: 0.086 when written)
+    # eq. 7 against the plant's root moment (no target: 0.086 when written)
     assert found.tau_ratio <= 0.15, found.tau_ratio
     assert found.peak_speed < 0.3 * found.clamped[0]  # inside the linear model's limit
     rows = link_rows(Results(link=found.as_dict()))

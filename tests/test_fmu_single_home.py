@@ -1,4 +1,4 @@
-"""Each default, limit, rule and code of the FMUs' algorithms has one home (issue 24).
+"""Each default, limit, rule and code of the FMUs' algorithms has one home.
 
 The names are imported from that home; the declarations, the settings and the messages
 are checked to read them; and the sources (``fmu_src``, ``plant_models``, ``cosim``,

@@ -1,4 +1,4 @@
-"""Honest uncertainty of the friction fit (issue 25): the standard errors' bandwidth
+"""Honest uncertainty of the friction fit: the standard errors' bandwidth
 counts a small correlation the innovations keep over many lags, and a friction term the
 rule leaves out widens the kept parameters by what it moves them on the opening where
 the rule compared the forms. Each test is numpy-only and fast."""

@@ -170,7 +170,7 @@ def test_no_import_cycle() -> None:
             visit(name)
 
 
-#: A module over this many lines says why in its docstring (issue 24).
+#: A module over this many lines says why in its docstring.
 MAX_LINES = 450
 REASON = re.compile(r"(?:^|[.!?]\s)Longer than 450 lines because\b")
 

@@ -1,6 +1,5 @@
 """The tip's motion online: the model-based observer on a flexible link's modal model
-(flexchain.link_observer, the observer FMU's ``link_modes``), against the link plant FMU
-(issue 28)."""
+(flexchain.link_observer, the observer FMU's ``link_modes``), against the link plant FMU."""
 
 from __future__ import annotations
 

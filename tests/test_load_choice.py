@@ -1,4 +1,4 @@
-"""The load torque chosen on the final fit (issue 25): with ``--load`` not given the
+"""The load torque chosen on the final fit: with ``--load`` not given the
 selection rule takes none, constant or slow, the chain is refitted with the load it
 takes and the report says so; a load the user gives is never overridden. The
 independent simulator (:mod:`benchmarks.field_sim`) writes the log."""

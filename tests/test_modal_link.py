@@ -1,6 +1,6 @@
 """The link simulated apart from the plant FMU (benchmarks/modal_link.py): the continuous
 beam's modes on a free hub, against the boundary-value problem, the finite-element plant
-and, identified from the hub, against Quanser's published link (issue 28's link we did not
+and, identified from the hub, against Quanser's published link (a link we did not
 write)."""
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ def test_it_agrees_with_the_finite_element_plant(build_fmus) -> None:
 
 @pytest.mark.slow
 def test_the_published_link_from_the_modal_simulator() -> None:
-    """Issue 28's targets on a simulator the fit shares nothing with: modes within 1 %,
+    """The link's targets on a simulator the fit shares nothing with: modes within 1 %,
     EI and ρA within 5 %, rms(α̂ − α) ≤ 0.1 rms(α) (measured, seed 1: 0.04 %, 0.01 %,
     0.014 %, 0.010)."""
     rig = replace(RIG, seed=1)

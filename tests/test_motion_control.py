@@ -121,7 +121,7 @@ def test_a_bench_move_settles_sensorless(delay: int) -> None:
 
 @pytest.mark.slow
 def test_the_bench_holds_the_motor_within_one_count() -> None:
-    """Issue 29's hold on the bench's two-mass chain: the motor within one count over the
+    """The controller's hold on the bench's two-mass chain: the motor within one count over the
     last 2 s and the last mass within 1.2 mrad rms (0.28 measured with the hold's dither,
     0.95 without). With the plain backward difference as the motor's velocity, each hop
     across an edge kicked the command by 0.25 A and the motor held two counts, 1.41 mrad;
@@ -187,7 +187,7 @@ def test_a_five_mass_move_settles_sensorless() -> None:
 
 @pytest.mark.slow
 def test_the_sensorless_move_settles_near_the_upper_bound() -> None:
-    """Issue 29's third criterion on the exact model: within 1.3 × the full-state loop's
+    """The controller's third criterion on the exact model: within 1.3 × the full-state loop's
     settling time. It needs the DOB told the motor's heading during the move: at the
     move's speeds the motor crosses less than a count per 1 ms step, and a DOB that took
     it as stuck left the estimator uncorrected (1.74 × the bound, the last mass's
@@ -205,7 +205,7 @@ def test_the_sensorless_move_settles_near_the_upper_bound() -> None:
     ("fj", "fk"), [(1.1, 0.9), (0.9, 1.1)], ids=["model J +10 %, k -10 %", "J -10 %, k +10 %"]
 )
 def test_the_soft_four_mass_chain_settles_near_the_bound_at_the_corners(fj, fk) -> None:
-    """Issue 29's third criterion on the four-mass chain's corners. It needs the DOB's
+    """The controller's third criterion on the four-mass chain's corners. It needs the DOB's
     heading weighed against the encoder's edges (``CrossedEdge.heading``). J +10 %,
     k −10 %: as the chain came to rest the motor crept below a count per step, a DOB that
     took it as stuck knew the reaction torque only within ±f_c and kept the estimator's

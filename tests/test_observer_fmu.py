@@ -1,4 +1,4 @@
-"""The observer FMU driven by the plant FMU: the accuracy claims of issue 3, its
+"""The observer FMU driven by the plant FMU: its accuracy claims, its
 interface and its failure handling."""
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def test_observer_validates_without_problems(build_fmus, n: int) -> None:
 
 
 def test_dob_matches_the_step_averaged_reaction_torque(fmus) -> None:
-    """Ideal sensors, 1 ms: τ̂_reac = G[mean τ_reac over each step] to 0.5 % (issue 3);
+    """Ideal sensors, 1 ms: τ̂_reac = G[mean τ_reac over each step] to 0.5 %;
     the pairing of docs/method.md makes it exact up to rounding."""
     t = np.arange(3000) * 1e-3
     current = 0.3 * np.sin(20 * t) + 0.1 * np.sin(95 * t) + 0.1 * np.sin(31 * t)
@@ -161,7 +161,7 @@ def test_literal_eq21_underestimates_k_by_kappa(fmus) -> None:
 
 
 def test_state_estimation_by_recursion(fmus, tmp_path_factory) -> None:
-    """θ_1 within 15 % of its flexible motion at g = 1000 rad/s (issue 3); the error of
+    """θ_1 within 15 % of its flexible motion at g = 1000 rad/s; the error of
     every further mass and at the paper's 100 rad/s is recorded, not bounded."""
     t = np.arange(10000) * 1e-3
     current = multisine(t, 0.48, np.array([3, 7, 13, 17, 22, 30, 41, 60, 90, 120.0]), seed=1)

@@ -55,7 +55,7 @@ def chain_rhs(J_m, k_t, D_m, J, k, B):
 
 
 def test_multisine_run_matches_solve_ivp() -> None:
-    """5 s, h = 2 ms, current held per step: agreement to 1e-6 relative (issue 2)."""
+    """5 s, h = 2 ms, current held per step: agreement to 1e-6 relative."""
     h, steps = 2e-3, 2500
     current = multisine(np.arange(steps) * h)
     plant = bench()

@@ -1,4 +1,4 @@
-"""Property-based tests (hypothesis) of what enters the command line (issue 18).
+"""Property-based tests (hypothesis) of what enters the command line.
 
 Arbitrary text, numbers and bytes go to the log reader, the ``--set`` parser and the
 sweep spec loader, directly and through ``arcosim``. Each either gives a valid result

@@ -1,4 +1,4 @@
-"""Steps shorter than a nanosecond (issue 26): taken by every FMU, never refused.
+"""Steps shorter than a nanosecond: taken by every FMU, never refused.
 
 A host that sums its time (t += 1e-3 ten thousand times) ends a 10 s run on a step of
 1.03e-13 s. FMI 2.0 asks only h > 0. The Python FMUs hold their state and outputs over

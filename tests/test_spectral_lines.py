@@ -1,7 +1,7 @@
 """The spectral front end finds no line the excitation did not play: a linear detrend
 of a multi-sine leaves a ramp that the Hann periodogram reads as a weak line one to two
 bins above 0 (0.48 rad/s on a 20 s record of 40 lines from 3 rad/s), which then fed
-the torque balance and the record-length check false warnings (issue 25). The line
+the torque balance and the record-length check false warnings. The line
 must pass the prominence test again on its fitted amplitude, over the noise and that
 remnant; a real line as low is kept."""
 

@@ -1,7 +1,7 @@
-"""The SSP carries OMSimulator's system annotation and stays valid SSP 1.0 (issue 26).
+"""The SSP carries OMSimulator's system annotation and stays valid SSP 1.0.
 
 OMSimulator cannot open an SSP 1.0 system without its vendor annotation naming the
-system's type ("[NewSystem] internal error", then an abort; its issue #1318). The
+system's type ("[NewSystem] internal error", then an abort; OMSimulator issue #1318). The
 annotation goes where SSP 1.0 allows any vendor's (``ssd:Annotations`` of the system),
 so the file validates against the SSP 1.0 schema fmpy ships, and every other reader
 (arcosim ssp, fmpy.ssp, ecos in tests/test_hosts.py) still reads it.

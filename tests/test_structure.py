@@ -1,4 +1,4 @@
-"""Structure chosen by evidence (issue 25): the rigid drive (n = 0), the selection rule on
+"""Structure chosen by evidence: the rigid drive (n = 0), the selection rule on
 the final fit, parameters at a bound, and decisions that do not flip when the user
 restates a value the tool fitted. The independent simulator
 (:mod:`benchmarks.field_sim`) writes every log."""

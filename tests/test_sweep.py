@@ -185,7 +185,7 @@ def test_example_spec_is_valid() -> None:
 
 
 def test_summary_plots_carry_units_and_leave_the_seed_out(fmus, tmp_path, monkeypatch) -> None:
-    """Issue 27: the plots' axes say their units; ``plant.seed`` is no factor."""
+    """The plots' axes say their units; ``plant.seed`` is no factor."""
     import csv
     import json
 

@@ -1,4 +1,4 @@
-"""Teardown in any order (issue 26): no call into a Python FMU crashes the host once the
+"""Teardown in any order: no call into a Python FMU crashes the host once the
 host's Python has finalized, or while it finalizes; calls from other threads work
 while it lives.
 

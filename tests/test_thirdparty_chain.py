@@ -66,7 +66,7 @@ def test_benchmark_skips_naming_the_source_when_the_fmu_is_absent(tmp_path, caps
 @pytest.mark.data(ENV)
 def test_identification_only_fits_without_moving(folder):
     """``score_seed(..., control=False)``: the third-party chain identified (n right,
-    J_i, k_i within the issue's 0.5 %), no move run."""
+    J_i, k_i within the 0.5 % target), no move run."""
     found = thirdparty_chain.score_seed(folder, 1, corners=False, control=False)
     assert "models" not in found
     ident = found["identification"]

@@ -111,7 +111,7 @@ def _execute(args: argparse.Namespace) -> int:
     print(text_table(motion.MOVE_HEADER, motion.move_rows(results.motion)))
     print("the same with a load-torque step on the last mass during the hold")
     print(text_table(motion.LOAD_HEADER, motion.load_rows(results.motion)))
-    print("the sensorless controller with model errors, against issue 29's Done-when criteria")
+    print("the sensorless controller with model errors, against its four criteria")
     print(text_table(motion.ERROR_HEADER, motion.error_rows(results.motion)))
     print(
         f"\nwrote {args.out / 'report.md'} and {len(results.files) - 1} more files "

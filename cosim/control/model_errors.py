@@ -1,6 +1,6 @@
 """The model errors a controller is checked against: every J_i and k_i scaled.
 
-The identification's errors as issue 29 states them: the model's load inertias and
+The identification's errors the controller is held to: the model's load inertias and
 stiffnesses each scaled by an independent factor uniform in ``[1 − e, 1 + e]`` (random
 draws), plus the two corners, every J_i at ``1 + e`` with every k_i at ``1 − e`` and the
 reverse. The motor's terms (J_mo, k_to, D_m) and the dampings B_i are left as they are.

@@ -17,7 +17,7 @@ closed_loop      -- the plant FMU with a Python controller in the loop (sequenti
 motion_baselines -- a drive's cascade tuned out of the box, and input shapers (ZV, ZVD)
 motion_metrics   -- how a move is scored (settling, residual, peak current, limit cycle)
 motion_experiment -- experiment 7: a move of the last mass by four controllers, Fig. 10
-motion_findings  -- its setup, scores, the issue's Done-when check, tables and report text
+motion_findings  -- its setup, scores, the four-criteria (Done-when) check, tables and report text
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """

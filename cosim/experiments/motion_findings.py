@@ -143,7 +143,7 @@ def score_load(
 
 
 def done_when(sensorless: MoveScore, cascade: MoveScore, upper: MoveScore) -> dict[str, bool]:
-    """The issue's four criteria for one move of the sensorless controller.
+    """The controller's four criteria for one move of the sensorless controller.
 
     Parameters
     ----------
@@ -380,7 +380,7 @@ error), and when it is back within ±1 %:
 Model errors: the sensorless controller and its upper bound designed on the identified
 chain with every J_i and k_i scaled by independent uniform factors in [0.9, 1.1] (seed
 {", ".join(str(s) for s in ERROR_SEEDS)} of numpy's generator; `arcosim bench control`
-runs 20 on three other chains) and the two corners. Done when (issue 29): ±1 % within
+runs 20 on three other chains) and the two corners. Done when: ±1 % within
 {SETTLE_LIMIT:g} s, a residual at most max({RESIDUAL_FRACTION:g} × the cascade's,
 {1e3 * RESIDUAL_FLOOR:g} mrad), within {UPPER_BOUND_FACTOR:g} × the upper bound's settling,
 no motor limit cycle beyond {LIMIT_CYCLE_COUNTS:g} count:

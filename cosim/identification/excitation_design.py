@@ -14,7 +14,7 @@ whole-chain rows (README):
 * motion the encoder sees at the top of the band: a line there, moving the motor by a
   (rad) against the counts' noise q/√12 per sample, is seen with t = a·√(6N)/q over N
   samples; below :data:`LINE_T` (rigid-body motion, J_total known: a lower bound) the
-  modes up there sink into the counts (the stiff belt drive of issue 19: t ≈ 1.6; the
+  modes up there sink into the counts (a stiff belt drive: t ≈ 1.6; the
   log's check, :func:`arcosim.identification.log_check.check_log`, holds the lines it
   finds in a log to the same threshold);
 * in a closed speed loop, a speed reference whose lines grow with frequency (about equal

@@ -62,7 +62,7 @@ def inertias(n: int) -> list[float]:
     return list(J) if n == 3 else [J[0]] * n
 
 
-# -- the flexible link (the FlexLinkPlant FMU, plant_models/flexlink_c; issue 28) ---------
+# -- the flexible link (the FlexLinkPlant FMU, plant_models/flexlink_c) ------------------
 #: A 0.4 m aluminium strip (about 20 mm × 2.4 mm) with a 20 g tip mass on the bench's
 #: motor: first clamped mode 39.8 rad/s with the tip mass (69.5 rad/s without).
 #: Hermite cubic elements of the built FMU (``arcosim build --elements``): the first three
@@ -112,12 +112,12 @@ CONTROL_MOVING_SPEED = 0.6
 #: prediction (within ±f_c); told the reference's heading while it turned round within a
 #: move, the DOB removed friction the wrong way (1 mN·m off over 0.1 s). The four-mass
 #: chain's corners (`arcosim bench control`) settled at 2.45 and 1.81 s against full-state
-#: bounds of 1.52 and 1.38 s; with the edges at 1.45 and 1.73 s (docs/development.md).
+#: bounds of 1.52 and 1.38 s; with the edges at 1.45 and 1.73 s (docs/design/dob-heading.md).
 SLIDING_INTERVAL = 10e-3
 #: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`): every
 #: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;
 #: 3 × 3 models, the chain itself among them). ±7 %, not the ±10 % the controller is
-#: scored at, so that its corners are not in the bank (docs/development.md).
+#: scored at, so that its corners are not in the bank (docs/design/estimator-bank.md).
 BANK_SCALES = (0.93, 1.0, 1.07)
 #: The time over which a member's squared open-loop error of τ̂_reac is averaged (s).
 BANK_MEMORY = 0.5
@@ -132,7 +132,7 @@ BANK_CHOICE_AFTER = 0.5
 #: start (dimensionless). On `arcosim bench control`'s four-mass chain (20 seeds, 42 runs;
 #: a prototype) 0.6, 0.7 and 0.8 met all four criteria on 36, 38 and 35 (none, 23): the
 #: choice is within the counts' noise; later leaves the feedback less time, earlier less
-#: data (docs/development.md).
+#: data (docs/design/move-refit.md).
 REFINE_AT = 0.7
 #: The fit's low-pass on the open-loop error of τ̂_reac (rad/s): above the chain's modes,
 #: below the encoder's noise in the DOB's acceleration.
@@ -180,7 +180,7 @@ REFINE_DIFFERENCE_STEP = 1e-3
 #: chains at 20 seeds it took the runs meeting all four criteria from 18 to 34 of 126 and
 #: those holding the motor within one count from 21 to 42. The amplitude was chosen with
 #: the dither observer's velocity fed back as well: 0.5–0.8 did alike on seeds 1–3, 0.9
-#: held the tests' bench two-mass chain over two counts (docs/development.md).
+#: held the tests' bench two-mass chain over two counts (docs/design/hold-dither.md).
 HOLD_DITHER = 0.7
 #: Its period (s): 125 Hz, far above the chains' modes; taken as a whole number of control
 #: steps, a multiple of four and at least four (8 steps at 1 ms).
@@ -197,7 +197,7 @@ HOLD_DITHER_AFTER = 0.5
 #: to the load estimates, and the feedback moved the motor with them: `bench control`'s
 #: four-mass chain, seeds 1–3, held one count on 0 of 12 runs, on 7, 10, 12 and 11 of 12
 #: at 0.5 (and 0.4), 0.3, 0.2 and 0.1. Switched at the dither's start, with the chain
-#: still ringing, its corners settled 0.7 s later (docs/development.md). The factor
+#: still ringing, its corners settled 0.7 s later (docs/design/hold-estimator-gain.md). The factor
 #: (dimensionless):
 HOLD_TORQUE_NOISE_SCALE = 0.2
 #: … how near its target the controlled mass's estimate must stay (rad),
@@ -212,7 +212,7 @@ HOLD_QUIET_LEAVE = 20e-3
 #: − HOLD_EDGE_NEAR counts (0 = the mean on an edge, 0.5 = off). With the target half way
 #: between two edges (`arcosim bench control --target-offset 0.19`) it took the two-mass
 #: chain from 53 to 80 of 80 runs within one count at rest, the three-mass chain from 67
-#: to 76 (docs/development.md). Counts:
+#: to 76 (docs/design/hold-near-edge.md). Counts:
 HOLD_EDGE_NEAR = 0.3
 #: … how far past the middle of a count the needed angle goes before the other edge is
 #: taken (counts): the edge is not traded back and forth on the load estimate's noise,
@@ -221,11 +221,11 @@ HOLD_EDGE_SWITCH = 0.1
 HOLD_EDGE_BANDWIDTH = 2.0
 #: Bandwidth of the motor-alone observer that averages the de-dithered reading (rad/s):
 #: at 150, with its velocity and the DOB fed from it too, two chains diverged at the J
-#: +10 %, k −10 % corner (docs/development.md).
+#: +10 %, k −10 % corner (docs/design/hold-dither.md).
 HOLD_OBSERVER_BANDWIDTH = 300.0
 
 
-# -- the observer on a flexible link (star of modes, ReactionTorqueObserver; issue 28) ----
+# -- the observer on a flexible link (star of modes, ReactionTorqueObserver) -------------
 #: The most link modes the observer FMU declares parameters for (a count).
 LINK_MODES_MAX = 4
 LINK_MODES = 0  #: link modes the observer runs on (0 = the chain of J, k, B)

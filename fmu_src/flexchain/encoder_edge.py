@@ -11,8 +11,9 @@ Where the motor was last known exactly is the edge it last crossed: the lower ed
 the count it rose into, the upper edge of the count it fell into. Its backward difference
 counts a count for a crossing that goes on in the same direction (as the plain
 difference does while the motor moves) and nothing for one that returns over the same
-edge (a dither). Measured on ``arcosim bench control``'s chains (docs/development.md):
-fed to the controller's state feedback and DOB in place of the plain difference, it took
+edge (a dither). Measured on ``arcosim bench control``'s chains
+(docs/design/encoder-edge-velocity.md): fed to the controller's state feedback and DOB in
+place of the plain difference, it took
 the runs within the residual criterion from 23 to 34 of 36 and the motor's limit cycle
 within one count from 0 to 8. The controller uses it only where it cancels Coulomb
 friction: on a frictionless motor the plain difference's kick at an edge is what holds

@@ -1,7 +1,7 @@
 """The hold's dither: a square current at rest that lets the encoder see inside a count.
 
 At rest an incremental encoder reads the same count wherever the motor sits inside it,
-and a motor held from that reading hunts over two to four counts (docs/development.md:
+and a motor held from that reading hunts over two to four counts (docs/design/hold-dither.md:
 with the true motor angle and velocity the same loop holds one count or none). A square
 current ``±A`` over ``P`` control steps (``defaults.HOLD_DITHER_PERIOD``, 8 ms) moves the
 motor, free at that frequency (far above its first spring's mode), along a known
@@ -15,7 +15,7 @@ error (about 0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s); fe
 the estimator on the identified chain alone, it made the five-mass chain diverge with its
 model's J 10 % high and k 10 % low. With the estimator bank
 (:mod:`~arcosim.fmu.flexchain.estimator_bank`), which moves to a model near the truth,
-that chain holds one count there (docs/development.md).
+that chain holds one count there (docs/design/hold-dither.md).
 
 Friction is cancelled along the dither's velocity, which the motor follows; what the
 slow motion meets then is a viscous friction of about ``2 f_c / v_peak`` per rad/s, the

@@ -4,7 +4,7 @@ The estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`) scales every J
 factor and every k_i by another: errors that differ from mass to mass change the chain's
 mode shapes, which no such pair reproduces, and on a four-mass chain with independent
 ±10 % errors the controller then settled up to 2 × slower than the same gains on the
-true states (docs/development.md). A move excites the chain enough to tell them apart:
+true states (docs/design/move-refit.md). A move excites the chain enough to tell them apart:
 :class:`~arcosim.fmu.flexchain.move_record.MoveRecord` keeps, from the move's start,
 what the bank's estimators take (τ̂_reac and the motor angle, each step), and
 :func:`fit_chain` finds the factors on every J_i
