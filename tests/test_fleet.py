@@ -216,3 +216,30 @@ def test_a_simulated_fleet_alarms_on_the_changed_spring_only(tmp_path: Path) -> 
     assert main(["fleet", "drift", str(out)]) == 1
     assert main(["fleet", "drift", str(out), "--json", "--threshold", "0.2"]) == 0
     assert np.isfinite(read_store(out)[0]["k[1]_std"])
+
+
+def test_a_second_run_into_a_held_folder_is_refused_naming_the_first(tmp_path: Path) -> None:
+    from arcosim.fleet.identify import LOCK_FILE
+    from arcosim.sweeps.runner import lock_folder
+
+    axis = tmp_path / "fleet" / "a1"
+    axis.mkdir(parents=True)
+    (axis / "axis.toml").write_text("[set]\nk_to = 0.04\nJ_mo = 2e-5\nencoder_cpr = 2000\n")
+    with (
+        lock_folder(tmp_path / "out", LOCK_FILE, "fleet identification"),
+        pytest.raises(UserError, match=r"another fleet identification is writing there \(pid"),
+    ):
+        arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "out")
+
+
+def test_identify_refuses_a_wrong_axis_file_with_one_line(tmp_path: Path, capsys) -> None:
+    axis = tmp_path / "fleet" / "a1"
+    axis.mkdir(parents=True)
+    (axis / "axis.toml").write_text(
+        "masses = 2\n[set]\nk_to = 0.04\nJ_mo = -2e-5\nencoder_cpr = 9\n"
+    )
+    out = str(tmp_path / "out")
+    assert main(["fleet", "identify", str(tmp_path / "fleet"), "--out", out]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "[set] J_mo = -2e-05: a finite number > 0" in err
+    assert main(["fleet", "identify", str(tmp_path / "fleet")]) == 2  # --out is required

@@ -130,13 +130,16 @@ def _identify(args: argparse.Namespace) -> int:
         workers=args.workers,
         progress=None if args.no_progress else sys.stderr,
     )
+    if not run.identified:
+        print(f"no new log: all {run.total} logs are in {run.store} already")
+        return 0
     print(
-        f"{run.identified} logs identified ({run.failed} failed), {run.skipped} already in "
-        f"the store, in {run.seconds:.1f} s; wrote {run.store}"
+        f"logs identified: {run.identified} ({run.failed} failed) in {run.seconds:.1f} s, "
+        f"{run.skipped} already in the store; wrote {run.store}"
     )
     if run.failed:
         print(
-            f"arcosim fleet identify: {run.failed} logs failed; their reasons are in "
+            f"arcosim fleet identify: failed logs: {run.failed}; their reasons are in "
             f"{run.store} (column reason) and `arcosim fleet drift {args.out}`",
             file=sys.stderr,
         )

@@ -119,8 +119,8 @@ class DriftReport:
     def text(self) -> str:
         """The report for a reader: the alarms first, then each axis, then the failures."""
         lines = [
-            f"{sum(len(d.alarms) for d in self.axes.values())} alarms "
-            f"(a change over {self.threshold:.0%} and over {SIGMAS:g} sigma)"
+            f"alarms: {sum(len(d.alarms) for d in self.axes.values())} "
+            f"(a change over {100 * self.threshold:g} % and over {SIGMAS:g} sigma)"
         ]
         for name, d in self.axes.items():
             for alarm in d.alarms:
@@ -130,7 +130,7 @@ class DriftReport:
             lines.extend(_axis_text(name, d))
         if self.failed:
             lines.append("")
-            lines.append(f"{len(self.failed)} logs failed:")
+            lines.append(f"failed logs: {len(self.failed)}")
             lines.extend(f"  {f['log']}: {f['reason']}" for f in self.failed)
         return "\n".join(lines)
 

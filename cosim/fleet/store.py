@@ -38,8 +38,16 @@ FIXED = (
 )
 #: A standard error's column is its parameter's name and this.
 STD = "_std"
-#: The unit of a parameter by its name's first letters (kg·m², N·m/rad, …).
-UNITS = {"J": "kg*m^2", "k": "N*m/rad", "B": "N*m*s/rad", "D_m": "N*m*s/rad", "f_c": "N*m"}
+#: The unit of a parameter by its name, a chain's ``J[i]``, ``k[i]``, ``B[i]`` by its letter.
+UNITS = {
+    "J": "kg*m^2",
+    "k": "N*m/rad",
+    "B": "N*m*s/rad",
+    "J_load": "kg*m^2",
+    "D_m": "N*m*s/rad",
+    "f_c": "N*m",
+    "tau_load": "N*m",
+}
 #: The columns whose text stays text when read back.
 TEXT = {"axis", "date", "log", "status", "reason", "verdict", "verdict_reasons", "version"}
 
@@ -117,7 +125,7 @@ def _unit(column: str) -> str:
         return "1"
     if column in TEXT:
         return ""
-    return UNITS.get(name, UNITS.get(name[:1], "N*m") if "[" in name else "")
+    return UNITS.get(name.split("[")[0], "")
 
 
 def _cell(value: object) -> object:
