@@ -3,7 +3,7 @@
 The rule's tests use hand-made rows (fast): an alarm needs both the relative threshold
 and 3 standard errors of the difference; an untrusted fit is never the baseline; a
 different n is a structure alarm. The end-to-end test identifies a tiny fleet simulated
-by the independent simulator (:mod:`benchmarks.field_sim`) on a one-worker cluster.
+by the independent simulator (:mod:`benchmarks.fleet_sample`) on a one-worker cluster.
 """
 
 from __future__ import annotations
@@ -142,50 +142,15 @@ def test_drift_refuses_a_folder_without_a_store_with_one_line(tmp_path: Path, ca
 # -- end to end: a tiny simulated fleet on one Dask worker ---------------------------------
 
 
-def write_log(path: Path, k1: float, seed: int) -> None:
-    """A 6 s log of a two-mass drive (k[1] in N·m/rad) from the independent simulator."""
-    from arcosim.experiments.scenarios import IDENTIFICATION_LINES
-    from arcosim.fmu.flexchain import defaults
-    from benchmarks import field_sim
-
-    drive = field_sim.Drive(
-        J_m=defaults.J_M,
-        k_t=defaults.K_T,
-        J=(4e-4, 8e-4),
-        k=(k1, 0.2),
-        B=(2e-5, 1.5e-5),
-        D_m=2e-5,
-        f_c=2e-3,
-        current_noise=5e-3,
-        counts=2000,
-    )
-    current = field_sim.multisine(IDENTIFICATION_LINES, 3.0, seed=seed + 1)
-    log = field_sim.simulate(drive, 1e-3, 6.0, current=current, seed=seed)
-    columns = {"time": log.time, "i_a": log.i_a, "omega_m": log.omega_m, "theta_m": log.theta_m}
-    arcosim.write_csv(path, columns)
-
-
-def make_fleet(folder: Path) -> None:
-    """Axes a1 (k[1] −12 % on the second date) and a2 (unchanged), and a corrupt log."""
-    from arcosim.fmu.flexchain import defaults
-
-    for axis, k_second in (("a1", 0.88 * K1), ("a2", K1)):
-        (folder / axis).mkdir(parents=True)
-        (folder / axis / "axis.toml").write_text(
-            f"[set]\nk_to = {defaults.K_T}\nJ_mo = {defaults.J_M}\nencoder_cpr = 2000\n"
-        )
-        write_log(folder / axis / "2026-01-05.csv", K1, seed=1)
-        write_log(folder / axis / "2026-02-05.csv", k_second, seed=2)
-    (folder / "a2" / "2026-01-20.csv").write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0,1,x,2\n")
-
-
 @pytest.mark.slow
 @pytest.mark.system
 def test_a_simulated_fleet_alarms_on_the_changed_spring_only(tmp_path: Path) -> None:
     from dask.distributed import LocalCluster
 
+    from benchmarks.fleet_sample import write_fleet, write_log
+
     fleet, out = tmp_path / "fleet", tmp_path / "out"
-    make_fleet(fleet)
+    write_fleet(fleet, axes=2, seconds=7.0)  # a1: k[1] -12 % on 2026-02-05; a2: a corrupt log
     with LocalCluster(
         n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0"
     ) as c:
@@ -196,7 +161,8 @@ def test_a_simulated_fleet_alarms_on_the_changed_spring_only(tmp_path: Path) -> 
 
         rows = {(r["axis"], r["date"]): r for r in read_store(out)}
         corrupt = rows[("a2", "2026-01-20")]
-        assert corrupt["status"] == "failed" and "row 3" in corrupt["reason"]
+        assert corrupt["status"] == "failed"
+        assert "row 3, column i_a: 'x' is not a number" in corrupt["reason"]
         assert all(r["verdict"] == "trusted" for k, r in rows.items() if k != ("a2", "2026-01-20"))
 
         report = arcosim.fleet_drift(out)
@@ -208,7 +174,7 @@ def test_a_simulated_fleet_alarms_on_the_changed_spring_only(tmp_path: Path) -> 
         again = arcosim.identify_fleet(fleet, out, scheduler=c.scheduler_address)
         assert (again.skipped, again.identified) == (5, 0)
 
-        write_log(fleet / "a2" / "2026-03-05.csv", K1, seed=3)
+        write_log(fleet / "a2" / "2026-03-05.csv", K1, seed=3, seconds=7.0)
         new = arcosim.identify_fleet(fleet, out, scheduler=c.scheduler_address)
         assert [(r["axis"], r["date"]) for r in new.rows] == [("a2", "2026-03-05")]
         assert len(read_store(out)) == 6
