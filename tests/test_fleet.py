@@ -209,3 +209,25 @@ def test_identify_refuses_a_wrong_axis_file_with_one_line(tmp_path: Path, capsys
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "[set] J_mo = -2e-05: a finite number > 0" in err
     assert main(["fleet", "identify", str(tmp_path / "fleet")]) == 2  # --out is required
+
+
+def test_a_log_too_short_or_missing_is_a_failed_row_with_its_reason(tmp_path: Path) -> None:
+    from arcosim.fleet.identify import identify_log
+
+    short = tmp_path / "2026-01-01.csv"
+    short.write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0.001,0.1,0,0\n0.002,0.2,0,0\n")
+    options = {"k_t": 0.0406, "J_m": 2.09e-5, "encoder_cpr": 2000}
+    row = identify_log(str(short), "a1", "2026-01-01", options)
+    assert row["status"] == "failed" and "at least 16 samples" in row["reason"]
+    assert "\n" not in row["reason"] and row["axis"] == "a1" and row["seconds"] >= 0
+    gone = identify_log(str(tmp_path / "gone.csv"), "a1", "2026-01-02", options)
+    assert gone["status"] == "failed" and gone["reason"].endswith("gone.csv: no such file")
+
+
+def test_an_output_folder_inside_the_fleet_is_not_an_axis(tmp_path: Path) -> None:
+    axis = tmp_path / "fleet" / "a1"
+    axis.mkdir(parents=True)
+    (axis / "axis.toml").write_text("[set]\nk_to = 0.04\nJ_mo = 2e-5\nencoder_cpr = 2000\n")
+    run = arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "fleet" / "out")
+    assert (run.total, run.identified) == (0, 0) and run.store.exists()
+    assert arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "fleet" / "out").total == 0

@@ -126,7 +126,7 @@ def identify_fleet(
     """
     start = time.perf_counter()
     folder, out = Path(folder), Path(out)
-    axes, logs = read_fleet(folder)
+    axes, logs = read_fleet(folder, skip=out)
     with lock_folder(out, LOCK_FILE, "fleet identification"):
         rows = read_store(out)
         done = {(str(row["axis"]), Path(str(row["log"])).name) for row in rows}
@@ -235,7 +235,7 @@ def _run(
         except OSError as error:
             raise UserError(f"--scheduler {scheduler}: cannot connect ({error})") from None
     try:
-        futures = [
+        futures = {
             client.submit(
                 identify_log,
                 str(log.path.resolve()),
@@ -243,12 +243,12 @@ def _run(
                 log.date,
                 _options(axes[log.axis]),
                 pure=False,
-            )
+            ): log
             for log in pending
-        ]
+        }
         started = time.perf_counter()
         for future in as_completed(futures):
-            row = future.result()
+            row = _result(future, futures[future])
             rows.append(row)
             added.append(row)
             write_store(out, sorted(rows, key=lambda r: (str(r["axis"]), str(r["date"]))))
@@ -257,6 +257,21 @@ def _run(
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _result(future, log: FleetLog) -> dict[str, object]:
+    """The task's row; a task Dask itself lost (a worker that died on it) is a failed row."""
+    try:
+        return future.result()
+    except Exception as error:  # the worker, not the log's identification, failed
+        return {
+            "axis": log.axis,
+            "date": log.date,
+            "log": str(log.path.resolve()),
+            "status": "failed",
+            "reason": f"the Dask task failed: {_reason(error)}",
+            "version": __version__,
+        }
 
 
 def _starting(count: int, scheduler: str | None, workers: int) -> str:

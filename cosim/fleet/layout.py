@@ -149,13 +149,15 @@ def log_date(path: Path) -> str:
         ) from None
 
 
-def read_fleet(folder: Path) -> tuple[dict[str, Axis], list[FleetLog]]:
+def read_fleet(folder: Path, skip: Path | None = None) -> tuple[dict[str, Axis], list[FleetLog]]:
     """Every axis of the fleet folder and every log, in order of axis and date.
 
     Parameters
     ----------
     folder : Path
         The fleet's folder (the module's docstring gives its layout).
+    skip : Path, optional
+        A folder that is no axis even inside ``folder`` (the output folder).
 
     Returns
     -------
@@ -174,7 +176,9 @@ def read_fleet(folder: Path) -> tuple[dict[str, Axis], list[FleetLog]]:
         raise UserError(f"{folder}: no such folder; give the fleet's folder (one per axis)")
     axes: dict[str, Axis] = {}
     logs: list[FleetLog] = []
-    for sub in sorted(p for p in folder.iterdir() if p.is_dir() and p.name[0] not in "._"):
+    skipped = skip.resolve() if skip is not None else None
+    subs = (p for p in folder.iterdir() if p.is_dir() and p.name[0] not in "._")
+    for sub in sorted(p for p in subs if p.resolve() != skipped):
         axes[sub.name] = read_axis(sub)
         for path in sorted(p for p in sub.glob("*.csv") if p.name[0] not in "._"):
             logs.append(FleetLog(sub.name, log_date(path), path))
