@@ -209,6 +209,9 @@ def test_identify_refuses_a_wrong_axis_file_with_one_line(tmp_path: Path, capsys
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "[set] J_mo = -2e-05: a finite number > 0" in err
     assert main(["fleet", "identify", str(tmp_path / "fleet")]) == 2  # --out is required
+    both = ["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"]  # 2 is the default, given
+    assert main(["fleet", "identify", str(tmp_path / "fleet"), "--out", out, *both]) == 2
+    assert "--scheduler: not allowed with argument --workers" in capsys.readouterr().err
 
 
 def test_a_log_too_short_or_missing_is_a_failed_row_with_its_reason(tmp_path: Path) -> None:

@@ -20,6 +20,8 @@ from arcosim.fleet.identify import identify_fleet
 
 #: Exit status of ``drift`` when any axis has an alarm.
 ALARM = 1
+#: Worker processes of the local cluster when ``--workers`` is not given.
+WORKERS = 2
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -40,11 +42,13 @@ arcosim fleet drift fleet-out
 arcosim fleet drift fleet-out --json --threshold 0.1""",
     )
     commands = p.add_subparsers(title="fleet commands", metavar="COMMAND", required=True)
-    _add_identify(commands)
-    _add_drift(commands)
+    for sub in (_add_identify(commands), _add_drift(commands)):
+        sub.epilog = sub.epilog.replace(
+            f'section "arcosim {sub.prog.split()[-1]}"', 'section "arcosim fleet"'
+        )
 
 
-def _add_identify(commands: argparse._SubParsersAction) -> None:
+def _add_identify(commands: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = add_command(
         commands,
         "identify",
@@ -71,15 +75,16 @@ arcosim fleet identify fleet/ --out fleet-out --scheduler tcp://10.0.0.5:8786"""
     where.add_argument(
         "--workers",
         type=whole_number(1, 1024),
-        default=2,
+        default=None,  # not 2: argparse would not see `--workers 2` given beside --scheduler
         metavar="N",
         help="worker processes of the local cluster, 1 to 1024 (default 2)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     p.set_defaults(execute=_identify)
+    return p
 
 
-def _add_drift(commands: argparse._SubParsersAction) -> None:
+def _add_drift(commands: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = add_command(
         commands,
         "drift",
@@ -113,6 +118,7 @@ arcosim fleet drift fleet-out --json --threshold 0.1 --baseline 2026-01-01""",
         help="ISO date: each axis's baseline is its first trusted fit from then on",
     )
     p.set_defaults(execute=_drift)
+    return p
 
 
 def _iso_date(text: str) -> str:
@@ -127,7 +133,7 @@ def _identify(args: argparse.Namespace) -> int:
         args.folder,
         args.out,
         scheduler=args.scheduler,
-        workers=args.workers,
+        workers=WORKERS if args.workers is None else args.workers,
         progress=None if args.no_progress else sys.stderr,
     )
     if not run.identified:
