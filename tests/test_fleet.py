@@ -234,3 +234,5 @@ def test_an_output_folder_inside_the_fleet_is_not_an_axis(tmp_path: Path) -> Non
     run = arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "fleet" / "out")
     assert (run.total, run.identified) == (0, 0) and run.store.exists()
     assert arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "fleet" / "out").total == 0
+    with pytest.raises(UserError, match="workers = 0: give a whole number of processes"):
+        arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "out", workers=0)

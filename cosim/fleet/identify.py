@@ -109,7 +109,8 @@ def identify_fleet(
     UserError
         A wrong fleet folder or ``axis.toml``, a log not named by an ISO date, a store
         that is not one, an ``out`` another run holds, a scheduler that cannot be
-        reached. A log that cannot be identified is a failed row, never an error.
+        reached, fewer than 1 worker. A log that cannot be identified is a failed row,
+        never an error.
 
     Examples
     --------
@@ -125,6 +126,8 @@ def identify_fleet(
     (0, 0, 'fleet.csv')
     """
     start = time.perf_counter()
+    if scheduler is None and not (isinstance(workers, int) and workers >= 1):
+        raise UserError(f"workers = {workers!r}: give a whole number of processes, 1 or more")
     folder, out = Path(folder), Path(out)
     axes, logs = read_fleet(folder, skip=out)
     with lock_folder(out, LOCK_FILE, "fleet identification"):
