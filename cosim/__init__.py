@@ -57,6 +57,11 @@ rigid_maneuver      -- a slow sine under raised-cosine ramps (mode 1)
 chirp               -- a linear frequency sweep
 filtered_random     -- low-passed Gaussian noise of a given rms
 
+Condition monitoring of a fleet of axes (Dask)
+----------------------------------------------
+identify_fleet      -- every new log of every axis identified, one row each in a store
+fleet_drift         -- each axis's parameters against its baseline; alarms on drift
+
 Building and checking FMUs
 --------------------------
 build_all           -- build the three FMUs and their SSP into a folder
@@ -77,7 +82,8 @@ The paper's experiments and the report are the command ``arcosim reproduce``
 Every name above is importable from ``arcosim`` directly (loaded on first use, so
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
 ``arcosim.host``, ``arcosim.build``, ``arcosim.control``, ``arcosim.experiments``,
-``arcosim.sweeps``, ``arcosim.fmu`` (the code inside the FMUs) and ``arcosim.plant``.
+``arcosim.sweeps``, ``arcosim.fleet``, ``arcosim.fmu`` (the code inside the FMUs) and
+``arcosim.plant``.
 
 Modules and subpackages, in the order data flows (each subpackage's docstring lists its
 modules):
@@ -93,6 +99,7 @@ chainfile                 -- a whole-chain report read back as its chain (``read
 control                   -- the motion controller's margins checked on numpy (``arcosim control``)
 experiments               -- the paper's experiments on the simulated bench, the report
 sweeps                    -- Monte Carlo and grid sweeps of co-simulations
+fleet                     -- many axes identified over time, and their parameters' drift
 outputs                   -- every file a command writes: checked first, written atomically
 errors, version           -- the errors a user can fix; the installed version
 cli, __main__             -- the ``arcosim`` command (imported by nothing else)
@@ -145,6 +152,8 @@ _API = {
     "rigid_maneuver": "arcosim.experiments.current_commands",
     "chirp": "arcosim.experiments.current_commands",
     "filtered_random": "arcosim.experiments.current_commands",
+    "identify_fleet": "arcosim.fleet.identify",
+    "fleet_drift": "arcosim.fleet.drift",
     "build_all": "arcosim.build.builder",
     "ensure_built": "arcosim.build.builder",
     "validate": "arcosim.host.validate",

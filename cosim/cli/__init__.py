@@ -20,6 +20,7 @@ control                -- ``arcosim control``: the motion controller for a chain
 example                -- ``arcosim example``: the sample log and its script into a folder
 reproduce              -- ``arcosim reproduce``: the paper's experiments and the report
 sweep                  -- ``arcosim sweep``: Monte Carlo and grid sweeps on Dask
+fleet                  -- ``arcosim fleet``: many axes identified on Dask, their drift
 ssp                    -- ``arcosim ssp``: an SSP system run
 validate               -- ``arcosim validate``: FMUs checked as a strict host would
 bench                  -- ``arcosim bench``: a benchmark of a source checkout
@@ -56,6 +57,7 @@ from arcosim.cli import (
     control,
     example,
     excite,
+    fleet,
     identify,
     reproduce,
     simulate,
@@ -101,6 +103,7 @@ def make_parser() -> argparse.ArgumentParser:
         example,
         reproduce,
         sweep,
+        fleet,
         ssp,
         validate,
         bench,

@@ -46,7 +46,15 @@ from arcosim.outputs import check_output_folder, write_text
 from arcosim.sweeps.spec import SweepSpec, check_names, draw_runs, load_spec, metric_columns
 from arcosim.sweeps.summary import complete, read_results, write_summary
 
-__all__ = ["draw_runs", "load_spec", "lock_sweep", "read_results", "run_one", "sweep"]
+__all__ = [
+    "draw_runs",
+    "load_spec",
+    "lock_folder",
+    "lock_sweep",
+    "read_results",
+    "run_one",
+    "sweep",
+]
 
 #: The lock file of a sweep folder; while locked it says who holds it.
 LOCK_FILE = ".arcosim-sweep.lock"
@@ -69,9 +77,32 @@ def lock_sweep(out: Path) -> Iterator[None]:
     UserError
         When another process holds the lock, or the folder cannot be used.
     """
+    with lock_folder(out):
+        yield
+
+
+@contextlib.contextmanager
+def lock_folder(out: Path, lock_file: str = LOCK_FILE, what: str = "sweep") -> Iterator[None]:
+    """Hold the lock ``lock_file`` of the folder ``out`` (one writer per folder), or refuse
+    naming the process that holds it; :func:`lock_sweep`'s mechanism for any job.
+
+    Parameters
+    ----------
+    out : Path
+        The folder, created if missing.
+    lock_file : str
+        The lock file's name inside ``out``.
+    what : str
+        The job that writes there, for the refusal ("another sweep is writing there").
+
+    Raises
+    ------
+    UserError
+        When another process holds the lock, or the folder cannot be used.
+    """
     check_output_folder(out)
     try:
-        handle = open(out / LOCK_FILE, "a+", encoding="utf-8")  # noqa: SIM115 (held across the yield)
+        handle = open(out / lock_file, "a+", encoding="utf-8")  # noqa: SIM115 (held across the yield)
     except OSError as error:
         raise UserError(f"--out {out}: cannot lock the folder ({error.strerror})") from None
     with handle:
@@ -80,7 +111,7 @@ def lock_sweep(out: Path) -> Iterator[None]:
         except BlockingIOError:
             holder = _holder(handle)
             raise UserError(
-                f"--out {out}: another sweep is writing there ({holder}); wait for it to "
+                f"--out {out}: another {what} is writing there ({holder}); wait for it to "
                 "finish or choose another --out"
             ) from None
         try:
