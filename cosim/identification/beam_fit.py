@@ -9,8 +9,9 @@ the fit is the chain's prediction-error fit from the motor current to the encode
 (:mod:`arcosim.identification.encoder_fit`: the same Kalman predictor, friction sign
 passes and Newey–West standard errors), on these parameters:
 
-* ``EI`` (N·m²), ``rhoA`` (kg/m), the damping ratio ``zeta[i]`` of each mode below the
-  record's band, then the motor's ``D_m``, ``f_c`` when not given (:func:`fit_link`);
+* ``EI`` (N·m²), ``rhoA`` (kg/m; held when the user gives it, from the link's weighed
+  mass), the damping ratio ``zeta[i]`` of each mode below the record's band, then the
+  motor's ``D_m``, ``f_c`` when not given (:func:`fit_link`);
 * without the geometry, each mode's frequency ``omega[i]`` (rad/s), ``zeta[i]`` and
   hub participation ``b[i]``, and the link's inertia outside the modes ``J_rest``
   (:func:`fit_modes`).
@@ -18,8 +19,10 @@ passes and Newey–West standard errors), on these parameters:
 Start: the record's first clamped mode (the subspace stabilization diagram,
 :func:`arcosim.identification.modal_start.detect_modes`) fixes EI/ρA for each ρA
 (the modes scale as √EI), and a scan of the innovations over ρA on the record's
-opening picks ρA; the fit then runs on openings twice as long each time, up to the
-whole record (a lightly damped mode's cost has local minima spaced π/T).
+opening picks ρA; with ρA given, EI follows from the first mode directly, and one
+clamped mode in the band suffices (without it, a record that shows one is refused: one
+mode cannot tell EI from ρA). The fit then runs on openings twice as long each time, up
+to the whole record (a lightly damped mode's cost has local minima spaced π/T).
 
 :func:`arcosim.identification.beam_motion.tip_motion` runs the Kalman smoother of the
 fitted model over the record: the tip's deflection and the link's reaction torque.
