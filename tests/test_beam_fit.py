@@ -17,7 +17,8 @@ import pytest
 from arcosim.chainfile import read_chain
 from arcosim.cli import main
 from arcosim.identification.beam_fit import fit_link, fit_modes, modal_of
-from arcosim.identification.beam_motion import stiffening_warning, tip_motion
+from arcosim.identification.beam_model import modal_model
+from arcosim.identification.beam_motion import link_assumptions, stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.records import encoder_record, motor_record
 from arcosim.logs import units_path, write_csv
@@ -77,8 +78,9 @@ def test_a_log_without_a_mode_is_refused():
         {"time": t, "i_a": i_a, "omega_m": 1.5 * np.cos(3.0 * t), "theta_m": theta}, t, t
     )
     encoder, motor = records(log)
-    with pytest.raises(IdentificationError, match="excite every mode"):
+    with pytest.raises(IdentificationError, match="no clamped mode of the link") as refused:
         fit_link(encoder, motor, bench.LINKS[0].geometry)
+    assert "masses" not in str(refused.value)
 
 
 @pytest.mark.slow
@@ -139,3 +141,74 @@ def test_a_hub_fast_against_the_first_mode_is_warned_of():
     assert stiffening_warning(slow, 20.0) is None
     text = stiffening_warning(-1.1 * slow, 20.0)
     assert text is not None and "centrifugal stiffening" in text and "6.4 rad/s" in text
+
+
+@functools.cache
+def one_mode_log(index: int, seed: int = 1, duration: float = bench.DURATION):
+    """A log of link ``index`` whose band holds only its first clamped mode (the lines
+    and the band below the second), its band-limited case and g_dist (rad/s)."""
+    case, g_dist = bench.one_mode(bench.LINKS[index])
+    return bench.simulate(case, seed, duration), case, g_dist
+
+
+def one_mode_records(index: int, duration: float = bench.DURATION):
+    log, case, g_dist = one_mode_log(index, duration=duration)
+    c, actuator = log.columns, bench.actuator()
+    motor = motor_record(c["time"], c["i_a"], c["omega_m"], c["theta_m"], actuator, g_dist)
+    encoder = encoder_record(
+        c["time"], c["i_a"], c["theta_m"], actuator, bench.CPR, True, "none", g_dist
+    )
+    return encoder, motor, case
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("index", [0, 1, 2])
+def test_ei_from_one_mode_with_rhoa_given(index):
+    """ρA given, only the first clamped mode in the band: EI within 5 % on each link."""
+    encoder, motor, case = one_mode_records(index)
+    result = fit_link(encoder, motor, case.geometry, rhoA=case.link.rhoA)
+    assert result.extra["detected_modes_rad_s"][0] < case.modes(2).frequency[1] / 2
+    assert result.as_dict()["EI"] == pytest.approx(case.link.EI, rel=0.05)
+
+
+def test_rhoa_given_is_held_and_reported_as_given():
+    """A short one-mode log: ρA is no parameter of the fit (no standard error), the
+    result and the modal model carry the given value, the assumptions say it is given."""
+    encoder, motor, case = one_mode_records(0, duration=6.0)
+    rhoA = 1.1 * case.link.rhoA
+    result = fit_link(encoder, motor, case.geometry, rhoA=rhoA)
+    assert "rhoA" not in result.names and "rhoA" not in result.std_dict()
+    assert result.names[0] == "EI" and result.extra["rhoA_given"] == rhoA
+    model = modal_of(result, case.geometry)
+    truth = bench.Link(result.as_dict()["EI"], rhoA, case.link.L)
+    assert model.J_link == pytest.approx(modal_model(truth, 1).J_link, rel=1e-9)
+    assert "given: ρA = 0.022 kg/m" in link_assumptions(case.geometry, rhoA)["rhoA"]
+    with pytest.raises(IdentificationError, match="rhoA must be > 0"):
+        fit_link(encoder, motor, case.geometry, rhoA=-1.0)
+
+
+def test_one_mode_without_rhoa_is_refused_naming_it(capsys, tmp_path):
+    """Without ρA a one-mode record is refused, naming --set rhoA, in the library and on
+    the command line, in words of modes and the link (not masses)."""
+    encoder, motor, case = one_mode_records(0, duration=6.0)
+    with pytest.raises(IdentificationError, match="one clamped mode of the link") as refused:
+        fit_link(encoder, motor, case.geometry)
+    assert "--set rhoA=M/L" in str(refused.value) and "masses" not in str(refused.value)
+    log, _, g_dist = one_mode_log(0, duration=6.0)
+    path = write_csv(tmp_path / "link.csv", log.columns)
+    given = [
+        *("--set", f"k_to={bench.K_T}", "--set", f"J_mo={bench.J_M}"),
+        *("--set", f"encoder_cpr={bench.CPR}", "--set", f"D_m={bench.D_M}"),
+        *("--set", f"f_c={bench.F_C}", "--set", f"g_dist={g_dist}"),
+        *("--set", f"L={case.link.L}"),
+    ]
+    assert main(["identify", str(path), *given, "--method", "beam"]) == 2
+    assert "--set rhoA=M/L" in capsys.readouterr().err
+    rhoA = ["--set", f"rhoA={case.link.rhoA}"]
+    code = main(["identify", str(path), *given, *rhoA, "--method", "beam", "--json"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    report = json.loads(out.out)
+    assert report["rhoA"] == case.link.rhoA and report["rhoA_given"] is True
+    assert "rhoA" not in report["std"] and "rhoA" in report["assumptions"]
+    assert report["EI"] == pytest.approx(case.link.EI, rel=0.05)

@@ -4,9 +4,11 @@ the tip's motion over the log (offline).
 
 The link's geometry comes with ``--set`` beside the motor's terms: ``L`` (m) and
 ``m_tip`` (kg) (what a user knows), ``J_tip`` (kg·m²) and ``r_hub`` (m) (0 unless
-given). ``--out FILE.json`` writes the report (its equivalent lumped chain at the top,
-so ``--chain FILE.json`` reads it); ``--out FILE.csv`` writes ``alpha_tip_hat`` (rad),
-``w_tip_hat`` (m) and ``tau_reac_hat`` (N·m) over time, with their units beside it.
+given), and ``rhoA`` (kg/m, the link's weighed mass over L), which holds ρA so that EI
+is fitted from one clamped mode. ``--out FILE.json`` writes the report (its equivalent
+lumped chain at the top, so ``--chain FILE.json`` reads it); ``--out FILE.csv`` writes
+``alpha_tip_hat`` (rad), ``w_tip_hat`` (m) and ``tau_reac_hat`` (N·m) over time, with
+their units beside it.
 """
 
 from __future__ import annotations
@@ -31,11 +33,19 @@ from arcosim.identification.log_check import log_plausibility
 from arcosim.identification.motor_friction import without_friction
 from arcosim.identification.noise_floor import floor_warning, noise_floor
 from arcosim.identification.output_error import ParameterFit, predict
-from arcosim.identification.records import encoder_record, motor_record
+from arcosim.identification.records import (
+    EncoderRecord,
+    MotorRecord,
+    encoder_record,
+    motor_record,
+)
 from arcosim.logs import DriveLog, tool_keys, write_csv
 
-#: The link's ``--set`` names and their units; ``L`` is needed for EI and ρA.
-GEOMETRY = {"L": "m", "m_tip": "kg", "J_tip": "kg.m2", "r_hub": "m"}
+#: The link's ``--set`` names and their units; ``L`` is needed for EI and ρA; ``rhoA``
+#: (mass per length, > 0) is held in the fit, not fitted.
+GEOMETRY = {"L": "m", "m_tip": "kg", "J_tip": "kg.m2", "r_hub": "m", "rhoA": "kg/m"}
+#: The ``--set`` names that must be > 0 (the others ≥ 0).
+POSITIVE = ("L", "rhoA")
 #: Units of the columns ``--out FILE.csv`` writes.
 STATE_UNITS = {"time": "s", "alpha_tip_hat": "rad", "w_tip_hat": "m", "tau_reac_hat": "N.m"}
 
@@ -74,9 +84,9 @@ def split_geometry(assignments: Sequence[str]) -> tuple[dict[str, float], list[s
             number = float(value)
         except ValueError:
             number = math.nan
-        low_ok = number > 0 if name.strip() == "L" else number >= 0
+        low_ok = number > 0 if name.strip() in POSITIVE else number >= 0
         if not (math.isfinite(number) and low_ok):
-            bound = "> 0" if name.strip() == "L" else "≥ 0"
+            bound = "> 0" if name.strip() in POSITIVE else "≥ 0"
             raise UserError(
                 f"--set {text}: the link's {name.strip()} must be a number {bound} "
                 f"({GEOMETRY[name.strip()]})"
@@ -110,8 +120,9 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
     shape, assignments = split_geometry(args.set)
     if "L" not in shape and set(shape) - {"L"}:
         raise UserError(
-            "--method beam: --set m_tip, J_tip or r_hub need the link's length --set L=… (m)"
+            "--method beam: --set m_tip, J_tip, r_hub or rhoA need the link's --set L=… (m)"
         )
+    rhoA = shape.pop("rhoA", None)
     values = known_parameters(1, assignments)
     given = set_names(assignments)
     friction_given = {"D_m", "f_c"} <= given
@@ -129,10 +140,11 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
         log.time, c["i_a"], c["theta_m"], actuator, cpr, friction_given, "none", values["g_dist"]
     )
     geometry = Geometry(**shape) if "L" in shape else None
-    what = "EI, ρA and the damping" if geometry else "the link's modal model"
+    what = "EI, ρA and the damping" if rhoA is None else "EI (ρA given) and the damping"
+    what = what if geometry else "the link's modal model"
     print(f"arcosim identify: fitting {what} to {len(log)} samples (seconds)…", file=sys.stderr)
     try:
-        result = fit_link(encoder, motor, geometry) if geometry else fit_modes(encoder, motor)
+        result = _fit(encoder, motor, geometry, rhoA)
     except IdentificationError as error:
         if not plausibility:
             raise
@@ -154,7 +166,7 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
     ):
         if text:
             warnings.append(text)
-    assumptions = link_assumptions(geometry)
+    assumptions = link_assumptions(geometry, rhoA)
     note = defaults_note(values, ("J_mo", "k_to", "encoder_cpr"), given)
     if note:
         assumptions["defaults"] = note
@@ -179,6 +191,15 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
     else:
         _print_report(report, len(log))
     return 0
+
+
+def _fit(
+    encoder: EncoderRecord, motor: MotorRecord, geometry: Geometry | None, rhoA: float | None
+) -> ParameterFit:
+    """EI (ρA unless given, kg/m) and the damping with the geometry, else the modal model."""
+    if geometry is None:
+        return fit_modes(encoder, motor)
+    return fit_link(encoder, motor, geometry, rhoA=rhoA)
 
 
 def _modes_of(result: ParameterFit) -> ModalModel:
@@ -215,6 +236,9 @@ def _report(
         J_rest=float(model.J_rest),
     )
     if geometry is not None:
+        rhoA = extra.get("rhoA_given")
+        if rhoA is not None:  # given, held: a value without a standard error
+            out.update(rhoA=rhoA, rhoA_given=True)
         out.update(
             L=geometry.L,
             m_tip=geometry.m_tip,

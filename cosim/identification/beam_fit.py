@@ -9,8 +9,9 @@ the fit is the chain's prediction-error fit from the motor current to the encode
 (:mod:`arcosim.identification.encoder_fit`: the same Kalman predictor, friction sign
 passes and Newey–West standard errors), on these parameters:
 
-* ``EI`` (N·m²), ``rhoA`` (kg/m), the damping ratio ``zeta[i]`` of each mode below the
-  record's band, then the motor's ``D_m``, ``f_c`` when not given (:func:`fit_link`);
+* ``EI`` (N·m²), ``rhoA`` (kg/m; held when the user gives it, from the link's weighed
+  mass), the damping ratio ``zeta[i]`` of each mode below the record's band, then the
+  motor's ``D_m``, ``f_c`` when not given (:func:`fit_link`);
 * without the geometry, each mode's frequency ``omega[i]`` (rad/s), ``zeta[i]`` and
   hub participation ``b[i]``, and the link's inertia outside the modes ``J_rest``
   (:func:`fit_modes`).
@@ -18,8 +19,10 @@ passes and Newey–West standard errors), on these parameters:
 Start: the record's first clamped mode (the subspace stabilization diagram,
 :func:`arcosim.identification.modal_start.detect_modes`) fixes EI/ρA for each ρA
 (the modes scale as √EI), and a scan of the innovations over ρA on the record's
-opening picks ρA; the fit then runs on openings twice as long each time, up to the
-whole record (a lightly damped mode's cost has local minima spaced π/T).
+opening picks ρA; with ρA given, EI follows from the first mode directly, and one
+clamped mode in the band suffices (without it, a record that shows one is refused: one
+mode cannot tell EI from ρA). The fit then runs on openings twice as long each time, up
+to the whole record (a lightly damped mode's cost has local minima spaced π/T).
 
 :func:`arcosim.identification.beam_motion.tip_motion` runs the Kalman smoother of the
 fitted model over the record: the tip's deflection and the link's reaction torque.
@@ -37,7 +40,7 @@ from arcosim.identification.beam_model import Link, ModalModel, modal_model, mod
 from arcosim.identification.blas import single_threaded
 from arcosim.identification.encoder_fit import innovation_criterion, stuck_aware_sign
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.fit_notes import T_CONFIRM, missing_modes
+from arcosim.identification.fit_notes import T_CONFIRM
 from arcosim.identification.kalman import Drive, Kalman, innovations
 from arcosim.identification.modal_start import DetectedModes, detect_modes
 from arcosim.identification.newey_west import decorrelation_lag, newey_west_covariance
@@ -55,6 +58,9 @@ T_WEAK = 10.0
 #: Largest modal damping ratio the fit allows (dimensionless): a mode the record barely
 #: excites may otherwise run off to an overdamped pole.
 MAX_ZETA = 0.5
+#: Modes above the fitted ones that a fit with ρA given keeps flexible (a count): EI
+#: and ρA fix them, the last fitted damping ratio damps them.
+ABOVE_BAND = 1
 #: Iterations of each least-squares stage.
 MAX_ITERATIONS = 40
 #: Modes beyond the fitted ones whose quasi-static tip deflection the tip estimate keeps.
@@ -110,8 +116,10 @@ def fit_link(
     motor: MotorRecord,
     geometry: Geometry,
     modes: int | None = None,
+    rhoA: float | None = None,
 ) -> ParameterFit:
-    """Fit EI, ρA, the modal damping and (when not given) the motor friction.
+    """Fit EI, ρA (unless given), the modal damping and (when not given) the motor
+    friction.
 
     Parameters
     ----------
@@ -126,31 +134,68 @@ def fit_link(
     modes : int, optional
         Modes in the model (a count; default: those below the record's band, at least
         one); the rest of the link is rigid on the hub.
+    rhoA : float, optional
+        The link's mass per length (kg/m, its weighed mass over L), held: then EI
+        follows from the record's first clamped mode alone (the modes scale as
+        √(EI/ρA)), and one mode in the band suffices; the model keeps
+        :data:`ABOVE_BAND` mode(s) above the band flexible (EI and ρA fix them). Without
+        it the record must show a second clamped mode, or the fit is refused.
 
     Returns
     -------
     ParameterFit
-        ``EI`` (N·m²), ``rhoA`` (kg/m), ``zeta[i]``, then ``D_m``, ``f_c`` with
-        standard errors; ``extra`` holds the modal model (``modes_rad_s``,
-        ``participation``, ``tip_shape_m``, ``J_link``), the equivalent chain, the
-        start and the evidence.
+        ``EI`` (N·m²), ``rhoA`` (kg/m; not when given), ``zeta[i]``, then ``D_m``,
+        ``f_c`` with standard errors; ``extra`` holds the modal model
+        (``modes_rad_s``, ``participation``, ``tip_shape_m``, ``J_link``), the
+        equivalent chain, the start, the evidence, ``rhoA_given`` (kg/m, or None) and
+        ``modes_above_band`` (a count).
 
     Raises
     ------
     IdentificationError
-        When the record shows no clamped mode, or the fit diverges.
+        When the record shows no clamped mode, only one without ``rhoA``, or the fit
+        diverges; or ``rhoA`` is not a number > 0.
+
+    Examples
+    --------
+    With ``encoder`` and ``motor`` from a log, L = 0.4 m, a 20 g tip, a 12 g link:
+
+    >>> fit_link(encoder, motor, Geometry(0.4, 0.02), rhoA=0.012 / 0.4)  # doctest: +SKIP
+
+    A mass per length that is not > 0 is refused before the record is read:
+
+    >>> fit_link(None, None, Geometry(0.4), rhoA=0.0)
+    Traceback (most recent call last):
+    ...
+    arcosim.identification.errors.IdentificationError: the link's mass per length ...
     """
+    if rhoA is not None and not (np.isfinite(rhoA) and rhoA > 0):
+        raise IdentificationError(f"the link's mass per length rhoA must be > 0 kg/m, got {rhoA}")
     detected = detect_modes(motor, 8)
-    EI0, rhoA0, count, note = _start(record, detected, geometry, _first_mode(detected, motor))
+    first = _first_mode(detected, motor)
+    if rhoA is None:
+        if not np.any(detected.frequency > 2.0 * first):  # a second mode, weak or not
+            raise IdentificationError(one_mode_only(detected, first))
+        EI0, rhoA0, count, note = _start(record, detected, geometry, first)
+    else:
+        EI0, rhoA0, count, note = _given_start(detected, geometry, first, rhoA)
     count = count if modes is None else modes
+    held = rhoA is not None
+    skip = 1 if held else 2
+
+    above = ABOVE_BAND if held else 0
 
     def model(p: np.ndarray) -> ModalModel:
-        return modal_model(geometry.link(p[0], p[1]), count).with_damping(p[2 : 2 + count])
+        link = geometry.link(p[0], rhoA0 if held else p[1])
+        zeta = p[skip : skip + count]
+        zeta = np.concatenate([zeta, np.full(above, zeta[-1])])
+        return modal_model(link, count + above).with_damping(zeta)
 
-    names = ["EI", "rhoA", *(f"zeta[{i}]" for i in range(1, count + 1))]
-    start = [EI0, rhoA0, *([START_ZETA] * count)]
-    lower = [1e-3 * EI0, 1e-3 * rhoA0, *([0.0] * count)]
-    upper = [np.inf, np.inf, *([MAX_ZETA] * count)]
+    zetas = [f"zeta[{i}]" for i in range(1, count + 1)]
+    names = ["EI", *zetas] if held else ["EI", "rhoA", *zetas]
+    start = [EI0, *([] if held else [rhoA0]), *([START_ZETA] * count)]
+    lower = [1e-3 * EI0, *([] if held else [1e-3 * rhoA0]), *([0.0] * count)]
+    upper = [np.inf, *([] if held else [np.inf]), *([MAX_ZETA] * count)]
     problem = _Problem(names, model, np.array(lower), np.array(upper))
     result = _fit(record, problem, np.array(start), note)
     fitted = model(result.values)
@@ -159,6 +204,8 @@ def fit_link(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
         residue_t_values=[float(t) for t in detected.t_value],
         J_link=fitted.J_link,
+        rhoA_given=float(rhoA) if held else None,
+        modes_above_band=above,
     )
     return result
 
@@ -193,7 +240,7 @@ def fit_modes(record: EncoderRecord, motor: MotorRecord, modes: int | None = Non
     _first_mode(detected, motor)
     count = detected.n if modes is None else modes
     if detected.n < count:
-        raise IdentificationError(missing_modes(detected, count, motor))
+        raise IdentificationError(missing_link_modes(detected, count))
     w0 = detected.frequency[:count]
     b0 = np.sqrt(detected.residue[:count]) / w0**2
     zeta0 = np.clip(detected.damping[:count], 1e-3, 0.2)
@@ -259,6 +306,21 @@ def _start(
     return EI0, rhoA0, modes, note
 
 
+def _given_start(
+    detected: DetectedModes, geometry: Geometry, first: float, rhoA: float
+) -> tuple[float, float, int, str]:
+    """The fit's start with ρA given (kg/m): EI (N·m²) that puts the first clamped mode
+    on the record's ``first`` (rad/s; the modes scale as √EI at a fixed ρA), ρA, the
+    modes below the band (a count, at least one) and a note for the report."""
+    EI0 = (first / modal_model(geometry.link(1.0, rhoA), 1).frequency[0]) ** 2
+    modes = max(1, int(np.sum(modal_model(geometry.link(EI0, rhoA), 8).frequency < detected.band)))
+    note = (
+        f"first clamped mode {first:.4g} rad/s (subspace stabilization diagram) with ρA "
+        f"given ({rhoA:.4g} kg/m): EI = {EI0:.4g} N.m²"
+    )
+    return EI0, rhoA, modes, note
+
+
 def _scanned(
     short: EncoderRecord,
     at: Callable[[float, int], ModalModel],
@@ -281,11 +343,98 @@ def _scanned(
     return float(np.exp(found.x))
 
 
+def _seen(detected: DetectedModes) -> str:
+    """What the record shows below its band: the modes (rad/s), the weak ones."""
+    found = ", ".join(f"{w:.1f}" for w in detected.frequency)
+    found = f"modes at {found} rad/s" if found else "no mode that counts"
+    text = f"below its band ({detected.band:.0f} rad/s) the record shows {found}"
+    if detected.weak:
+        weak = ", ".join(f"{w:.1f} rad/s (t = {t:.1f})" for w, t in detected.weak)
+        text += f", and too weakly excited to count: {weak}"
+    return text
+
+
+def _excite(detected: DetectedModes) -> str:
+    """How to excite a link's modes better (a clause for a refusal)."""
+    return (
+        "more current per line (fewer lines, or a higher amplitude), lines on both sides "
+        "of each mode up to the band, a longer record, a finer encoder; the band is "
+        f"min(3·g_dist, 0.3/h) = {detected.band:.0f} rad/s (`arcosim.design_excitation`)"
+    )
+
+
+def missing_link_modes(detected: DetectedModes, count: int | None) -> str:
+    """Why the record cannot support a link of ``count`` modes (None: not even one
+    clamped mode), and what to do.
+
+    Parameters
+    ----------
+    detected : DetectedModes
+        The modes the record shows (:func:`~arcosim.identification.modal_start.detect_modes`).
+    count : int or None
+        The modes asked for (a count), or None when the record shows none that counts.
+
+    Returns
+    -------
+    str
+        The refusal, naming the modes seen (rad/s) and the band (rad/s).
+
+    Examples
+    --------
+    >>> from arcosim.identification.modal_start import DetectedModes
+    >>> none = np.empty(0)
+    >>> detected = DetectedModes(none, none, none, none, [], np.empty(0, int), 150.0, none)
+    >>> missing_link_modes(detected, None)[:58]
+    'the record shows no clamped mode of the link that counts ('
+    """
+    if count is None:
+        head = "the record shows no clamped mode of the link that counts"
+        tail = "excite the link's first clamped mode"
+    else:
+        head = f"the record shows {detected.n} clamped mode(s) of the link, {count} asked"
+        tail = "fit fewer modes (modes=…), or excite each mode asked"
+    return f"{head} ({_seen(detected)}): {tail}: {_excite(detected)}"
+
+
+def one_mode_only(detected: DetectedModes, first: float) -> str:
+    """Why EI and ρA cannot both be fitted from a record with one clamped mode
+    ``first`` (rad/s), and the two ways out: ρA given, or the second mode excited.
+
+    Parameters
+    ----------
+    detected : DetectedModes
+        The modes the record shows.
+    first : float
+        The first clamped mode that counts (rad/s).
+
+    Returns
+    -------
+    str
+        The refusal, naming ``--set rhoA``.
+
+    Examples
+    --------
+    >>> from arcosim.identification.modal_start import DetectedModes
+    >>> one = np.array([15.0])
+    >>> detected = DetectedModes(one, one, one, one, [], np.zeros(1, int), 75.0, one)
+    >>> "--set rhoA=M/L" in one_mode_only(detected, 15.0)
+    True
+    """
+    return (
+        f"the record shows one clamped mode of the link ({first:.1f} rad/s; "
+        f"{_seen(detected)}): EI and ρA move it alike (the modes scale as √(EI/ρA)), so "
+        "one mode cannot tell them apart. Give the link's mass per length, --set "
+        "rhoA=M/L (kg/m: its weighed mass M over its length L; rhoA= in the library), "
+        "to fit EI from this mode; or excite the second clamped mode inside the band: "
+        + _excite(detected)
+    )
+
+
 def _first_mode(detected: DetectedModes, motor: MotorRecord) -> float:
     """The lowest mode that counts (rad/s), or the refusal naming what is missing."""
     strong = detected.frequency[detected.t_value >= T_CONFIRM]
     if not strong.size:
-        raise IdentificationError(missing_modes(detected, None, motor))
+        raise IdentificationError(missing_link_modes(detected, None))
     return float(strong[0])
 
 
@@ -394,7 +543,8 @@ def _least_squares(
         if not np.all(np.isfinite(e)):
             raise IdentificationError(
                 "the flexible link's prediction-error fit diverged (the record does not "
-                "determine the link): excite its modes better, or check L and m_tip"
+                "determine the link): excite its modes better, or check L, m_tip and "
+                "rhoA when given"
             )
         return e
 
@@ -413,12 +563,15 @@ def _least_squares(
 
 def modal_of(result: ParameterFit, geometry: Geometry, count: int | None = None) -> ModalModel:
     """The fitted link's modal model (of :func:`fit_link`'s result), ``count`` modes
-    (default the fit's), the next :data:`STATIC_MODES` in its quasi-static tip
-    deflection; a mode beyond the fit's takes the last fitted damping."""
+    (default the fit's, with ρA given those above the band it kept too), the next
+    :data:`STATIC_MODES` in its quasi-static tip deflection; a mode beyond the fitted
+    damping ratios takes the last of them. ρA is the fitted or the given one."""
     values = result.as_dict()
     zeta = [values[n] for n in result.names if n.startswith("zeta[")]
-    count = len(zeta) if count is None else count
-    link = geometry.link(values["EI"], values["rhoA"])
+    above = int(result.extra.get("modes_above_band", 0))
+    count = len(zeta) + above if count is None else count
+    rhoA = values["rhoA"] if "rhoA" in values else float(result.extra["rhoA_given"])
+    link = geometry.link(values["EI"], rhoA)
     zeta_all = np.concatenate([zeta, np.full(max(count - len(zeta), 0), zeta[-1])])[:count]
     full = modal_model(link, count + STATIC_MODES).first(count)
     return full.with_damping(zeta_all)
