@@ -143,17 +143,26 @@ def _write(path, log, current=None, time_scale=1.0):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("noise", [0.0, 5e-3])
-def test_a_current_without_excitation_is_refused_naming_it(tmp_path, capsys, noise):
-    """A constant current (or one that holds only its sensor's noise) was read as a
-    broadband excitation and fitted to a rigid drive with J_load 1.8e-18 ± 0, exit 0."""
+def test_a_constant_current_is_refused_naming_it(tmp_path, capsys):
+    """A constant current was read as an excitation and fitted to a rigid drive with
+    J_load 1.8e-18 ± 0, exit 0."""
     log = _log()
-    current = 0.5 + noise * np.random.default_rng(1).standard_normal(len(log.time))
-    path = _write(tmp_path / "constant.csv", log, current)
+    path = _write(tmp_path / "constant.csv", log, np.full(len(log.time), 0.5))
     assert main(["check", path]) == 1
-    assert "the current i_a " in capsys.readouterr().out
+    assert "the current i_a is constant" in capsys.readouterr().out
     assert main(["identify", path, "--method", "whole-chain"]) == 2
-    assert "the current i_a " in capsys.readouterr().err
+    assert "the current i_a is constant" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_current_of_noise_only_is_not_trusted(tmp_path, capsys):
+    """A current that holds only its sensor's noise (the motor moved by something else)
+    fits, but the torque balance names the current and k_t."""
+    log = _log()
+    noise = 0.5 + 5e-3 * np.random.default_rng(1).standard_normal(len(log.time))
+    path = _write(tmp_path / "noise.csv", log, noise)
+    assert main(["identify", path, "--method", "whole-chain"]) == 3
+    assert "--scale i_a=" in capsys.readouterr().out
 
 
 @pytest.mark.slow

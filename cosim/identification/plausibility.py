@@ -44,6 +44,10 @@ INERTIA_HIGH = 1e3
 #: hold: the line's frequency is then resolved to a third of itself, and the fits' start
 #: transients (a few periods of the slowest motion) leave part of the record.
 LEAST_PERIODS = 3.0
+#: The torque balance's inertia counts as implausible only when it lies this many of its
+#: standard errors outside the plausible range (the three-sigma rule: a plausible log
+#: crosses it by chance 0.3 % of the time).
+BALANCE_SIGMAS = 3.0
 #: Least number of periods (a count) of the lowest mode a record should hold: its
 #: spectrum's resolution 2π/T is then at most a tenth of the mode, and the fit's start
 #: transients (a few periods of the slowest motion) leave most of the record. The 20 s
@@ -152,8 +156,17 @@ def torque_balance(
     >>> torque_balance(t, current * 1e-3, theta, 0.04, 1e-4, 2.0)[:28]
     'the torque balance k_t·i = J'
     """
-    J = balance_inertia(time, i_a, theta_m, k_t, lowest)
-    if J is None or INERTIA_LOW * J_m <= J <= INERTIA_HIGH * J_m:
+    found = balance_inertia(time, i_a, theta_m, k_t, lowest, with_error=True)
+    if found is None:
+        return None
+    J, sigma = found
+    # implausible only beyond the balance's own uncertainty: a slow load's motion, or a
+    # line the encoder barely sees, widens it (BALANCE_SIGMAS standard errors)
+    if (
+        INERTIA_LOW * J_m - BALANCE_SIGMAS * sigma
+        <= J
+        <= INERTIA_HIGH * J_m + BALANCE_SIGMAS * sigma
+    ):
         return None
     return (
         f"the torque balance k_t·i = J·α at {lowest:.3g} rad/s asks for a total inertia "
@@ -164,29 +177,44 @@ def torque_balance(
 
 
 def balance_inertia(
-    time: np.ndarray, i_a: np.ndarray, theta_m: np.ndarray, k_t: float, lowest: float | None
-) -> float | None:
+    time: np.ndarray,
+    i_a: np.ndarray,
+    theta_m: np.ndarray,
+    k_t: float,
+    lowest: float | None,
+    with_error: bool = False,
+):
     """Total inertia (kg·m²) of the torque balance at the line ``lowest`` (see
-    :func:`torque_balance`; arguments alike), or None when there is no line or motion."""
+    :func:`torque_balance`; arguments alike), or None when there is no line or motion;
+    with ``with_error``, ``(J, σ_J)``: σ_J (kg·m²) from the two line fits' standard
+    errors (their residuals taken as white), propagated to first order."""
     theta = np.asarray(theta_m, float)
     if not lowest or lowest <= 0 or len(theta) < 16:
         return None
     t = np.asarray(time, float) - time[0]
-    torque = _line_amplitude(t, k_t * np.asarray(i_a, float), lowest)
-    angle = _line_amplitude(t, theta, lowest)
+    torque, sigma_torque = _line_amplitude(t, k_t * np.asarray(i_a, float), lowest)
+    angle, sigma_angle = _line_amplitude(t, theta, lowest)
     if not abs(angle) > 0:
         return None
-    return float(-(torque / angle).real / lowest**2)
+    J = float(-(torque / angle).real / lowest**2)
+    if not with_error:
+        return J
+    relative = np.hypot(sigma_torque / max(abs(torque), 1e-300), sigma_angle / abs(angle))
+    return J, float(abs(torque / angle) / lowest**2 * relative)
 
 
-def _line_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> complex:
+def _line_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> tuple[complex, float]:
     """Complex amplitude of ``x`` (shape ``(N,)``) at ``w`` (rad/s) over times ``t`` (s):
-    least squares on a sine and cosine, a cubic trend removed."""
+    least squares on a sine and cosine, a cubic trend removed; with its standard error
+    (the magnitude's, the residual taken as white; ``x``'s unit)."""
     span = t[-1] if t[-1] > 0 else 1.0
     s = t / span
     X = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(s), s, s**2, s**3])
-    c = np.linalg.lstsq(X, x, rcond=None)[0]
-    return complex(c[0], -c[1])
+    c, *_ = np.linalg.lstsq(X, x, rcond=None)
+    residual = x - X @ c
+    variance = float(residual @ residual) / max(len(x) - X.shape[1], 1)
+    covariance = np.linalg.pinv(X.T @ X)[:2, :2] * variance
+    return complex(c[0], -c[1]), float(np.sqrt(max(np.trace(covariance) / 2.0, 0.0)))
 
 
 def record_length(time: np.ndarray, lowest: float | None) -> str | None:
