@@ -65,6 +65,7 @@ class Verdict:
 
     Examples
     --------
+    >>> from arcosim.identification.verdict import Verdict
     >>> Verdict(()).word, Verdict(("a mode lies above the band",)).word
     ('trusted', 'untrusted')
     """
