@@ -146,6 +146,22 @@ def test_drift_refuses_a_folder_without_a_store_with_one_line(tmp_path: Path, ca
     assert "run `arcosim fleet identify` first" in capsys.readouterr().err
 
 
+def test_the_fleet_benchmark_scores_alarms_by_axis_parameter_and_sign() -> None:
+    from benchmarks.fleet_accuracy import expected_alarms, found_alarms
+
+    rows = [
+        fit("k-drop", "2026-01-05", K1, 1e-3),
+        fit("k-drop", "2026-03-05", 0.88 * K1, 1e-3),
+        fit("two", "2026-01-05", K1, 1e-3),
+        fit("two", "2026-03-05", 1.2 * K1, 1e-3),  # a false alarm, up
+        fit("three", "2026-01-05", K1, 1e-3),
+        fit("three", "2026-03-05", K1, 1e-3, n=2),  # a structure alarm
+    ]
+    found = found_alarms(drift_of(rows))
+    assert found == {("k-drop", "k[1]", -1), ("two", "k[1]", 1), ("three", "n", 1)}
+    assert expected_alarms() == {("k-drop", "k[1]", -1), ("friction-rise", "f_c", 1)}
+
+
 # -- end to end: a tiny simulated fleet on one Dask worker ---------------------------------
 
 
