@@ -16,9 +16,9 @@ mean fit time of a log against the wall time per log and worker (the difference 
 the cluster's and the store's overhead per log), each worker's peak memory, the time
 to rewrite a store of 10,000 rows; and from these, on paper, 10,000 logs on 64 cores.
 
-Run: ``arcosim bench fleet [--fleets N] [--seconds 20] [--workers 2] [--out FILE.json]``
-or ``arcosim bench fleet --scaling`` (about 6 s of simulation and a few seconds of fit
-per 20 s log on the 2-core machine; 25 logs a fleet).
+Run: ``arcosim bench fleet [--fleets N] [--first-seed 0] [--seconds 20] [--workers 2]
+[--out FILE.json]`` or ``arcosim bench fleet --scaling`` (about 8 s of simulation and 4 s
+of fit per 20 s log on the loaded 2-core machine; 25 logs a fleet).
 """
 
 from __future__ import annotations
@@ -256,7 +256,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--fleets", type=int, default=5, help="fleets, seeds 0.. (default 5)")
+    p.add_argument("--fleets", type=int, default=5, help="fleets (default 5)")
+    p.add_argument("--first-seed", type=int, default=0, help="the first fleet's seed")
     p.add_argument("--seconds", type=float, default=20.0, help="each log's length (s)")
     p.add_argument("--workers", type=int, default=2, help="local workers (default 2)")
     p.add_argument(
@@ -283,7 +284,7 @@ def _execute(args: argparse.Namespace) -> int:
             print(scaling_text(result))
         else:
             fleets = []
-            for seed in range(args.fleets):
+            for seed in range(args.first_seed, args.first_seed + args.fleets):
                 fleets.append(score_fleet(seed, args.seconds, args.workers, folder / f"{seed}"))
                 print(_fleet_text(fleets[-1]), flush=True)
             result = {"fleets": fleets}
