@@ -108,6 +108,14 @@ def test_a_different_number_of_masses_is_a_structure_alarm() -> None:
     assert alarm["kind"] == "structure" and (alarm["baseline"], alarm["latest"]) == (1, 2)
 
 
+def test_a_parameter_the_latest_fit_does_not_hold_is_not_compared() -> None:
+    base = fit("a", "2026-01-01", K1, 1e-3, D_m=2e-5, D_m_std=1e-6)
+    last = fit("a", "2026-02-01", K1, 1e-3, D_m=math.nan, D_m_std=math.nan)  # D_m not fitted
+    drift = drift_of([base, last]).axes["a"]
+    assert [c["parameter"] for c in drift.changes] == ["J[1]", "k[1]"]
+    assert "nan" not in drift_of([base, last]).text()
+
+
 def test_the_report_as_json_and_text() -> None:
     rows = [fit("a", "2026-01-01", K1, 1e-3), fit("a", "2026-02-01", 0.88 * K1, 1e-3)]
     report = drift_of(rows)
