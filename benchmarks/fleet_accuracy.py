@@ -17,7 +17,7 @@ the cluster's and the store's overhead per log), each worker's peak memory, the 
 to rewrite a store of 10,000 rows; and from these, on paper, 10,000 logs on 64 cores.
 
 Run: ``arcosim bench fleet [--fleets N] [--first-seed 0] [--seconds 20] [--workers 2]
-[--out FILE.json]`` or ``arcosim bench fleet --scaling`` (about 8 s of simulation and 4 s
+[--out FILE.json]`` or ``arcosim bench fleet --scaling`` (about 8 s of simulation and 6 s
 of fit per 20 s log on the loaded 2-core machine; 25 logs a fleet).
 """
 
