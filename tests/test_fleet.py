@@ -3,7 +3,9 @@
 The rule's tests use hand-made rows (fast): an alarm needs both the relative threshold
 and 3 standard errors of the difference; an untrusted fit is never the baseline; a
 different n is a structure alarm. The end-to-end test identifies a tiny fleet simulated
-by the independent simulator (:mod:`benchmarks.fleet_sample`) on a one-worker cluster.
+by the independent simulator (:mod:`benchmarks.fleet_sample`) on a one-worker cluster;
+another identifies it on a scheduler and two workers started apart (``dask scheduler``,
+``dask worker``), as a user's own cluster, and finds the local cluster's store.
 """
 
 from __future__ import annotations
@@ -11,6 +13,11 @@ from __future__ import annotations
 import io
 import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +28,7 @@ from arcosim.cli import main
 from arcosim.errors import UserError
 from arcosim.fleet.drift import drift_of
 from arcosim.fleet.layout import log_date, read_fleet
-from arcosim.fleet.store import read_store, write_store
+from arcosim.fleet.store import parameter_names, read_store, write_store
 
 K1 = 0.3  # N·m/rad
 
@@ -101,6 +108,14 @@ def test_a_different_number_of_masses_is_a_structure_alarm() -> None:
     assert alarm["kind"] == "structure" and (alarm["baseline"], alarm["latest"]) == (1, 2)
 
 
+def test_a_parameter_the_latest_fit_does_not_hold_is_not_compared() -> None:
+    base = fit("a", "2026-01-01", K1, 1e-3, D_m=2e-5, D_m_std=1e-6)
+    last = fit("a", "2026-02-01", K1, 1e-3, D_m=math.nan, D_m_std=math.nan)  # D_m not fitted
+    drift = drift_of([base, last]).axes["a"]
+    assert [c["parameter"] for c in drift.changes] == ["J[1]", "k[1]"]
+    assert "nan" not in drift_of([base, last]).text()
+
+
 def test_the_report_as_json_and_text() -> None:
     rows = [fit("a", "2026-01-01", K1, 1e-3), fit("a", "2026-02-01", 0.88 * K1, 1e-3)]
     report = drift_of(rows)
@@ -137,6 +152,22 @@ def test_a_log_not_named_by_an_iso_date_is_refused_naming_it(tmp_path: Path) -> 
 def test_drift_refuses_a_folder_without_a_store_with_one_line(tmp_path: Path, capsys) -> None:
     assert main(["fleet", "drift", str(tmp_path)]) == 2
     assert "run `arcosim fleet identify` first" in capsys.readouterr().err
+
+
+def test_the_fleet_benchmark_scores_alarms_by_axis_parameter_and_sign() -> None:
+    from benchmarks.fleet_accuracy import expected_alarms, found_alarms
+
+    rows = [
+        fit("k-drop", "2026-01-05", K1, 1e-3),
+        fit("k-drop", "2026-03-05", 0.88 * K1, 1e-3),
+        fit("two", "2026-01-05", K1, 1e-3),
+        fit("two", "2026-03-05", 1.2 * K1, 1e-3),  # a false alarm, up
+        fit("three", "2026-01-05", K1, 1e-3),
+        fit("three", "2026-03-05", K1, 1e-3, n=2),  # a structure alarm
+    ]
+    found = found_alarms(drift_of(rows))
+    assert found == {("k-drop", "k[1]", -1), ("two", "k[1]", 1), ("three", "n", 1)}
+    assert expected_alarms() == {("k-drop", "k[1]", -1), ("friction-rise", "f_c", 1)}
 
 
 # -- end to end: a tiny simulated fleet on one Dask worker ---------------------------------
@@ -236,3 +267,88 @@ def test_an_output_folder_inside_the_fleet_is_not_an_axis(tmp_path: Path) -> Non
     assert arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "fleet" / "out").total == 0
     with pytest.raises(UserError, match="workers = 0: give a whole number of processes"):
         arcosim.identify_fleet(tmp_path / "fleet", tmp_path / "out", workers=0)
+
+
+# -- a scheduler and workers started apart, as a cluster of one's own ---------------------
+
+
+def _start(command: list[str], env: dict[str, str], log: Path) -> subprocess.Popen:
+    """A Dask process of the test's own, in its own process group (its children with it)."""
+    with open(log, "w") as out:
+        return subprocess.Popen(
+            command, stdout=out, stderr=subprocess.STDOUT, env=env, start_new_session=True
+        )
+
+
+def _stop(process: subprocess.Popen) -> None:
+    """End a process :func:`_start` started and its children: SIGTERM, then SIGKILL."""
+    if process.poll() is None:
+        os.killpg(process.pid, signal.SIGTERM)
+    try:
+        process.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait(timeout=10)
+
+
+def _same_stores(one: list[dict], other: list[dict]) -> None:
+    """The rows of two stores agree: logs, status, reason, n, verdict, parameters to 1e-9."""
+    first = {(r["axis"], r["date"]): r for r in one}
+    second = {(r["axis"], r["date"]): r for r in other}
+    assert sorted(first) == sorted(second)
+    for key, a in first.items():
+        b = second[key]
+        for column in ("log", "status", "reason", "n", "verdict", "verdict_reasons"):
+            assert a[column] == b[column], (key, column)
+        assert parameter_names(a) == parameter_names(b), key
+        for name in parameter_names(a):
+            assert b[name] == pytest.approx(a[name], rel=1e-9), (key, name)
+            std_a, std_b = a[name + "_std"], b[name + "_std"]
+            assert (math.isnan(std_a) and math.isnan(std_b)) or std_b == pytest.approx(
+                std_a, rel=1e-9
+            ), (key, name + "_std")
+
+
+@pytest.mark.slow
+@pytest.mark.system
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX) end the workers")
+def test_a_scheduler_started_apart_gives_the_store_of_a_local_cluster(tmp_path: Path) -> None:
+    from dask.distributed import Client
+
+    from benchmarks.fleet_sample import write_fleet
+
+    fleet = tmp_path / "fleet"
+    write_fleet(fleet, axes=2, seconds=5.0)  # 2 axes x 2 dates, and a corrupt log on a2
+    local = arcosim.identify_fleet(fleet, tmp_path / "local", workers=1)
+    assert (local.total, local.failed) == (5, 1)
+
+    root = Path(__file__).resolve().parents[1]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")])),
+    }
+    address_file = tmp_path / "scheduler.json"
+    scheduler = [sys.executable, "-m", "distributed.cli.dask_scheduler", "--port", "0"]
+    scheduler += ["--dashboard-address", ":0", "--scheduler-file", str(address_file)]
+    worker = [sys.executable, "-m", "distributed.cli.dask_worker", "--nworkers", "1"]
+    worker += ["--nthreads", "1", "--no-dashboard", "--scheduler-file", str(address_file)]
+    processes: list[subprocess.Popen] = []
+    try:
+        processes.append(_start(scheduler, env, tmp_path / "scheduler.log"))
+        deadline = time.monotonic() + 60
+        while not address_file.exists() or not address_file.read_text().strip():
+            assert processes[0].poll() is None, (tmp_path / "scheduler.log").read_text()
+            assert time.monotonic() < deadline, "no scheduler file after 60 s"
+            time.sleep(0.2)
+        time.sleep(0.2)  # the file is written whole, once; let the write end
+        address = json.loads(address_file.read_text())["address"]
+        for i in (1, 2):
+            processes.append(_start(worker, env, tmp_path / f"worker{i}.log"))
+        with Client(address, timeout=30) as client:
+            client.wait_for_workers(2, timeout=90)
+        apart = arcosim.identify_fleet(fleet, tmp_path / "apart", scheduler=address)
+    finally:
+        for process in reversed(processes):
+            _stop(process)
+    assert (apart.total, apart.identified, apart.failed) == (5, 5, 1)
+    _same_stores(read_store(tmp_path / "local"), read_store(tmp_path / "apart"))

@@ -21,6 +21,7 @@ BENCHMARKS = {
     "accuracy": "accuracy",
     "speed": "speed",
     "control": "control_accuracy",
+    "fleet": "fleet_accuracy",
     "public": "public_records",
     "thirdparty": "thirdparty_chain",
     "verdict": "verdict_accuracy",

@@ -224,7 +224,8 @@ def axis_drift(
     if base["n"] != last["n"]:
         alarm = {"parameter": "n", "kind": "structure", "baseline": base["n"], "latest": last["n"]}
         return AxisDrift(name, base, last, [], [alarm], history, untrusted)
-    changes = [_change(p, base, last, threshold) for p in parameter_names(base) if p in last]
+    held = set(parameter_names(last))  # a column of the store is NaN where a fit has none
+    changes = [_change(p, base, last, threshold) for p in parameter_names(base) if p in held]
     alarms = [{"kind": "drift", **c} for c in changes if c["alarm"]]
     return AxisDrift(name, base, last, changes, alarms, history, untrusted)
 
