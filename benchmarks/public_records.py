@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.experiments.report import markdown_table
-from arcosim.logs import write_csv
+from arcosim.logs import COLUMN_UNITS, write_csv
 from benchmarks import public_loaders as loaders
 
 #: Where each file can be had: the source's page, then a GitHub copy (raw file).
@@ -266,6 +266,14 @@ def run_record(record: Record, data: Path, work: Path, fmus: Path | None) -> dic
         work / f"{record.name}.csv", converted.columns, units=converted.units, force=True
     )
     sets = [a for s in settings for a in ("--set", s)]
+    # a column the loader keeps in the record's own unit (the EMPS's control voltage in V
+    # with k_to in N/V, its axis in m) is taken as it is, and said so: --scale COLUMN=1
+    sets += [
+        a
+        for column, unit in converted.units.items()
+        if column in COLUMN_UNITS and unit != COLUMN_UNITS[column]
+        for a in ("--scale", f"{column}=1")
+    ]
     status, out, err = arcosim(["check", str(log), *sets, "--json"])
     check = json.loads(out) if out.strip().startswith("{") else {}
     result = {"log": str(log), "data_file": str(path), "note": converted.note}
