@@ -7,7 +7,6 @@ function), not from what happens to be imported, so a deferred import counts too
 from __future__ import annotations
 
 import ast
-import re
 import sys
 from pathlib import Path
 
@@ -168,22 +167,3 @@ def test_no_import_cycle() -> None:
     for name in sorted(MODULES):
         if name not in state:
             visit(name)
-
-
-#: A module over this many lines says why in its docstring.
-MAX_LINES = 450
-REASON = re.compile(r"(?:^|[.!?]\s)Longer than 450 lines because\b")
-
-
-def test_no_module_is_over_450_lines_without_saying_why() -> None:
-    long = {}
-    for name, path in MODULES.items():
-        source = path.read_text(encoding="utf-8")
-        lines = len(source.splitlines())
-        docstring = " ".join((ast.get_docstring(ast.parse(source)) or "").split())
-        if lines > MAX_LINES and not REASON.search(docstring):
-            long[name] = lines
-    assert not long, (
-        f"over {MAX_LINES} lines with no sentence 'Longer than {MAX_LINES} lines because …' "
-        f"in the module docstring: {long}"
-    )
