@@ -25,7 +25,7 @@ from threadpoolctl import threadpool_limits
 from arcosim.errors import ArcosimError, UserError
 from arcosim.fleet.layout import Axis, FleetLog, read_fleet
 from arcosim.fleet.store import STD, read_store, store_path, write_store
-from arcosim.sweeps.runner import lock_folder
+from arcosim.sweeps.runner import dask_client, lock_folder
 from arcosim.version import __version__
 
 #: The lock file of a fleet's output folder.
@@ -223,21 +223,10 @@ def _run(
     progress: TextIO | None,
 ) -> None:
     """Send the pending logs to Dask; write the store after each result."""
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import as_completed
 
     _say(progress, _starting(len(pending), scheduler, workers))
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
-        )
-        client = Client(cluster)
-    else:
-        try:
-            client = Client(scheduler, timeout=20)
-        except OSError as error:
-            raise UserError(f"--scheduler {scheduler}: cannot connect ({error})") from None
-    try:
+    with dask_client(scheduler, workers) as client:
         futures = {
             client.submit(
                 identify_log,
@@ -256,10 +245,6 @@ def _run(
             added.append(row)
             write_store(out, sorted(rows, key=lambda r: (str(r["axis"]), str(r["date"]))))
             _say(progress, _progress_line(added, len(pending), time.perf_counter() - started))
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def _result(future, log: FleetLog) -> dict[str, object]:

@@ -340,15 +340,37 @@ def result_units(
 
 
 def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progress) -> None:
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import as_completed
     from tqdm import tqdm
 
-    cluster = None
     if show_progress:  # Dask takes seconds to start, before the bar's first run
         how = f"starting a local Dask cluster ({workers} workers)"
         if scheduler is not None:
             how = f"connecting to the Dask scheduler at {scheduler}"
         print(f"{spec.name}: {how} for {len(pending)} runs…", file=sys.stderr)
+    with dask_client(scheduler, workers) as client:
+        shipped = client.scatter(blobs, broadcast=True)
+        futures = [client.submit(run_one, i, v, spec, shipped, pure=False) for i, v in pending]
+        with tqdm(total=len(futures), unit="run", disable=not show_progress, desc=spec.name) as bar:
+            for future in as_completed(futures):
+                writer.writerow(future.result())
+                f.flush()
+                bar.update(1)
+
+
+@contextlib.contextmanager
+def dask_client(scheduler: str | None, workers: int) -> Iterator[object]:
+    """A Dask client, closed on leaving: on a local cluster of ``workers`` processes of
+    one thread each (closed too), or on the scheduler at the address ``scheduler``.
+
+    Raises
+    ------
+    UserError
+        When the scheduler cannot be reached, naming its address.
+    """
+    from dask.distributed import Client, LocalCluster
+
+    cluster = None
     if scheduler is None:
         cluster = LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
@@ -360,13 +382,7 @@ def _run_tasks(spec, pending, blobs, writer, f, scheduler, workers, show_progres
         except OSError as error:
             raise UserError(f"--scheduler {scheduler}: cannot connect ({error})") from None
     try:
-        shipped = client.scatter(blobs, broadcast=True)
-        futures = [client.submit(run_one, i, v, spec, shipped, pure=False) for i, v in pending]
-        with tqdm(total=len(futures), unit="run", disable=not show_progress, desc=spec.name) as bar:
-            for future in as_completed(futures):
-                writer.writerow(future.result())
-                f.flush()
-                bar.update(1)
+        yield client
     finally:
         client.close()
         if cluster is not None:
