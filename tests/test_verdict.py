@@ -63,10 +63,11 @@ def test_an_excitation_above_the_observers_band_names_g_dist():
 def test_judge_collects_every_reason_once():
     floor = ["the residual is 6 × the noise floor"]
     weak = unresolved({"J[1]": 1e-9, "k[1]": 0.3}, {"J[1]": 1e-9, "k[1]": 0.01})
-    verdict = judge(["check the current's scale"], floor + floor, weak, [248.0], LINES, 40.0)
+    doubts = ["check the current's scale", excitation_above_band(LINES, 40.0)]
+    verdict = judge(doubts, floor + floor, weak, [248.0], LINES)
     assert not verdict.trusted and verdict.word == "untrusted"
     assert len(verdict.reasons) == 5  # plausibility, floor (once), J[1], mode, band
-    assert judge([], [], None, [11.7], LINES, 100.0) == Verdict(())
+    assert judge([], [], None, [11.7], LINES) == Verdict(())
 
 
 def test_an_inertia_or_stiffness_within_three_sigma_of_zero_is_unresolved():

@@ -286,12 +286,11 @@ def identify_drive(
     chain = split(fit.values, choice.n)
     std = {k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})}
     verdict = judge(
-        plausibility,
+        decision.doubts,
         floor_findings,
         unresolved(parameters, std),
         driving_point_modes(chain[0], chain[1])[0] if choice.n else [],
         decision.spectrum,
-        g_dist,
     )
     return DriveIdentification(
         masses=choice.n,

@@ -77,10 +77,9 @@ class LogDecision:
         What both ``check`` and ``identify`` warn of, one sentence each.
     plausibility : list of str
         The plausibility findings among the warnings (a refusal names them first).
-    doubts : list of str
-        The findings among the warnings that leave any fit of the log untrusted (the
-        plausibility findings, an excitation above the band the fit searches:
-        :mod:`~arcosim.identification.verdict`).
+    above_band : str or None
+        The excitation reaching above the disturbance observer's band, when it does
+        (:func:`~arcosim.identification.verdict.excitation_above_band`).
     step : float
         Mean sample step (s).
     step_spread : float
@@ -110,7 +109,7 @@ class LogDecision:
     problems: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     plausibility: list[str] = field(default_factory=list)
-    doubts: list[str] = field(default_factory=list)
+    above_band: str | None = None
     step: float = 0.0
     step_spread: float = 0.0
     range_counts: float = 0.0
@@ -126,6 +125,13 @@ class LogDecision:
     def ok(self) -> bool:
         """No problem: the fit goes ahead."""
         return not self.problems
+
+    @property
+    def doubts(self) -> list[str]:
+        """The findings among the warnings that leave any fit of the log untrusted: the
+        plausibility findings and an excitation above the band
+        (:mod:`~arcosim.identification.verdict`)."""
+        return self.plausibility + ([self.above_band] if self.above_band else [])
 
 
 def decide_log(
@@ -200,8 +206,7 @@ def decide_log(
     decision.plausibility = plausibility_warnings(
         time, i_a, omega_m, theta_m, k_t, J_m, decision.spectrum.lowest
     )
-    above = excitation_above_band(decision.spectrum, g_dist)
-    decision.doubts = decision.plausibility + ([above] if above else [])
+    decision.above_band = excitation_above_band(decision.spectrum, g_dist)
     decision.warnings += decision.doubts
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0
     _motion(decision, theta_m, h, count, g_dist)

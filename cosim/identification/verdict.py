@@ -208,20 +208,20 @@ def excitation_above_band(spectrum: ExcitationSpectrum | None, g_dist: float) ->
 
 
 def judge(
-    plausibility: Sequence[str],
+    doubts: Sequence[str],
     floor: Sequence[str],
     resolution: str | None,
     modes: Sequence[float],
     spectrum: ExcitationSpectrum | None,
-    g_dist: float,
 ) -> Verdict:
     """The verdict on a final model from the evidence the structure choice did not use.
 
     Parameters
     ----------
-    plausibility : sequence of str
-        The log's implausible units or length
-        (:func:`~arcosim.identification.plausibility.plausibility_warnings`).
+    doubts : sequence of str
+        What leaves any fit of the log untrusted, found before the fit
+        (:attr:`~arcosim.identification.log_decision.LogDecision.doubts`: the log's
+        implausible units or length, :func:`excitation_above_band`).
     floor : sequence of str
         The residual's findings against the noise floor on the final model
         (:func:`~arcosim.identification.noise_floor.floor_warning`,
@@ -232,8 +232,6 @@ def judge(
         The final chain's clamped modes (rad/s); empty for a rigid drive.
     spectrum : ExcitationSpectrum or None
         What the current's spectrum shows.
-    g_dist : float
-        The disturbance observer's bandwidth (rad/s).
 
     Returns
     -------
@@ -242,17 +240,13 @@ def judge(
 
     Examples
     --------
-    >>> judge([], [], None, [], None, 100.0).word
+    >>> judge([], [], None, [], None).word
     'trusted'
-    >>> judge(["check the current's scale (--scale i_a=…)"], [], None, [], None, 100.0).reasons
+    >>> judge(["check the current's scale (--scale i_a=…)"], [], None, [], None).reasons
     ("check the current's scale (--scale i_a=…)",)
     """
-    found = [*plausibility, *floor]
-    for reason in (
-        resolution,
-        modes_outside(modes, spectrum),
-        excitation_above_band(spectrum, g_dist),
-    ):
+    found = [*doubts, *floor]
+    for reason in (resolution, modes_outside(modes, spectrum)):
         if reason is not None:
             found.append(reason)
     return Verdict(tuple(dict.fromkeys(found)))
