@@ -6,18 +6,37 @@
   (``arcosim bench speed``, or ``python -m benchmarks.speed``);
 - :mod:`benchmarks.public_records`: ``check`` and ``identify`` on public measured records
   of real drives against their published values (``arcosim bench public --data DIR``);
-- :mod:`benchmarks.memory`, :mod:`benchmarks.b_bias`, :mod:`benchmarks.noise_envelope`:
-  one-off measurements, run as scripts;
+- :mod:`benchmarks.memory`, :mod:`benchmarks.noise_envelope`: measurements run as scripts;
 - :mod:`benchmarks.link_frequencies`: the flexible-link FMU's frequencies against the
   continuous beam's, for 2, 4 and 8 elements (``python -m benchmarks.link_frequencies``).
 - :mod:`benchmarks.published_link`: a link we did not write, Quanser's rotary flexible
   link from its published parameters, on the link FMU and on the continuous beam's modes
-  (:mod:`benchmarks.modal_link`, a simulator written apart from the FMU), identified
+  (:mod:`benchmarks.simulators.modal_link`, a simulator written apart from the FMU), identified
   from the hub (``python -m benchmarks.published_link``).
 - :mod:`benchmarks.thirdparty_chain`: a chain assembled from Dymola-exported FMUs
-  (:mod:`benchmarks.thirdparty_plant`), identified and controlled
+  (:mod:`benchmarks.simulators.thirdparty_plant`), identified and controlled
   (``arcosim bench thirdparty --fmus DIR``); :mod:`benchmarks.thirdparty_cosim`, the same
   chain coupled explicitly in co-simulation (one-off, why it is not).
+
+The rows and their parts:
+
+- :mod:`benchmarks.cases`: the chains and sensors the accuracy rows score on;
+- :mod:`benchmarks.chain_accuracy`, :mod:`benchmarks.load_accuracy`,
+  :mod:`benchmarks.beam_accuracy`, :mod:`benchmarks.field_accuracy`,
+  :mod:`benchmarks.excitation_accuracy` (on the logs of :mod:`benchmarks.excitations`):
+  the rows of ``arcosim bench accuracy``;
+- :mod:`benchmarks.verdict_accuracy`: the whole-chain fit's verdict on logs with and
+  without a user's mistake (``arcosim bench verdict``);
+- :mod:`benchmarks.control_accuracy`: sensorless motion control against its four criteria
+  (``arcosim bench control``); :mod:`benchmarks.control_margins`, the controller's margins;
+  :mod:`benchmarks.bank_reach`, how far the estimator bank reaches;
+- :mod:`benchmarks.fleet_accuracy`: the fleet's drift alarms and its scaling
+  (``arcosim bench fleet``);
+- :mod:`benchmarks.public_loaders`, :mod:`benchmarks.public_figure`: the public records'
+  readers and the motor bench's figure;
+- :mod:`benchmarks.sample_log`: writes the sample drive log the examples identify;
+- :mod:`benchmarks.golden`: the outputs a refactor must leave byte for byte the same;
+- :mod:`benchmarks.simulators`: the simulators written apart from the plant FMU.
 
 They import :mod:`arcosim`; nothing in :mod:`arcosim` imports them.
 """

@@ -11,7 +11,7 @@ then run again on the recorded logs, offline, in every configuration (the same
 ``flexchain`` code the FMU bundles), so one pair of runs scores every method:
 
 * identification: literal eq. 21 and eq. 21 with κ (rigid maneuver, mode 1) and
-  output error (broadband, ``cosim/identification/uniform_fit.py``); k̂ and B̂
+  output error (broadband, ``cosim/identification/fit/uniform_fit.py``); k̂ and B̂
   against the truth (the mean of the springs for the non-uniform case);
 * state estimation on the broadband run: the paper's recursion (eq. 22–26), the
   model-based observer, and the naive ``θ̂_i = θ_m``; score per mass
@@ -52,10 +52,10 @@ from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.codes import Estimator, Mode
+from arcosim.identification.fit.output_error import ParameterFit
+from arcosim.identification.fit.uniform_fit import uniform_chain
 from arcosim.identification.offline_observer import estimate_states, replay
-from arcosim.identification.output_error import ParameterFit
-from arcosim.identification.records import MotorRecord, motor_record
-from arcosim.identification.uniform_fit import uniform_chain
+from arcosim.identification.records.record import MotorRecord, motor_record
 from benchmarks import (
     beam_accuracy,
     chain_accuracy,
@@ -353,7 +353,7 @@ def run(
     summary["whole_chain_field"] = field_rows
     text += (
         "\nWhole-chain identification on drives the project never tuned on (logs from "
-        "`benchmarks/field_sim.py`, a simulator written apart from the plant; "
+        "`benchmarks/simulators/field_sim.py`, a simulator written apart from the plant; "
         f"{len(chain_seeds)} seeds; `auto`; only k_t, J_m and the counts known, the friction "
         "where the row says):\n\n" + field_accuracy.markdown(field_rows)
     )

@@ -32,17 +32,17 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.build.builder import ensure_built
-from arcosim.experiments.motion_experiment import (
+from arcosim.experiments.motion.experiment import (
     Runs,
     design_parameters,
     identify_chain,
     scaled,
     sensorless,
 )
-from arcosim.experiments.motion_findings import UPPER_BOUND_FACTOR
+from arcosim.experiments.motion.findings import UPPER_BOUND_FACTOR
 from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain.estimator_bank import EstimatorBank
-from arcosim.fmu.flexchain.motion_control import MotionController
+from arcosim.fmu.flexchain.control.controller import MotionController
+from arcosim.fmu.flexchain.control.estimator_bank import EstimatorBank
 from benchmarks.control_accuracy import CHAINS, score, seed_models
 
 

@@ -2,15 +2,15 @@
 
 Three links of our own (no tip mass; a heavy tip mass with tip inertia and a hub radius;
 a stiff link with a light tip mass), 2–4 clamped modes below the record's band. Each log
-comes from :mod:`benchmarks.field_sim` (the drive simulator written apart from the
+comes from :mod:`benchmarks.simulators.field_sim` (the drive simulator written apart from the
 plant: Coulomb friction with sticking, the current's noise, the encoder's counts) with
 the link as its modes on their own springs to the hub (``star=True``; 8 modes, more than
 the fit's, the rest rigid), driven by a 20 s multi-sine of log-spaced lines across the
 modes. Only k_t, J_m, the encoder's counts, L, m_tip (J_tip, r_hub) and the friction
-are given; the fit (:func:`arcosim.identification.beam_fit.fit_link`) finds EI, ρA and
+are given; the fit (:func:`arcosim.identification.link.beam_fit.fit_link`) finds EI, ρA and
 the damping. Per link, over the seeds: the largest |error| of the first two clamped
 modes, of EI and ρA, and rms(α̂ − α)/rms(α) of the tip angle after the first second
-(:func:`arcosim.identification.beam_motion.tip_motion`).
+(:func:`arcosim.identification.link.beam_motion.tip_motion`).
 
 With ``--one-mode`` (:func:`score_one_mode`): each link's log holds only its first
 clamped mode in the band (40 lines from 2 rad/s to 0.7 × the second mode, the band at
@@ -33,12 +33,12 @@ import numpy as np
 
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.beam_fit import Geometry, fit_link, modal_of
-from arcosim.identification.beam_model import Link, ModalModel, modal_model
-from arcosim.identification.beam_motion import tip_motion
-from arcosim.identification.blas import single_threaded
-from arcosim.identification.records import encoder_record, motor_record
-from benchmarks import field_sim
+from arcosim.identification.link.beam_fit import Geometry, fit_link, modal_of
+from arcosim.identification.link.beam_model import Link, ModalModel, modal_model
+from arcosim.identification.link.beam_motion import tip_motion
+from arcosim.identification.records.record import encoder_record, motor_record
+from arcosim.identification.threads import single_threaded
+from benchmarks.simulators import field_sim
 
 #: The motor (kg·m², N·m/A, N·m·s/rad, N·m) and the sensors: field_sim's rows'.
 J_M, K_T, D_M, F_C = 2.09e-5, 0.0406, 2e-5, 2e-3

@@ -18,8 +18,8 @@ import numpy as np
 from arcosim.experiments.metrics import percent_error
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import SCENARIOS
-from arcosim.identification.records import encoder_record, motor_record
-from arcosim.identification.whole_chain import identify_whole_chain, split
+from arcosim.identification.fit.whole_chain import identify_whole_chain, split
+from arcosim.identification.records.record import encoder_record, motor_record
 from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
 
 #: The chains: the bench and two with unequal springs (n = 2 and n = 5).

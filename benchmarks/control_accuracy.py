@@ -16,7 +16,7 @@ and by the sensorless controller and its full-state upper bound, each designed o
 A seed passes a criterion when the sensorless move settles the last mass within ±1 % in
 ≤ 2.5 s, leaves a residual ≤ max(0.1 × the cascade's, 1 mrad rms), settles within 1.3 ×
 the upper bound's time (same design) and holds no motor limit cycle over one count
-(:func:`arcosim.experiments.motion_findings.done_when`). Prints the pass counts per chain
+(:func:`arcosim.experiments.motion.findings.done_when`). Prints the pass counts per chain
 and model; writes ``control.md`` and ``control.json`` into ``--out``.
 
 ``--encoder-cpr`` sets the encoder of the plant, of the identification's log and of the
@@ -43,8 +43,8 @@ import numpy as np
 from arcosim.build.builder import ensure_built
 from arcosim.errors import UserError
 from arcosim.experiments.closed_loop import LoopRun
-from arcosim.experiments.motion_baselines import CascadeController, cascade_gains, chain_modes
-from arcosim.experiments.motion_experiment import (
+from arcosim.experiments.motion.baselines import CascadeController, cascade_gains, chain_modes
+from arcosim.experiments.motion.experiment import (
     MotionChain,
     Runs,
     design_parameters,
@@ -53,7 +53,7 @@ from arcosim.experiments.motion_experiment import (
     scaled,
     sensorless,
 )
-from arcosim.experiments.motion_findings import (
+from arcosim.experiments.motion.findings import (
     DISTANCE,
     I_MAX,
     MOVE_TIME,

@@ -33,8 +33,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from arcosim.experiments.report import markdown_table
-from arcosim.identification.log_check import check_log
-from benchmarks import excitations, field_accuracy, field_sim
+from arcosim.identification.checks.log_check import check_log
+from benchmarks import excitations, field_accuracy
+from benchmarks.simulators import field_sim
 
 #: Position loop around the PI speed loop: gain (1/s), PI (A·s/rad, A/rad), limit (A).
 POSITION_GAIN, SPEED_PI, CURRENT_LIMIT = 20.0, (0.3, 2.25), 10.0
@@ -179,7 +180,7 @@ def table(
     summaries, _ = score_rows(names, seeds, progress)
     text = (
         "\nWhole-chain identification by excitation (three-mass drive of "
-        "`benchmarks/field_sim.py`, friction fitted, `auto`, "
+        "`benchmarks/simulators/field_sim.py`, friction fitted, `auto`, "
         f"{len(seeds)} seeds; `benchmarks/excitation_accuracy.py` states each "
         "excitation; `check` agreeing with `identify` on every seed):\n\n" + markdown(summaries)
     )

@@ -1,12 +1,12 @@
 """Excitations a drive log may carry, as reusable log generators for the benchmark rows
-and tests (on :mod:`benchmarks.field_sim`, the simulator written apart from the plant).
+and tests (on :mod:`benchmarks.simulators.field_sim`, the simulator written apart from the plant).
 
 - :func:`offgrid_lines`: a multi-sine's lines moved to half a bin off the record's
   frequency grid (the worst leakage);
 - :func:`prbs`: a maximum-length pseudo-random binary current, held for ``clock``
   samples;
 - :func:`square_position`: a square-wave position reference, for a P position loop
-  around a PI speed loop (:class:`benchmarks.field_sim.SpeedLoop` with
+  around a PI speed loop (:class:`benchmarks.simulators.field_sim.SpeedLoop` with
   ``position_gain``).
 """
 

@@ -1,6 +1,6 @@
 """Whole-chain rows on drives the project never tuned on (part of the accuracy benchmark).
 
-Logs come from :mod:`benchmarks.field_sim`, a drive simulator written apart from the
+Logs come from :mod:`benchmarks.simulators.field_sim`, a drive simulator written apart from the
 project's plant; the chains are not the project's. Per row: a drive, an excitation and
 what the user gives (k_t, J_m, the encoder's counts; the friction or not; a load torque
 modelled or not); ``masses="auto"`` every time. Per seed (the seed changes the current
@@ -30,11 +30,11 @@ import numpy as np
 
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain.defaults import G_DIST
-from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
-from arcosim.identification.drive import identify_drive
+from arcosim.identification.drive_identification import identify_drive
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.whole_chain import split
-from benchmarks import field_sim
+from arcosim.identification.fit.whole_chain import split
+from arcosim.identification.modes.chain_modes import chain_from_modes, driving_point_modes
+from benchmarks.simulators import field_sim
 
 #: The motor of most rows: the paper bench's EC motor class (kg·m², N·m/A, N·m·s/rad, N·m).
 J_M, K_T, D_M, F_C = 2.09e-5, 0.0406, 2e-5, 2e-3

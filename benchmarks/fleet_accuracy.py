@@ -1,7 +1,7 @@
 """``arcosim bench fleet``: the fleet's drift alarms on simulated fleets, and what a
 fleet costs per log on Dask.
 
-Each fleet is :mod:`benchmarks.fleet_sample`'s monitoring fleet (8 axes x 3 dates,
+Each fleet is :mod:`benchmarks.simulators.fleet_sample`'s monitoring fleet (8 axes x 3 dates,
 chains of n = 2 and 3, stick-slip friction on two axes, a corrupt log; k[1] 6 % then
 12 % lower on ``k-drop``, the fitted Coulomb friction f_c 50 % then 100 % higher on
 ``friction-rise``), its noise drawn from the fleet's seed. It is identified with
@@ -37,7 +37,7 @@ from arcosim.errors import UserError
 from arcosim.experiments.report import markdown_table
 from arcosim.fleet.drift import DriftReport
 from arcosim.fleet.store import read_store, write_store
-from benchmarks.fleet_sample import MONITORING, write_monitoring_fleet
+from benchmarks.simulators.fleet_sample import MONITORING, write_monitoring_fleet
 
 #: Logs of the paper estimate, and its cores.
 PAPER_LOGS, PAPER_CORES = 10_000, 64

@@ -1,6 +1,6 @@
 """A link we did not write: Quanser's Rotary Flexible Link on its SRV02 servo (high gear),
 from the parameters Quanser publishes, simulated by the link plant FMU and, apart from
-it, by the continuous beam's own modes (``benchmarks/modal_link.py``), and identified
+it, by the continuous beam's own modes (``benchmarks/simulators/modal_link.py``), and identified
 from the hub alone.
 
 Published (Quanser's courseware for the rig: ``config_flexgage_exp.m`` of the Rotary
@@ -52,7 +52,7 @@ from arcosim.experiments.flexible_link import (
     simulate_link,
 )
 from arcosim.experiments.report import markdown_table
-from benchmarks.modal_link import simulate_modal_link
+from benchmarks.simulators.modal_link import simulate_modal_link
 
 INCH = 0.0254
 #: The link (config_flexgage_exp.m): length (m), mass (kg), measured frequency (rad/s).

@@ -1,6 +1,6 @@
 """Write ``examples/data/belt_drive.csv``: the sample drive log the examples identify.
 
-A belt drive the project was never tuned on, simulated by :mod:`benchmarks.field_sim`
+A belt drive the project was never tuned on, simulated by :mod:`benchmarks.simulators.field_sim`
 (written apart from the plant): the paper bench's motor (J_m 2.09e-5 kg·m²,
 k_t 0.0406 N·m/A, friction D_m 2e-5 N·m·s/rad and f_c 2e-3 N·m) turning a pulley of
 3e-4 kg·m² and, through a belt, a load of 9e-4 kg·m² (springs 0.45 and 0.3 N·m/rad,
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.identification.excitation_design import design_excitation
-from benchmarks import field_sim
+from arcosim.identification.excitation.design import design_excitation
+from benchmarks.simulators import field_sim
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The sample log: package data (``arcosim example``), linked from ``examples/data/``.

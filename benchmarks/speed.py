@@ -12,7 +12,7 @@ Every figure is the median over R runs (spread: min–max) on this machine:
   in its row, is included in every row);
 * the observer's algorithms stepped in plain Python (no FMI), over the same signals;
 * the whole loop for n = 1, 3, 10, 20 masses and for 1, 10, 100 s records;
-* output-error identification (:mod:`arcosim.identification.uniform_fit`) of a 10 s
+* output-error identification (:mod:`arcosim.identification.fit.uniform_fit`) of a 10 s
   bench record, and whole-chain identification of the field drives
   (:mod:`benchmarks.field_accuracy`).
 

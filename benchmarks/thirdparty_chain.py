@@ -1,7 +1,7 @@
 """Identification and sensorless motion control on a plant we did not write.
 
 The plant: a motor and two load masses, each an instance of Dymola's ``edrive_mass.fmu``
-(:mod:`benchmarks.thirdparty_plant`), joined by our springs and dampers, driven by our
+(:mod:`benchmarks.simulators.thirdparty_plant`), joined by our springs and dampers, driven by our
 actuator (k_t·i) and read by our sensors (2000-count encoder, 5 mA current noise). The
 chain is :mod:`benchmarks.control_accuracy`'s first (J = 5e-4, 1.5e-3 kg·m², k = 0.3,
 0.15 N·m/rad, B = 1e-5 N·m·s/rad; lowest mode 19.7 rad/s, damped at about 0.1 %), the
@@ -19,7 +19,7 @@ motor the bench's (J_m, k_t, D_m = 2e-5 N·m·s/rad, no Coulomb friction).
    sensorless controller (``MotionController``) and its full-state upper bound, designed
    on the identified chain, on it with every J_i, k_i scaled by uniform factors in
    [0.9, 1.1] (seeded with the seed) and, on the first seed, the two corners. Scored by
-   :func:`arcosim.experiments.motion_findings.score_move` and ``done_when`` (the controller's four
+   :func:`arcosim.experiments.motion.findings.score_move` and ``done_when`` (the controller's four
    criteria), as :mod:`benchmarks.control_accuracy` does.
 
 The FMU is not in the repository: ``--fmus DIR`` names the folder that holds
@@ -44,23 +44,23 @@ import numpy as np
 from arcosim.build.builder import ensure_built
 from arcosim.errors import UserError
 from arcosim.experiments.closed_loop import LoopRun, OpenLoop, run_closed_loop
-from arcosim.experiments.motion_baselines import CascadeController, cascade_gains, chain_modes
-from arcosim.experiments.motion_experiment import (
+from arcosim.experiments.motion.baselines import CascadeController, cascade_gains, chain_modes
+from arcosim.experiments.motion.experiment import (
     MotionChain,
     design_parameters,
     model_errors,
     scaled,
     sensorless,
 )
-from arcosim.experiments.motion_findings import DISTANCE, DURATION, I_MAX, MOVE_TIME, done_when
+from arcosim.experiments.motion.findings import DISTANCE, DURATION, I_MAX, MOVE_TIME, done_when
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import IDENTIFICATION_DURATION, identification_current
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR, I_NOISE_STD, STEP
-from arcosim.identification.drive import DriveIdentification, identify_drive
+from arcosim.identification.drive_identification import DriveIdentification, identify_drive
 from arcosim.logs import write_csv
 from benchmarks import control_accuracy, progress
-from benchmarks.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
+from benchmarks.simulators.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
 
 #: The chain: control_accuracy's first (lowest mode 19.7 rad/s).
 _OURS = control_accuracy.CHAINS[0]

@@ -1,4 +1,4 @@
-"""One-off: why :mod:`benchmarks.thirdparty_plant` couples through model exchange.
+"""One-off: why :mod:`benchmarks.simulators.thirdparty_plant` couples through model exchange.
 
 The same chain as :mod:`benchmarks.thirdparty_chain` (motor and two load masses, each a
 co-simulation instance of Dymola's ``edrive_mass.fmu``), coupled explicitly the usual
@@ -26,7 +26,7 @@ from arcosim.experiments.closed_loop import OpenLoop, run_closed_loop
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.defaults import STEP
 from benchmarks import thirdparty_chain as chain
-from benchmarks.thirdparty_plant import FMU_FILE, where
+from benchmarks.simulators.thirdparty_plant import FMU_FILE, where
 
 
 def explicit(folder: Path, substeps: int, duration: float = chain.FREE_RUN) -> np.ndarray:

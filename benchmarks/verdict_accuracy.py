@@ -1,7 +1,7 @@
 """``arcosim bench verdict``: the whole-chain fit's verdict on logs with and without the
 mistakes users make, over seeds.
 
-Every log comes from the independent simulator (:mod:`benchmarks.field_sim`, written
+Every log comes from the independent simulator (:mod:`benchmarks.simulators.field_sim`, written
 apart from the plant FMU): a motor with Coulomb friction that sticks drives a chain,
 a current sensor with 5 mA of noise, a 2000-count encoder, 1 ms, the ``identification``
 scenario's 40 lines (3–150 rad/s, 3 A, 20 s; the seed draws the phases and the
@@ -42,7 +42,7 @@ from arcosim.errors import ArcosimError, UserError
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import IDENTIFICATION_LINES
 from arcosim.fmu.flexchain import defaults
-from benchmarks import field_sim
+from benchmarks.simulators import field_sim
 
 K_T, J_M, CPR = defaults.K_T, defaults.J_M, 2000
 TWO = ((4e-4, 8e-4), (0.3, 0.2), (2e-5, 1.5e-5))

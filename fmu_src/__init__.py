@@ -12,6 +12,8 @@ Subpackages, in the order data flows:
 - :mod:`~arcosim.fmu.arsource`: the excitation source FMU class (the current command);
 - :mod:`~arcosim.fmu.arobserver`: the observer FMU class (from the plant's measured
   current and encoder to the estimates);
+- :mod:`~arcosim.fmu.arcontroller`: the controller FMU class (from the motor's current
+  and encoder to the current command that moves the last mass);
 - :mod:`~arcosim.fmu.pythonfmu`: in the source tree only, a stand-in for the pythonfmu
   runtime each FMU bundles.
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.motion_control import MotionController, design_controller
+from arcosim.fmu.flexchain.control.controller import MotionController, design_controller
 from arcosim.fmu.flexchain.noise import quantize
 from arcosim.plant.motorchain.physics import PlantPhysics
 

@@ -1,9 +1,9 @@
-"""Identify the independent simulator's logs (:mod:`benchmarks.field_sim`) from tests."""
+"""Identify the independent simulator's logs (:mod:`benchmarks.simulators.field_sim`) from tests."""
 
 from __future__ import annotations
 
-from arcosim.identification.drive import DriveIdentification, identify_drive
-from benchmarks import field_sim
+from arcosim.identification.drive_identification import DriveIdentification, identify_drive
+from benchmarks.simulators import field_sim
 
 
 def identify_log(
@@ -13,7 +13,8 @@ def identify_log(
     J_m: float | None = None,
     **kw: object,
 ) -> DriveIdentification:
-    """:func:`~arcosim.identification.drive.identify_drive` on ``log`` of drive ``d``:
+    """:func:`~arcosim.identification.drive_identification.identify_drive` on ``log`` of drive
+    ``d``:
     its k_t and encoder counts given, J_m the drive's unless ``J_m`` (kg·m²) is, the
     friction D_m, f_c given when ``friction_given``; ``kw`` passed on (``masses``,
     ``load``, …)."""

@@ -3,8 +3,8 @@ fixed, its controller without d̂ feeds no load torque back, its counts are the 
 
 from __future__ import annotations
 
-from arcosim.experiments.motion_experiment import sensorless
-from arcosim.experiments.motion_findings import UPPER_BOUND_FACTOR
+from arcosim.experiments.motion.experiment import sensorless
+from arcosim.experiments.motion.findings import UPPER_BOUND_FACTOR
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.noise import quantize
 from arcosim.plant.motorchain.physics import PlantPhysics

@@ -1,5 +1,5 @@
 """A flexible link identified from the hub alone: simulated 20 s multi-sine logs (current
-noise, encoder counts, Coulomb friction with sticking; benchmarks.field_sim with the
+noise, encoder counts, Coulomb friction with sticking; benchmarks.simulators.field_sim with the
 link's modes), EI, ρA and the first two clamped modes recovered, the tip angle
 estimated; and ``arcosim identify --method beam`` end to end.
 
@@ -16,11 +16,11 @@ import pytest
 
 from arcosim.chainfile import read_chain
 from arcosim.cli import main
-from arcosim.identification.beam_fit import fit_link, fit_modes, modal_of
-from arcosim.identification.beam_model import modal_model
-from arcosim.identification.beam_motion import link_assumptions, stiffening_warning, tip_motion
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.records import encoder_record, motor_record
+from arcosim.identification.link.beam_fit import fit_link, fit_modes, modal_of
+from arcosim.identification.link.beam_model import modal_model
+from arcosim.identification.link.beam_motion import link_assumptions, stiffening_warning, tip_motion
+from arcosim.identification.records.record import encoder_record, motor_record
 from arcosim.logs import units_path, write_csv
 from benchmarks import beam_accuracy as bench
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from scipy import optimize
 
-from arcosim.identification.beam_model import Link, assemble, modal_model
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.kalman import Drive
+from arcosim.identification.fit.kalman import Drive
+from arcosim.identification.link.beam_model import Link, assemble, modal_model
 
 #: βL of the clamped-free Euler–Bernoulli beam, first four modes (Blevins, table 8-1).
 CLAMPED_FREE = (1.8751040687, 4.6940911330, 7.8547574382, 10.9955407349)

@@ -1,5 +1,5 @@
 """``check`` and ``identify`` share one set of decisions
-(:func:`arcosim.identification.log_decision.decide_log`): on one seed of every log type
+(:func:`arcosim.identification.checks.log_decision.decide_log`): on one seed of every log type
 — the README's sample, an off-grid multi-sine, a square-wave position reference in a
 position loop, a PRBS (the log generators of ``benchmarks/excitation_accuracy.py``), a
 3 s record, the time in ms, the current in A read with ``--scale i_a=0.001`` — ``check``

@@ -12,7 +12,7 @@ from fmpy.validation import validate_fmu
 
 from arcosim.errors import UserError
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.motion_control import MotionController, design_controller
+from arcosim.fmu.flexchain.control.controller import MotionController, design_controller
 from arcosim.host.control_loop import control_loop
 from arcosim.host.instance import FmuInstance
 from tests.control_runs import BENCH_3, observer_params

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from arcosim.fmu.flexchain.encoder_edge import CrossedEdge
+from arcosim.fmu.flexchain.control.encoder_edge import CrossedEdge
 
 COUNT = 2 * math.pi / 2000  # one count of a 2000-count encoder (rad)
 H = 1e-3

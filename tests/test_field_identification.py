@@ -1,5 +1,5 @@
 """Whole-chain identification on logs of the independent drive simulator
-(benchmarks/field_sim.py): chains, rates, friction, closed loops and loads the project's
+(benchmarks/simulators/field_sim.py): chains, rates, friction, closed loops and loads the project's
 plant never made; and the simulator itself, against the project's plant."""
 
 from __future__ import annotations
@@ -10,16 +10,16 @@ import scipy.linalg
 
 from arcosim.fmu.flexchain import defaults, waveforms
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
-from arcosim.identification.drive import identify_drive
+from arcosim.identification.checks.log_check import check_log
+from arcosim.identification.drive_identification import identify_drive
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.excitation_design import ExcitationError, design_excitation
-from arcosim.identification.kalman import Drive, discrete_drive, filter_riccati
-from arcosim.identification.log_check import check_log
-from arcosim.identification.modal_recursion import linear_recursion, output_recursion
-from arcosim.identification.records import encoder_record, mean_sign
-from arcosim.identification.whole_chain import split
-from benchmarks import field_sim
+from arcosim.identification.excitation.design import ExcitationError, design_excitation
+from arcosim.identification.fit.kalman import Drive, discrete_drive, filter_riccati
+from arcosim.identification.fit.modal_recursion import linear_recursion, output_recursion
+from arcosim.identification.fit.whole_chain import split
+from arcosim.identification.modes.chain_modes import chain_from_modes, driving_point_modes
+from arcosim.identification.records.record import encoder_record, mean_sign
+from benchmarks.simulators import field_sim
 from tests.field_runs import identify_log
 
 LINES = np.geomspace(3.0, 150.0, 40)
@@ -232,9 +232,9 @@ def test_identify_drive_reads_the_modes_once(monkeypatch) -> None:
     the one the fit starts from, not made again: the same chain, one reading."""
     from threadpoolctl import threadpool_info
 
-    import arcosim.identification.drive as drive_module
-    import arcosim.identification.log_decision as log_decision
-    import arcosim.identification.whole_chain as whole_chain
+    import arcosim.identification.checks.log_decision as log_decision
+    import arcosim.identification.drive_identification as drive_module
+    import arcosim.identification.fit.whole_chain as whole_chain
 
     d = drive()
     log = field_sim.simulate(d, 1e-3, 10.0, current=field_sim.multisine(LINES, 3.0))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arcosim.identification.plausibility import LEAST_MODE_PERIODS, mode_record_length
+from arcosim.identification.checks.plausibility import LEAST_MODE_PERIODS, mode_record_length
 
 
 def test_the_record_s_length_against_its_lowest_mode() -> None:

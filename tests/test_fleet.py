@@ -3,7 +3,7 @@
 The rule's tests use hand-made rows (fast): an alarm needs both the relative threshold
 and 3 standard errors of the difference; an untrusted fit is never the baseline; a
 different n is a structure alarm. The end-to-end test identifies a tiny fleet simulated
-by the independent simulator (:mod:`benchmarks.fleet_sample`) on a one-worker cluster;
+by the independent simulator (:mod:`benchmarks.simulators.fleet_sample`) on a one-worker cluster;
 another identifies it on a scheduler and two workers started apart (``dask scheduler``,
 ``dask worker``), as a user's own cluster, and finds the local cluster's store.
 """
@@ -178,7 +178,7 @@ def test_the_fleet_benchmark_scores_alarms_by_axis_parameter_and_sign() -> None:
 def test_a_simulated_fleet_alarms_on_the_changed_spring_only(tmp_path: Path) -> None:
     from dask.distributed import LocalCluster
 
-    from benchmarks.fleet_sample import write_fleet, write_log
+    from benchmarks.simulators.fleet_sample import write_fleet, write_log
 
     fleet, out = tmp_path / "fleet", tmp_path / "out"
     write_fleet(fleet, axes=2, seconds=7.0)  # a1: k[1] -12 % on 2026-02-05; a2: a corrupt log
@@ -315,7 +315,7 @@ def _same_stores(one: list[dict], other: list[dict]) -> None:
 def test_a_scheduler_started_apart_gives_the_store_of_a_local_cluster(tmp_path: Path) -> None:
     from dask.distributed import Client
 
-    from benchmarks.fleet_sample import write_fleet
+    from benchmarks.simulators.fleet_sample import write_fleet
 
     fleet = tmp_path / "fleet"
     write_fleet(fleet, axes=2, seconds=5.0)  # 2 axes x 2 dates, and a corrupt log on a2

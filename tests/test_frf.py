@@ -1,5 +1,6 @@
-"""The measured frequency response (arcosim.identification.frf) and the spectral front end
-(arcosim.identification.spectrum), on logs of benchmarks.field_sim (written apart from the
+"""The measured frequency response (arcosim.identification.checks.frf) and the spectral front end
+(arcosim.identification.excitation.spectrum), on logs of benchmarks.simulators.field_sim (written
+apart from the
 plant) and on synthetic signals: each estimator against the chain's exact response."""
 
 from __future__ import annotations
@@ -7,9 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arcosim.identification.frf import measured_response, model_response
-from arcosim.identification.spectrum import excitation_spectrum, harmonic_fundamental
-from benchmarks import excitations, field_sim
+from arcosim.identification.checks.frf import measured_response, model_response
+from arcosim.identification.excitation.spectrum import excitation_spectrum, harmonic_fundamental
+from benchmarks import excitations
+from benchmarks.simulators import field_sim
 
 J_M, K_T = 2.09e-5, 0.0406
 CHAIN = dict(J=(3e-4,), k=(0.45,), B=(2e-5,))

@@ -1,5 +1,5 @@
 """The hold's dither: its current and path, the motor's angle below a count, the design's
-refusals and the controller's use of it (``arcosim.fmu.flexchain.hold_dither``)."""
+refusals and the controller's use of it (``arcosim.fmu.flexchain.control.hold_dither``)."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from arcosim.fmu.flexchain.control_design import design_controller
-from arcosim.fmu.flexchain.hold_dither import HoldDither
-from arcosim.fmu.flexchain.motion_control import MotionController
+from arcosim.fmu.flexchain.control.controller import MotionController
+from arcosim.fmu.flexchain.control.design import design_controller
+from arcosim.fmu.flexchain.control.hold_dither import HoldDither
 from tests.control_runs import BENCH_2, observer_params
 
 H = 1e-3

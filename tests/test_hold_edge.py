@@ -12,8 +12,9 @@ import math
 
 import pytest
 
-from arcosim.fmu.flexchain import defaults, hold_edge
-from arcosim.fmu.flexchain.hold_edge import HoldEdge
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.control import hold_edge
+from arcosim.fmu.flexchain.control.hold_edge import HoldEdge
 
 Q = 2 * math.pi / 2000  # one count (rad)
 

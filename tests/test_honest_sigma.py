@@ -9,13 +9,13 @@ import numpy as np
 from scipy.signal import lfilter
 from threadpoolctl import threadpool_limits
 
-from arcosim.identification.newey_west import (
+from arcosim.identification.fit.newey_west import (
     decorrelation_lag,
     newey_west_covariance,
     significance_lag,
 )
-from arcosim.identification.output_error import ParameterFit
-from arcosim.identification.structure_choice import carry_over, with_form_shift
+from arcosim.identification.fit.output_error import ParameterFit
+from arcosim.identification.fit.structure_choice import carry_over, with_form_shift
 
 
 def _regression(seed: int) -> tuple[np.ndarray, np.ndarray, float]:

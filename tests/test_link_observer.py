@@ -20,7 +20,12 @@ from arcosim.fmu.flexchain.driven_chain import continuous_matrices
 from arcosim.fmu.flexchain.link_observer import StarLink
 from arcosim.fmu.flexchain.observer import Observer, ObserverSettings
 from arcosim.host.instance import FmuInstance
-from arcosim.identification.beam_model import Link, ModalModel, modal_model, observer_parameters
+from arcosim.identification.link.beam_model import (
+    Link,
+    ModalModel,
+    modal_model,
+    observer_parameters,
+)
 from arcosim.logs import write_csv
 
 #: Scores skip the first second (the observer's start from rest, the excitation's).

@@ -1,15 +1,15 @@
 """The load torque chosen on the final fit: with ``--load`` not given the
 selection rule takes none, constant or slow, the chain is refitted with the load it
 takes and the report says so; a load the user gives is never overridden. The
-independent simulator (:mod:`benchmarks.field_sim`) writes the log."""
+independent simulator (:mod:`benchmarks.simulators.field_sim`) writes the log."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from arcosim.identification.output_error import ParameterFit
-from arcosim.identification.structure_choice import LOAD_MARGIN, choose, load_candidate
+from arcosim.identification.fit.output_error import ParameterFit
+from arcosim.identification.fit.structure_choice import LOAD_MARGIN, choose, load_candidate
 from benchmarks.field_accuracy import ROWS
 from tests.field_runs import identify_log
 

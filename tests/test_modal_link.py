@@ -1,4 +1,4 @@
-"""The link simulated apart from the plant FMU (benchmarks/modal_link.py): the continuous
+"""The link simulated apart from the plant FMU (benchmarks/simulators/modal_link.py): the continuous
 beam's modes on a free hub, against the boundary-value problem, the finite-element plant
 and, identified from the hub, against Quanser's published link (a link we did not
 write)."""
@@ -12,8 +12,8 @@ import pytest
 
 from arcosim.experiments.flexible_link import identify_link, simulate_link
 from benchmarks.link_frequencies import beam_frequencies
-from benchmarks.modal_link import link_modes, simulate_modal_link
 from benchmarks.published_link import RIG
+from benchmarks.simulators.modal_link import link_modes, simulate_modal_link
 
 
 def test_the_modes_are_the_continuous_beams_and_orthonormal() -> None:

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from arcosim.experiments.closed_loop import LoadStep, OpenLoop, run_closed_loop
-from arcosim.experiments.motion_baselines import (
+from arcosim.experiments.motion.baselines import (
     CascadeController,
     Shaper,
     cascade_gains,
@@ -22,14 +22,14 @@ from arcosim.experiments.motion_baselines import (
     chain_modes,
     smooth_profile,
 )
-from arcosim.experiments.motion_findings import (
+from arcosim.experiments.motion.findings import (
     CONTROLLERS,
     ChainFindings,
     MoveScore,
     done_when,
     move_rows,
 )
-from arcosim.experiments.motion_metrics import (
+from arcosim.experiments.motion.metrics import (
     limit_cycle_counts,
     residual_rms,
     settling_time,
@@ -254,8 +254,8 @@ def test_experiment_on_the_bench_has_the_four_rows(fmus) -> None:
     """The experiment's four runs on the bench (designed on the true chain): four rows, the
     cascade ringing (the bench's modes are damped at 0.1 %: never within ±1 %), shaping on
     the cascade's modes cutting the residual at least threefold."""
-    from arcosim.experiments.motion_experiment import CHAINS, Runs
-    from arcosim.experiments.motion_findings import DISTANCE, score_move
+    from arcosim.experiments.motion.experiment import CHAINS, Runs
+    from arcosim.experiments.motion.findings import DISTANCE, score_move
 
     params = {**BENCH, "f_c": defaults.F_C, "encoder_cpr": 2000, "g_dist": defaults.G_DIST}
     runs = Runs(fmus, CHAINS[0], False).four(params)
@@ -271,8 +271,8 @@ def test_experiment_on_the_bench_has_the_four_rows(fmus) -> None:
 def test_runs_give_the_plant_the_encoder_asked_for(fmus) -> None:
     """``Runs(..., encoder_cpr=N)`` puts an encoder of N counts on the plant (every reading
     a whole count of 2π/N), not the bench's 2000 (a 0.1 A push: the motor turns)."""
-    from arcosim.experiments.motion_experiment import CHAINS, Runs
-    from arcosim.experiments.motion_findings import DURATION
+    from arcosim.experiments.motion.experiment import CHAINS, Runs
+    from arcosim.experiments.motion.findings import DURATION
 
     push = OpenLoop(np.full(round(DURATION / defaults.STEP), 0.1))
     run = Runs(fmus, CHAINS[0], False, encoder_cpr=20000).run(push)

@@ -14,7 +14,8 @@ import pytest
 import scipy.linalg
 
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.control_design import (
+from arcosim.fmu.flexchain.control.controller import shaped_step
+from arcosim.fmu.flexchain.control.design import (
     DECAY_RATIO,
     design_controller,
     goals,
@@ -22,7 +23,6 @@ from arcosim.fmu.flexchain.control_design import (
     plant_matrices,
     regulator_gain,
 )
-from arcosim.fmu.flexchain.motion_control import shaped_step
 from arcosim.fmu.flexchain.riccati import solve_doubling
 from benchmarks.control_accuracy import CHAINS
 from tests.control_runs import ACTUATOR, BENCH_2, FIVE, closed_loop, observer_params

@@ -8,11 +8,11 @@ import math
 import pytest
 
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.estimator_bank import EstimatorBank
+from arcosim.fmu.flexchain.control.controller import shaped_step
+from arcosim.fmu.flexchain.control.estimator_bank import EstimatorBank
+from arcosim.fmu.flexchain.control.move_fit import MoveRecord, Sample, fit_chain
 from arcosim.fmu.flexchain.load_observer import LoadTorqueObserver
 from arcosim.fmu.flexchain.model_observer import NoiseModel
-from arcosim.fmu.flexchain.motion_control import shaped_step
-from arcosim.fmu.flexchain.move_fit import MoveRecord, Sample, fit_chain
 from tests.control_runs import closed_loop
 
 H = 1e-3

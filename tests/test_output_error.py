@@ -1,4 +1,5 @@
-"""Output-error identification (cosim/identification/output_error.py, uniform_fit.py), its CLI, and
+"""Output-error identification (cosim/identification/fit/output_error.py, uniform_fit.py), its
+CLI, and
 the accuracy benchmark in quick mode."""
 
 from __future__ import annotations
@@ -14,9 +15,9 @@ from arcosim.cli import main
 from arcosim.experiments.scenarios import SCENARIOS, run_scenario
 from arcosim.fmu.flexchain import defaults
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.output_error import predict
-from arcosim.identification.records import MotorRecord, constant_step, motor_record
-from arcosim.identification.uniform_fit import uniform_chain
+from arcosim.identification.fit.output_error import predict
+from arcosim.identification.fit.uniform_fit import uniform_chain
+from arcosim.identification.records.record import MotorRecord, constant_step, motor_record
 from benchmarks.accuracy import ACTUATOR
 
 H = 1e-3

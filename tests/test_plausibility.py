@@ -11,17 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from arcosim.identification.drive import identify_drive
-from arcosim.identification.errors import IdentificationError
-from arcosim.identification.log_check import check_log, log_plausibility
-from arcosim.identification.noise_floor import FLOOR_FACTOR, current_noise, floor_warning
-from arcosim.identification.plausibility import (
+from arcosim.identification.checks.log_check import check_log, log_plausibility
+from arcosim.identification.checks.noise_floor import FLOOR_FACTOR, current_noise, floor_warning
+from arcosim.identification.checks.plausibility import (
     INERTIA_HIGH,
     balance_inertia,
     record_length,
     step_against_motion,
     torque_balance,
 )
+from arcosim.identification.drive_identification import identify_drive
+from arcosim.identification.errors import IdentificationError
 from arcosim.logs import read_log
 
 SAMPLE = Path(__file__).parents[1] / "examples" / "data" / "belt_drive.csv"
@@ -134,7 +134,8 @@ def test_check_warnings_are_among_identify_warnings(rows, scales) -> None:
     ],
 )
 def test_the_independent_simulator_s_logs(name) -> None:
-    """On logs of benchmarks.field_sim (written apart from the plant; 10 s): nothing on the
+    """On logs of benchmarks.simulators.field_sim (written apart from the plant; 10 s): nothing on
+    the
     log as simulated; time in ms names the time column, the current 1000 × low its scale."""
     from benchmarks import field_accuracy
 

@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 
 from arcosim.fmu.flexchain import waveforms
-from arcosim.identification.band import BAND_PER_G, SAMPLE_BAND, search_band
-from arcosim.identification.excitation_design import LINE_T, design_excitation
+from arcosim.identification.excitation.band import BAND_PER_G, SAMPLE_BAND, search_band
+from arcosim.identification.excitation.design import LINE_T, design_excitation
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Folders whose Python sources are searched.
 SOURCES = ("cosim", "fmu_src", "plant_models", "benchmarks")
-BAND = ROOT / "cosim" / "identification" / "band.py"
+BAND = ROOT / "cosim" / "identification" / "excitation" / "band.py"
 
 
 def trees() -> dict[Path, ast.Module]:
@@ -75,7 +75,7 @@ def band_arithmetic(node: ast.AST) -> bool:
 
 def test_the_line_threshold_has_one_home() -> None:
     assert LINE_T == 5.0
-    assert definitions("LINE_T") == ["cosim/identification/excitation_design.py"]
+    assert definitions("LINE_T") == ["cosim/identification/excitation/design.py"]
 
 
 def test_the_search_band_has_one_home() -> None:
@@ -83,7 +83,7 @@ def test_the_search_band_has_one_home() -> None:
     assert search_band(50.0, 1e-3) == 150.0  # the DOB's limit
     assert search_band(200.0, 1e-3) == 300.0  # the sample rate's
     for name in ("BAND_PER_G", "SAMPLE_BAND"):
-        assert definitions(name) == ["cosim/identification/band.py"]
+        assert definitions(name) == ["cosim/identification/excitation/band.py"]
 
 
 def test_the_band_is_computed_only_in_its_home() -> None:

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arcosim.identification.spectrum import excitation_spectrum
-from benchmarks import field_sim
+from arcosim.identification.excitation.spectrum import excitation_spectrum
+from benchmarks.simulators import field_sim
 
 LINES = np.geomspace(3.0, 150.0, 40)  # the README's multi-sine: 40 lines 3–150 rad/s
 T = np.arange(20001) * 1e-3  # 20 s at 1 kHz

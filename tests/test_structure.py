@@ -1,7 +1,7 @@
 """Structure chosen by evidence: the rigid drive (n = 0), the selection rule on
 the final fit, parameters at a bound, and decisions that do not flip when the user
 restates a value the tool fitted. The independent simulator
-(:mod:`benchmarks.field_sim`) writes every log."""
+(:mod:`benchmarks.simulators.field_sim`) writes every log."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from arcosim.fmu.flexchain import defaults
-from arcosim.identification.drive import identify_drive
+from arcosim.identification.drive_identification import identify_drive
 from arcosim.identification.errors import IdentificationError
-from benchmarks import field_sim
+from benchmarks.simulators import field_sim
 from tests.field_runs import identify_log
 
 LINES = np.geomspace(3.0, 150.0, 40)

@@ -2,7 +2,8 @@
 project's exact plant FMU.
 
 The FMU is not in the repository: name the folder that holds it with
-``ARCOSIM_THIRDPARTY_FMUS`` (where to get it: :data:`benchmarks.thirdparty_plant.SOURCE`);
+``ARCOSIM_THIRDPARTY_FMUS`` (where to get it:
+:data:`benchmarks.simulators.thirdparty_plant.SOURCE`);
 without it the test is deselected (marker ``data``) and the run's summary says so; a
 folder without the file skips, naming where to get it.
 
@@ -24,7 +25,7 @@ import numpy as np
 import pytest
 
 from benchmarks import thirdparty_chain
-from benchmarks.thirdparty_plant import ENV, FMU_FILE, where
+from benchmarks.simulators.thirdparty_plant import ENV, FMU_FILE, where
 
 
 @pytest.fixture(scope="module")

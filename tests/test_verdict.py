@@ -1,7 +1,7 @@
 """The verdict on a whole-chain fit: trusted on a clean log, untrusted with a reason that
 names what to check when the log holds something the chain cannot describe.
 
-The logs come from the independent simulator (``benchmarks/field_sim.py``), not the
+The logs come from the independent simulator (``benchmarks/simulators/field_sim.py``), not the
 plant FMU: a two-mass chain with Coulomb friction that sticks, a 2000-count encoder,
 5 mA of current noise and the ``identification`` scenario's 40 lines (3–150 rad/s, 3 A,
 20 s).
@@ -17,8 +17,7 @@ import pytest
 import arcosim
 from arcosim.cli import main
 from arcosim.experiments.scenarios import IDENTIFICATION_LINES
-from arcosim.identification.spectrum import ExcitationSpectrum
-from arcosim.identification.verdict import (
+from arcosim.identification.checks.verdict import (
     Verdict,
     excitation_above_band,
     judge,
@@ -26,7 +25,8 @@ from arcosim.identification.verdict import (
     resolved_band,
     unresolved,
 )
-from benchmarks import field_sim
+from arcosim.identification.excitation.spectrum import ExcitationSpectrum
+from benchmarks.simulators import field_sim
 
 K_T, J_M = 0.0406, 2.09e-5
 LINES = ExcitationSpectrum("lines", IDENTIFICATION_LINES, np.ones(40), (3.0, 150.0))

@@ -1,4 +1,4 @@
-"""Whole-chain identification (cosim/identification/whole_chain.py, modal_start.py,
+"""Whole-chain identification (cosim/identification/fit/whole_chain.py, modes/detection.py,
 chain_modes.py, encoder_fit.py, kalman.py): every J_i, k_i, B_i from the motor side alone."""
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ import pytest
 from arcosim.cli import main
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification import encoder_fit, kalman
-from arcosim.identification.chain_modes import chain_from_modes, driving_point_modes
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.output_error import ParameterFit, predict
-from arcosim.identification.records import EncoderRecord, MotorRecord, encoder_record
-from arcosim.identification.whole_chain import fit_chain, identify_whole_chain, names, split
+from arcosim.identification.fit import encoder_fit, kalman
+from arcosim.identification.fit.output_error import ParameterFit, predict
+from arcosim.identification.fit.whole_chain import fit_chain, identify_whole_chain, names, split
+from arcosim.identification.modes.chain_modes import chain_from_modes, driving_point_modes
+from arcosim.identification.records.record import EncoderRecord, MotorRecord, encoder_record
 
 H = 1e-3
 J = (4e-4, 8e-4)

@@ -6,6 +6,7 @@ Modules, in the order data flows:
 recipes    -- what is built: one ``FmuRecipe`` per FMU, the numbers of masses supported
 cache      -- where FMUs go (per-user cache or a folder), their source digest and lock
 cplant     -- the plant FMU compiled from C (``plant_models/motorchain_c/``)
+clink      -- the flexible-link plant FMU compiled from C (``plant_models/flexlink_c/``)
 exit_fix   -- pythonfmu 0.7's exit-time use-after-free removed from its Linux binary
 portable   -- pythonfmu's FMU rewritten to run anywhere: one bundle, the C trampoline
 ssp        -- the SSP system source → plant → observer (``ActionReaction.ssp``)

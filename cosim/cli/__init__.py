@@ -10,12 +10,7 @@ build                  -- ``arcosim build``: the FMUs and their SSP into a folde
 simulate               -- ``arcosim simulate``: one scenario, any parameter overridden
 excite                 -- ``arcosim excite``: the excitation to play for identification
 check                  -- ``arcosim check``: can a log support identification?
-identify               -- ``arcosim identify``: its parser, and the method chosen
-identify_options       -- the options every method shares: ``--masses``, ``--out``, the report
-identify_observer      -- ``--method observer``: the observer FMU replayed over the log
-identify_output_error  -- ``--method output-error``: the uniform chain's k and B
-identify_whole_chain   -- ``--method whole-chain``: every J_i, k_i, B_i and n
-identify_load_torque   -- ``--method load-torque``: the torque on a load mass over time
+identify/              -- ``arcosim identify``: one module per method (its package lists them)
 control                -- ``arcosim control``: the motion controller for a chain, its margins
 example                -- ``arcosim example``: the sample log and its script into a folder
 reproduce              -- ``arcosim reproduce``: the paper's experiments and the report
@@ -58,13 +53,13 @@ from arcosim.cli import (
     example,
     excite,
     fleet,
-    identify,
     reproduce,
     simulate,
     ssp,
     sweep,
     validate,
 )
+from arcosim.cli.identify import command as identify
 from arcosim.errors import ArcosimError
 from arcosim.version import __version__
 

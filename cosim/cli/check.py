@@ -1,7 +1,7 @@
 """``arcosim check LOG.csv``: can this log support whole-chain identification?
 
 Before any fit, the decisions ``arcosim identify --method whole-chain`` acts on
-(:func:`arcosim.identification.log_decision.decide_log`): exit status 0 exactly when
+(:func:`arcosim.identification.checks.log_decision.decide_log`): exit status 0 exactly when
 identify fits, 1 when it would refuse (the reasons printed), 2 for a bad input; every
 warning printed is one identify gives too. With the figures behind them: the step, the
 motion, the excitation (a multi-sine's lines, a periodic reference's harmonics or a
@@ -17,10 +17,10 @@ from __future__ import annotations
 import argparse
 import json
 
-from arcosim.cli.identify_options import EXIT_UNTRUSTED, masses_option
+from arcosim.cli.identify.options import EXIT_UNTRUSTED, masses_option
 from arcosim.cli.options import add_command, log_options
 from arcosim.cli.parameters import defaults_note, known_parameters, set_names
-from arcosim.identification.log_check import check_log
+from arcosim.identification.checks.log_check import check_log
 from arcosim.logs import parse_scales, read_log
 
 #: The drive's figures a check needs, as observer parameter names.

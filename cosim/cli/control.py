@@ -19,7 +19,7 @@ import json
 import sys
 from collections.abc import Mapping, Sequence
 
-from arcosim.cli.identify_options import chain_assignments, chain_option, masses_option
+from arcosim.cli.identify.options import chain_assignments, chain_option, masses_option
 from arcosim.cli.options import add_command, number
 from arcosim.cli.parameters import defaults_note, drive_parameters, set_names
 from arcosim.control.margins import controller_margins

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from arcosim.cli.options import add_command, force_option, number, step_option, whole_number
 from arcosim.host.overrides import INT_MAX
-from arcosim.identification.excitation_design import DURATION, LINES, design_excitation
+from arcosim.identification.excitation.design import DURATION, LINES, design_excitation
 from arcosim.logs import write_csv
 from arcosim.outputs import check_output
 

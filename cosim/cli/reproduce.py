@@ -16,7 +16,6 @@ import time
 from pathlib import Path
 
 from arcosim.cli.options import add_command, add_fmus_option, tool_names_option
-from arcosim.experiments import motion_findings as motion
 from arcosim.experiments.findings import (
     LINK_HEADER,
     LOAD_HEADER,
@@ -32,6 +31,7 @@ from arcosim.experiments.findings import (
     whole_chain_rows,
     whole_state_rows,
 )
+from arcosim.experiments.motion import findings as motion
 from arcosim.experiments.report import text_table
 from arcosim.experiments.reproduce import reproduce
 

@@ -1,6 +1,6 @@
 """The state feedback's own loop: the true angles and velocities of every mass fed back.
 
-From a :class:`~arcosim.fmu.flexchain.control_design.ControllerDesign`: ``x ← F x + g u``
+From a :class:`~arcosim.fmu.flexchain.control.design.ControllerDesign`: ``x ← F x + g u``
 with ``u = −K x``, broken at the current for the margins (the loop gain
 ``L(z) = K (zI − F)⁻¹ g``), and the same gain on the plant a model error makes of the
 chain. The upper bound the sensorless loop is measured against.
@@ -13,7 +13,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from arcosim.fmu.flexchain.control_design import (
+from arcosim.fmu.flexchain.control.design import (
     ControllerDesign,
     hold_discretize,
     indexed_values,
@@ -88,7 +88,7 @@ def margins(design: ControllerDesign) -> dict[str, float]:
     Parameters
     ----------
     design : ControllerDesign
-        From :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
+        From :func:`~arcosim.fmu.flexchain.control.design.design_controller`.
 
     Returns
     -------
@@ -100,7 +100,7 @@ def margins(design: ControllerDesign) -> dict[str, float]:
 
     Examples
     --------
-    >>> from arcosim.fmu.flexchain.control_design import design_controller
+    >>> from arcosim.fmu.flexchain.control.design import design_controller
     >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3,
     ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
     >>> m = margins(design_controller(chain, h=1e-3))

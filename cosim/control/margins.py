@@ -20,15 +20,15 @@ import numpy as np
 from arcosim.control import full_state
 from arcosim.control.model_errors import ERROR, RANDOM_MODELS, ModelError, model_errors
 from arcosim.control.sensorless_loop import sensorless_decay
-from arcosim.fmu.flexchain import control_design
-from arcosim.fmu.flexchain.control_design import (
+from arcosim.fmu.flexchain.control import design as control_design
+from arcosim.fmu.flexchain.control.controller import REFERENCE_SHARE, shaped_step
+from arcosim.fmu.flexchain.control.design import (
     ControllerDesign,
     design_controller,
     goals,
     indexed_values,
     plant_matrices,
 )
-from arcosim.fmu.flexchain.motion_control import REFERENCE_SHARE, shaped_step
 
 #: Smaller errors tried, in turn, when the loop is not stable at the error asked for.
 SMALLER_ERRORS = (0.1, 0.05, 0.02, 0.01)
@@ -322,7 +322,7 @@ def controller_margins(
         Called once the inputs are checked, before the runs (which take seconds).
     **goals_
         ``control_mass``, ``move_time``, ``bandwidth``, ``i_max``, ``hold_dither`` for
-        :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
+        :func:`~arcosim.fmu.flexchain.control.design.design_controller`.
 
     Returns
     -------

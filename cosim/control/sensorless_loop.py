@@ -1,6 +1,6 @@
 """The sensorless loop's poles, from the controller's and the plant's own code.
 
-The controller (:class:`~arcosim.fmu.flexchain.motion_control.MotionController`, designed
+The controller (:class:`~arcosim.fmu.flexchain.control.controller.MotionController`, designed
 on a model) drives the plant (:class:`~arcosim.plant.motorchain.physics.PlantPhysics`, the
 true chain) with an exact encoder and no Coulomb friction, so that the loop is linear
 (the encoder's counts, the friction and the hold's dither, which need both, are left
@@ -23,8 +23,8 @@ import numpy as np
 
 from arcosim.control.full_state import slowest
 from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.control_design import design_controller, indexed_values
-from arcosim.fmu.flexchain.motion_control import MotionController
+from arcosim.fmu.flexchain.control.controller import MotionController
+from arcosim.fmu.flexchain.control.design import design_controller, indexed_values
 from arcosim.plant.motorchain.physics import PlantPhysics
 
 #: Attributes the linearization leaves alone: caches and settings (constant over a run)
@@ -92,7 +92,7 @@ def sensorless_loop(
 
     With ``hold`` the controller is designed with the model's encoder (``encoder_cpr``,
     default ``defaults.ENCODER_CPR``) so that its hold's dither runs at rest
-    (:mod:`~arcosim.fmu.flexchain.hold_dither`: the feedback's motor angle and velocity from
+    (:mod:`~arcosim.fmu.flexchain.control.hold_dither`: the feedback's motor angle and velocity from
     the dither's observer, as in the runs), while the plant's angle stays exact and
     friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts and
     then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain (if they
@@ -113,7 +113,7 @@ def sensorless_loop(
         Linearize at rest with the hold's dither running (above).
     **goals
         ``control_mass``, ``move_time``, ``bandwidth``, ``i_max``, ``hold_dither`` for
-        :func:`~arcosim.fmu.flexchain.control_design.design_controller`.
+        :func:`~arcosim.fmu.flexchain.control.design.design_controller`.
 
     Returns
     -------

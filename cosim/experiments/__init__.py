@@ -13,11 +13,10 @@ reproduce        -- the seven experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
 reproduce_figures -- Figs. 4–9 from the runs and what they found
 report           -- the figures drawn, and tables as Markdown or text
+control_scenarios -- the closed-loop scenarios: the controller FMU moving the plant's last mass
 closed_loop      -- the plant FMU with a Python controller in the loop (sequential, zero delay)
-motion_baselines -- a drive's cascade tuned out of the box, and input shapers (ZV, ZVD)
-motion_metrics   -- how a move is scored (settling, residual, peak current, limit cycle)
-motion_experiment -- experiment 7: a move of the last mass by four controllers, Fig. 10
-motion_findings  -- its setup, scores, the four-criteria (Done-when) check, tables and report text
+motion/          -- experiment 7: a move of the last mass by four controllers (baselines,
+                    metrics, experiment, findings)
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """

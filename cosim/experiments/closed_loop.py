@@ -4,7 +4,7 @@ At each t_k the master reads the plant's sample of t_k (measured current, veloci
 angle: the observer's timing contract), asks the controller for the current to hold
 over [t_k, t_k + h], sets it (and any external torque) and steps the plant: zero delay.
 The controller is any object with ``step(h, theta_ref, i_a, omega_m, theta_m) -> i_ref``
-(:class:`arcosim.experiments.motion_baselines.CascadeController`, the sensorless
+(:class:`arcosim.experiments.motion.baselines.CascadeController`, the sensorless
 ``MotionController``); with ``full_state=True`` the master calls its
 ``step_full_state(h, theta_ref, angles, velocities[, i_a])`` with the plant's true angles
 and velocities of the motor and every mass instead (the upper bound), and the measured

@@ -14,7 +14,7 @@ import numpy as np
 from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
 from arcosim.experiments.flexible_link import EXPERIMENT_RIG, SETTLE
 from arcosim.experiments.metrics import percent_error
-from arcosim.experiments.motion_findings import MotionResults, motion_markdown
+from arcosim.experiments.motion.findings import MotionResults, motion_markdown
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
 from arcosim.experiments.report import markdown_table
 from arcosim.experiments.scenarios import LOAD_PROFILE
@@ -67,7 +67,7 @@ class Results:
         Experiment 6: the flexible link from the hub alone
         (:meth:`arcosim.experiments.flexible_link.LinkFindings.as_dict`).
     motion : dict of str to ChainFindings
-        Experiment 7: the moves by chain (:mod:`arcosim.experiments.motion_findings`).
+        Experiment 7: the moves by chain (:mod:`arcosim.experiments.motion.findings`).
     files : list of Path
         Every file written, ``report.md`` last.
     """

@@ -7,8 +7,8 @@ model) with a current command and records what a log holds (current, encoder) wi
 plant's truth beside it (its root moment ``tau_reac``, eq. 7, and the tip angle
 ``alpha_tip``). :func:`identify_link` gives the fit only k_t, J_m, the friction, the
 encoder's counts and the link's L, m_tip, J_tip and r (what a user knows):
-:func:`arcosim.identification.beam_fit.fit_link` finds EI, ρA and the damping, and
-:func:`arcosim.identification.beam_motion.tip_motion` the tip angle and eq. 7's reaction
+:func:`arcosim.identification.link.beam_fit.fit_link` finds EI, ρA and the damping, and
+:func:`arcosim.identification.link.beam_motion.tip_motion` the tip angle and eq. 7's reaction
 torque over the record. :func:`clamped_frequencies` are the hub-locked modes of the
 continuous beam (the roots of its characteristic equation, not finite elements) the
 identified modes are scored against.
@@ -26,9 +26,9 @@ from arcosim.experiments.current_commands import multisine
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.host.instance import FmuInstance
-from arcosim.identification.beam_fit import Geometry, fit_link, modal_of
-from arcosim.identification.beam_motion import tip_motion
-from arcosim.identification.records import encoder_record, motor_record
+from arcosim.identification.link.beam_fit import Geometry, fit_link, modal_of
+from arcosim.identification.link.beam_motion import tip_motion
+from arcosim.identification.records.record import encoder_record, motor_record
 
 #: The FMU file of the flexible-link plant in an FMU folder.
 LINK_FMU = "FlexLinkPlant.fmu"

@@ -8,7 +8,7 @@
    true angle of every mass, the model-based observer of experiment 4 beside it);
 4. beyond the paper: the whole bench chain (every J_i, k_i, B_i, and n) identified
    from one identification record with only the actuator terms of experiment 1
-   known (:mod:`arcosim.identification.whole_chain`), then every mass's angle
+   known (:mod:`arcosim.identification.fit.whole_chain`), then every mass's angle
    estimated in mode 2 (model-based observer) with those parameters alone → Fig. 7;
 5. beyond the paper: a load torque on mass 3 (a step of a tenth of the drive's peak
    torque, then a 2 rad/s sine) during the broadband maneuver, estimated from the motor
@@ -21,7 +21,7 @@
 7. beyond the paper: a 1 rad move of the last mass on the bench and a five-mass chain,
    each identified by ``identify_drive``, by a drive's cascade, the cascade with input
    shaping, the sensorless controller and its full-state upper bound, a load-torque
-   step and model errors (:mod:`arcosim.experiments.motion_experiment`) → Fig. 10.
+   step and model errors (:mod:`arcosim.experiments.motion.experiment`) → Fig. 10.
 
 :func:`reproduce` writes ``report.md``, the figures and the runs as CSV into a folder.
 """
@@ -54,8 +54,8 @@ from arcosim.experiments.flexible_link import (
 )
 from arcosim.experiments.load_scores import score_profile
 from arcosim.experiments.metrics import flexible_score
-from arcosim.experiments.motion_experiment import motion_control, motion_steps
-from arcosim.experiments.motion_findings import FIGURE as MOTION_FIGURE
+from arcosim.experiments.motion.experiment import motion_control, motion_steps
+from arcosim.experiments.motion.findings import FIGURE as MOTION_FIGURE
 from arcosim.experiments.reproduce_figures import (
     link_figure,
     load_torque_figure,
@@ -74,9 +74,9 @@ from arcosim.fmu.flexchain.defaults import G_DIST, STEP
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.fmu.flexchain.observer import ObserverSettings
 from arcosim.host.master import Recording
+from arcosim.identification.fit.whole_chain import ChainChoice, identify_whole_chain
 from arcosim.identification.offline_observer import estimate_states
-from arcosim.identification.records import encoder_record, motor_record
-from arcosim.identification.whole_chain import ChainChoice, identify_whole_chain
+from arcosim.identification.records.record import encoder_record, motor_record
 from arcosim.logs import units_path, write_csv
 from arcosim.outputs import check_output_folder, refuse_existing, warn_left_over, write_text
 

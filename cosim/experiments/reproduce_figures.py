@@ -27,8 +27,8 @@ from arcosim.experiments.report import (
 from arcosim.experiments.scenarios import IDENTIFICATION_LINES, LOAD_PROFILE
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.host.master import Recording
-from arcosim.identification.chain_modes import driving_point_response
-from arcosim.identification.output_error import through_g
+from arcosim.identification.fit.output_error import through_g
+from arcosim.identification.modes.chain_modes import driving_point_response
 
 
 def paper_figures(

@@ -179,7 +179,7 @@ def identify_log(path: str, axis: str, date: str, options: Mapping[str, object])
 
 
 def _identified(path: str, options: Mapping[str, object]) -> dict[str, object]:
-    from arcosim.identification.drive import identify_drive
+    from arcosim.identification.drive_identification import identify_drive
     from arcosim.logs import read_log
 
     options = dict(options)

@@ -5,7 +5,9 @@ Modules, in the order data flows:
 
 overrides  -- ``plant.k[2]=0.2`` texts typed and checked against an FMU's variables
 instance   -- one FMU instance through fmpy's FMI 2.0 calls (``FmuInstance``), ctypes ports
+stepping   -- what every fixed-step loop over FMUs needs (the step grid, the recording)
 master     -- the fixed-step master of plant and observer (``cosimulate``, ``Recording``)
+control_loop -- a fixed-step master for the closed loop controller → plant → controller
 replay     -- a drive log fed to the observer FMU, sample by sample (``replay_log``)
 ssp        -- an SSP 1.0 system read and run by a Jacobi master (``run_ssp``)
 ecos       -- the ecos C++ engine in a separate process: the FMUs in a host not Python

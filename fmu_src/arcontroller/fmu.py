@@ -7,7 +7,7 @@ velocity and angle at t_k (the observer's timing contract, docs/method.md); afte
 sequential master steps the controller, then the plant with that command (zero delay);
 a parallel master applies it one step later, which the design tolerates with the same
 gains. The gains are computed at initialization from the chain and the goals
-(:mod:`arcosim.fmu.flexchain.control_design`); all algorithms live in
+(:mod:`arcosim.fmu.flexchain.control.design`); all algorithms live in
 :mod:`flexchain`, this class maps FMU variables to them.
 """
 
@@ -16,8 +16,8 @@ from __future__ import annotations
 from typing import ClassVar
 
 from ..flexchain import defaults
-from ..flexchain.control_design import MOVE_BANDWIDTH_PRODUCT, design_controller, goals
-from ..flexchain.motion_control import MotionController
+from ..flexchain.control.controller import MotionController
+from ..flexchain.control.design import MOVE_BANDWIDTH_PRODUCT, design_controller, goals
 from ..fmukit import FmuSlave, Variable, array, indexed, inp, out, par, range_problems
 from ..fmukit.checks import chain_rate_problems
 

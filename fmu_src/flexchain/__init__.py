@@ -46,9 +46,6 @@ The controller
 
 * :mod:`~arcosim.fmu.flexchain.riccati` — the discrete Riccati equation (the Kalman gains'
   and the state feedback's one solver).
-* :mod:`~arcosim.fmu.flexchain.control_design` — the discrete motor and chain, the state
-  feedback from the chain and a move time or bandwidth.
-* :mod:`~arcosim.fmu.flexchain.motor_observer` — the motor's angle, velocity and friction.
-* :mod:`~arcosim.fmu.flexchain.motion_control` — the controller: estimates, reference
-  shaping, feedback, limit.
+* :mod:`~arcosim.fmu.flexchain.control` — the motion controller (its package lists its
+  modules).
 """

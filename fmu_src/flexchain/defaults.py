@@ -104,7 +104,7 @@ CONTROL_TORQUE_NOISE_STD = 1e-3
 #: 0.3 and 1 rad/s were also tried on `arcosim bench control`'s chains).
 CONTROL_MOVING_SPEED = 0.6
 #: Until the hold's dither starts, the encoder's edges are weighed against the reference's
-#: heading (:meth:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge.heading`): a motor that
+#: heading (:meth:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge.heading`): a motor that
 #: crosses new edges one way at most this far apart (s; at 2000 counts a third of a rad/s)
 #: slides that way until as long again has passed, and for this long after an edge against
 #: the reference's heading the DOB decides from its samples. Taken as stuck while it crept
@@ -114,7 +114,7 @@ CONTROL_MOVING_SPEED = 0.6
 #: chain's corners (`arcosim bench control`) settled at 2.45 and 1.81 s against full-state
 #: bounds of 1.52 and 1.38 s; with the edges at 1.45 and 1.73 s (docs/design/dob-heading.md).
 SLIDING_INTERVAL = 10e-3
-#: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.estimator_bank`): every
+#: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.control.estimator_bank`): every
 #: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;
 #: 3 × 3 models, the chain itself among them). ±7 %, not the ±10 % the controller is
 #: scored at, so that its corners are not in the bank (docs/design/estimator-bank.md).
@@ -128,7 +128,7 @@ BANK_HYSTERESIS = 0.3
 #: move time after it (dimensionless).
 BANK_CHOICE_AFTER = 0.5
 #: The bank refines its chosen model's every J_i and k_i from a move's response
-#: (:mod:`~arcosim.fmu.flexchain.move_fit`) this share of the move time after the move's
+#: (:mod:`~arcosim.fmu.flexchain.control.move_fit`) this share of the move time after the move's
 #: start (dimensionless). On `arcosim bench control`'s four-mass chain (20 seeds, 42 runs;
 #: a prototype) 0.6, 0.7 and 0.8 met all four criteria on 36, 38 and 35 (none, 23): the
 #: choice is within the counts' noise; later leaves the feedback less time, earlier less
@@ -176,7 +176,7 @@ REFINE_DIFFERENCE_STEP = 1e-3
 #: The hold's dither (encoder counts, peak to peak): at rest the controller adds a square
 #: current that moves the motor over this much of a count, so that the encoder's reading,
 #: less the dither's known path, tells where the motor is inside its count
-#: (:mod:`~arcosim.fmu.flexchain.hold_dither`); 0 = off. On `arcosim bench control`'s
+#: (:mod:`~arcosim.fmu.flexchain.control.hold_dither`); 0 = off. On `arcosim bench control`'s
 #: chains at 20 seeds it took the runs meeting all four criteria from 18 to 34 of 126 and
 #: those holding the motor within one count from 21 to 42. The amplitude was chosen with
 #: the dither observer's velocity fed back as well: 0.5–0.8 did alike on seeds 1–3, 0.9
@@ -206,7 +206,7 @@ HOLD_QUIET_ANGLE = 5e-3
 HOLD_QUIET_TIME = 0.3
 #: … and how far off it gives the move's gain back (rad).
 HOLD_QUIET_LEAVE = 20e-3
-#: Where the hold keeps the motor's mean (:mod:`~arcosim.fmu.flexchain.hold_edge`): within
+#: Where the hold keeps the motor's mean (:mod:`~arcosim.fmu.flexchain.control.hold_edge`): within
 #: HOLD_EDGE_NEAR counts of an encoder edge, so that the dither crosses that edge alone;
 #: the hold's target moves by the least that takes it there, up to 0.5 + HOLD_EDGE_SWITCH
 #: − HOLD_EDGE_NEAR counts (0 = the mean on an edge, 0.5 = off). With the target half way
@@ -230,7 +230,7 @@ HOLD_OBSERVER_BANDWIDTH = 300.0
 LINK_MODES_MAX = 4
 LINK_MODES = 0  #: link modes the observer runs on (0 = the chain of J, k, B)
 #: The default link's (LINK_EI … LINK_BETA above) hub-locked modes as
-#: ``arcosim.identification.beam_model.modal_model`` gives them (24 elements, rounded):
+#: ``arcosim.identification.link.beam_model.modal_model`` gives them (24 elements, rounded):
 #: frequencies ω_i (rad/s), damping ratios β ω_i / 2, hub participations b_i (kg·m per
 #: modal unit, i.e. √kg·m) and tip shape values φ_i(L) (m per modal unit).
 LINK_OMEGA = (39.8506, 334.044, 1021.83, 2096.2)

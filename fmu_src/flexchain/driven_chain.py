@@ -1,6 +1,6 @@
 """The load chain driven by the motor angle: the one chain model the model-based
 observer (:mod:`arcosim.fmu.flexchain.model_observer`) and the offline output-error
-identification (:mod:`arcosim.identification.output_error`) share.
+identification (:mod:`arcosim.identification.fit.output_error`) share.
 
 The motor angle is taken as linear between two samples, so over the step that ends at
 ``t_k`` it moves with the constant speed ``v_k = (θ_m,k − θ_m,k−1) / h``. The load state

@@ -9,7 +9,7 @@ reports; no eigen-solver here), obeys (docs/method.md, eq. 7)::
 
 Written as a star of masses on their own springs to the hub (:func:`star_chain`: mass
 b_i², spring b_i² ω_i², damper 2 ζ_i ω_i b_i², angle ``θ_i = θ_m + q_i / b_i``, the
-convention of ``arcosim.identification.beam_model.ModalModel.star``), the modes are
+convention of ``arcosim.identification.link.beam_model.ModalModel.star``), the modes are
 exactly the model-based observer's driven spring–mass model
 (:func:`~arcosim.fmu.flexchain.model_observer.step_model` with ``star=True``): the same
 Kalman design and step, the star's momentum Σ b_i² ω̇_i its reaction torque. The link's

@@ -1,0 +1,342 @@
+"""Is a drive log plausible at all? Checks of its units and length at the door (offline).
+
+A log with its time in ms, its current off by 1000 or a record shorter than its slowest
+line still fits, confidently and wrongly; these checks name the column and the
+``--scale`` or ``--set`` to try first. Each is a pure function returning one line (the
+problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, and both
+:func:`~arcosim.identification.checks.log_check.check_log` and
+:func:`~arcosim.identification.drive_identification.identify_drive` call it, so ``check`` and
+``identify`` warn alike.
+
+- :func:`step_against_motion`: the speed the angle's differences give over the step
+  against the logged ω_m; off by more than :data:`SPEED_RATIO_LIMIT` (a time in ms
+  gives 1000).
+- :func:`torque_balance`: the low-frequency balance k_t·i = J·α + D·ω at the lowest
+  excitation line (least squares of the current and angle there); J outside
+  [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m names the current scale, k_t and the
+  time column.
+- :func:`record_length`: fewer than :data:`LEAST_PERIODS` periods of the lowest line the
+  current shows.
+- :func:`mode_record_length`: fewer than :data:`LEAST_MODE_PERIODS` periods of the
+  lowest mode the record shows (judged once the modes are read,
+  :func:`~arcosim.identification.checks.log_decision.decide_log`; it does not rest on finding
+  the lines, which a short record of many close lines blurs).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Largest factor (dimensionless) between the RMS speed the angle's differences give
+#: over the logged step and the RMS logged ω_m. Both measure the same motion; the
+#: encoder's quantization and a backward difference change the RMS by a few % only,
+#: while a wrong time or speed unit gives 1000 (ms), 9.55 (rpm) or 2π (rev/s).
+SPEED_RATIO_LIMIT = 1.5
+#: Lower bound of the plausible total inertia, in units of J_m (dimensionless). The
+#: load can only add to the motor's inertia; a fit above the modes sees J_m alone, and
+#: noise scatters it, so half of J_m is the margin before a scale error is named.
+INERTIA_LOW = 0.5
+#: Upper bound of the plausible total inertia, in units of J_m (dimensionless): a load
+#: 1000 times the motor's inertia is outside any servo's inertia-ratio range (10–30
+#: usual, a few hundred at most).
+INERTIA_HIGH = 1e3
+#: Least number of periods (a count) of the lowest excitation line a record should
+#: hold: the line's frequency is then resolved to a third of itself, and the fits' start
+#: transients (a few periods of the slowest motion) leave part of the record.
+LEAST_PERIODS = 3.0
+#: The torque balance's inertia counts as implausible only when it lies this many of its
+#: standard errors outside the plausible range (the three-sigma rule: a plausible log
+#: crosses it by chance 0.3 % of the time).
+BALANCE_SIGMAS = 3.0
+#: Least number of periods (a count) of the lowest mode a record should hold: its
+#: spectrum's resolution 2π/T is then at most a tenth of the mode, and the fit's start
+#: transients (a few periods of the slowest motion) leave most of the record. The 20 s
+#: logs of the benchmarks hold 36–45 periods of their lowest mode; 3 s of the README's
+#: excitation holds 5.3 of the three-mass chain's 11.2 rad/s.
+LEAST_MODE_PERIODS = 10.0
+
+
+def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
+    """The sample step against the motion: does the angle's difference over one step
+    give the logged speed?
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    omega_m : ndarray
+        Motor velocity (rad/s), shape ``(N,)``.
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+
+    Returns
+    -------
+    str or None
+        The problem and its fix, when the RMS speeds differ by more than
+        :data:`SPEED_RATIO_LIMIT`; None otherwise.
+
+    Examples
+    --------
+    >>> t = np.arange(2000) * 1e-3
+    >>> step_against_motion(t, np.cos(t), np.sin(t)) is None
+    True
+    >>> step_against_motion(t * 1e3, np.cos(t), np.sin(t))[:23]
+    'the sample step is 1 s:'
+    """
+    h = float(np.mean(np.diff(time)))
+    from_angle = float(np.sqrt(np.mean((np.diff(theta_m) / h) ** 2)))
+    logged = float(np.sqrt(np.mean(np.asarray(omega_m, float)[1:] ** 2)))
+    if not (from_angle > 0 and logged > 0):
+        return None
+    ratio = from_angle / logged
+    if 1 / SPEED_RATIO_LIMIT <= ratio <= SPEED_RATIO_LIMIT:
+        return None
+    hint = _unit_hint(ratio)
+    return (
+        f"the sample step is {h:.4g} s: the angle's differences over it give speeds "
+        f"{ratio:.3g} × the logged omega_m{hint}"
+    )
+
+
+def _unit_hint(ratio: float) -> str:
+    """The likely unit error for a ratio (angle-difference speed / logged speed)."""
+    if 3e-4 < ratio < 3e-3:
+        return ": is `time` in ms? use --scale time=0.001"
+    if 300 < ratio < 3000:
+        return ": is `time` in ks? use --scale time=1000"
+    return (
+        f": check the units of `time`, `omega_m` and `theta_m` (--scale omega_m={ratio:.4g} "
+        "if the angle and time are right)"
+    )
+
+
+def torque_balance(
+    time: np.ndarray,
+    i_a: np.ndarray,
+    theta_m: np.ndarray,
+    k_t: float,
+    J_m: float,
+    lowest: float | None,
+) -> str | None:
+    """The low-frequency torque balance: the total inertia k_t·i asks for.
+
+    At the lowest excitation line ω, under the chain's first mode, the chain moves as
+    one body: k_t·I = (−ω²·J + jω·D)·Θ for the line's complex amplitudes I of the
+    current and Θ of the angle, so J = −Re(k_t·I/Θ)/ω² (the viscous and Coulomb
+    friction sit in the imaginary part).
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    i_a : ndarray
+        Motor current (A), shape ``(N,)``.
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+    k_t : float
+        Torque constant (N·m/A).
+    J_m : float
+        Motor inertia (kg·m²).
+    lowest : float or None
+        The lowest excitation line (rad/s); None: not checked.
+
+    Returns
+    -------
+    str or None
+        The problem and the columns or values to check, when J lies outside
+        [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m; None otherwise.
+
+    Examples
+    --------
+    >>> t = np.arange(4000) * 1e-3
+    >>> theta = 0.1 * np.sin(2 * t)
+    >>> current = -1e-3 * 0.4 * np.sin(2 * t) / 0.04   # J = 1e-3, k_t = 0.04
+    >>> torque_balance(t, current, theta, 0.04, 1e-4, 2.0) is None
+    True
+    >>> torque_balance(t, current * 1e-3, theta, 0.04, 1e-4, 2.0)[:28]
+    'the torque balance k_t·i = J'
+    """
+    found = balance_inertia(time, i_a, theta_m, k_t, lowest, with_error=True)
+    if found is None:
+        return None
+    J, sigma = found
+    # implausible only beyond the balance's own uncertainty: a slow load's motion, or a
+    # line the encoder barely sees, widens it (BALANCE_SIGMAS standard errors)
+    if (
+        INERTIA_LOW * J_m - BALANCE_SIGMAS * sigma
+        <= J
+        <= INERTIA_HIGH * J_m + BALANCE_SIGMAS * sigma
+    ):
+        return None
+    return (
+        f"the torque balance k_t·i = J·α at {lowest:.3g} rad/s asks for a total inertia "
+        f"J = {J:.3g} kg·m² = {J / J_m:.3g} × J_m (plausible: {INERTIA_LOW:g} … "
+        f"{INERTIA_HIGH:g} × J_m): check the current's scale (--scale i_a=…; A or mA?), "
+        "k_t (--set k_to=…) and the time column's unit (--scale time=…)"
+    )
+
+
+def balance_inertia(
+    time: np.ndarray,
+    i_a: np.ndarray,
+    theta_m: np.ndarray,
+    k_t: float,
+    lowest: float | None,
+    with_error: bool = False,
+):
+    """Total inertia (kg·m²) of the torque balance at the line ``lowest`` (see
+    :func:`torque_balance`; arguments alike), or None when there is no line or motion;
+    with ``with_error``, ``(J, σ_J)``: σ_J (kg·m²) from the two line fits' standard
+    errors (their residuals taken as white), propagated to first order."""
+    theta = np.asarray(theta_m, float)
+    if not lowest or lowest <= 0 or len(theta) < 16:
+        return None
+    t = np.asarray(time, float) - time[0]
+    torque, sigma_torque = _line_amplitude(t, k_t * np.asarray(i_a, float), lowest)
+    angle, sigma_angle = _line_amplitude(t, theta, lowest)
+    if not abs(angle) > 0:
+        return None
+    J = float(-(torque / angle).real / lowest**2)
+    if not with_error:
+        return J
+    relative = np.hypot(sigma_torque / max(abs(torque), 1e-300), sigma_angle / abs(angle))
+    return J, float(abs(torque / angle) / lowest**2 * relative)
+
+
+def _line_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> tuple[complex, float]:
+    """Complex amplitude of ``x`` (shape ``(N,)``) at ``w`` (rad/s) over times ``t`` (s):
+    least squares on a sine and cosine, a cubic trend removed; with its standard error
+    (the magnitude's, the residual taken as white; ``x``'s unit)."""
+    span = t[-1] if t[-1] > 0 else 1.0
+    s = t / span
+    X = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(s), s, s**2, s**3])
+    c, *_ = np.linalg.lstsq(X, x, rcond=None)
+    residual = x - X @ c
+    variance = float(residual @ residual) / max(len(x) - X.shape[1], 1)
+    covariance = np.linalg.pinv(X.T @ X)[:2, :2] * variance
+    return complex(c[0], -c[1]), float(np.sqrt(max(np.trace(covariance) / 2.0, 0.0)))
+
+
+def record_length(time: np.ndarray, lowest: float | None) -> str | None:
+    """The record's length against its lowest line.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    lowest : float or None
+        The lowest excitation line the record shows (rad/s); None: none.
+
+    Returns
+    -------
+    str or None
+        The problem and its fix, when the record holds fewer than
+        :data:`LEAST_PERIODS` periods of ``lowest``; None otherwise.
+
+    Examples
+    --------
+    >>> record_length(np.arange(3001) * 1e-3, 3.0)[:32]
+    'the record lasts 3 s, 1.4 period'
+    """
+    short = _periods_short(time, lowest, LEAST_PERIODS)
+    if short is None:
+        return None
+    duration, periods = short
+    return (
+        f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest excitation "
+        f"line ({lowest:.3g} rad/s; fewer than {LEAST_PERIODS:g}): modes that low are "
+        f"poorly resolved; record at least {LEAST_PERIODS * 2 * np.pi / lowest:.3g} s"
+    )
+
+
+def _periods_short(
+    time: np.ndarray, omega: float | None, least: float
+) -> tuple[float, float] | None:
+    """(record length in s, periods of ``omega`` rad/s in it) when fewer than ``least``
+    periods; None when ``omega`` is absent or the record is long enough."""
+    if not omega or omega <= 0:
+        return None
+    duration = float(time[-1] - time[0])
+    periods = duration * omega / (2 * np.pi)
+    return None if periods >= least else (duration, periods)
+
+
+def mode_record_length(time: np.ndarray, lowest_mode: float | None) -> str | None:
+    """The record's length against its lowest mode.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    lowest_mode : float or None
+        The lowest mode the record shows (rad/s); None: none.
+
+    Returns
+    -------
+    str or None
+        The problem and its fix, when the record holds fewer than
+        :data:`LEAST_MODE_PERIODS` periods of ``lowest_mode``; None otherwise.
+
+    Examples
+    --------
+    >>> mode_record_length(np.arange(3001) * 1e-3, 11.2)[:48]
+    'the record lasts 3 s, 5.3 periods of its lowest '
+    >>> mode_record_length(np.arange(20001) * 1e-3, 11.2) is None
+    True
+    """
+    short = _periods_short(time, lowest_mode, LEAST_MODE_PERIODS)
+    if short is None:
+        return None
+    duration, periods = short
+    return (
+        f"the record lasts {duration:.3g} s, {periods:.2g} periods of its lowest mode "
+        f"({lowest_mode:.3g} rad/s; fewer than {LEAST_MODE_PERIODS:g}): that mode and its "
+        "damping rest on few periods, their σ may not cover the error; record at least "
+        f"{LEAST_MODE_PERIODS * 2 * np.pi / lowest_mode:.3g} s"
+    )
+
+
+def plausibility_warnings(
+    time: np.ndarray,
+    i_a: np.ndarray,
+    omega_m: np.ndarray,
+    theta_m: np.ndarray,
+    k_t: float,
+    J_m: float,
+    lowest: float | None,
+) -> list[str]:
+    """Every plausibility check's finding, in order: the step against the motion, the
+    torque balance, the record's length.
+
+    Parameters
+    ----------
+    time, i_a, omega_m, theta_m : ndarray
+        The log: times (s), current (A), motor velocity (rad/s) and angle (rad), each of
+        shape ``(N,)``.
+    k_t : float
+        Torque constant (N·m/A).
+    J_m : float
+        Motor inertia (kg·m²).
+    lowest : float or None
+        The lowest excitation line the current shows (rad/s); None: none found.
+
+    Returns
+    -------
+    list of str
+        One line per finding, each naming the column and the ``--scale`` or ``--set``
+        to try; empty for a plausible log.
+
+    Examples
+    --------
+    >>> t = np.arange(20000) * 1e-3
+    >>> theta = 0.1 * np.sin(3 * t)
+    >>> current = -1e-3 * 0.9 * np.sin(3 * t) / 0.04   # J = 1e-3, k_t = 0.04
+    >>> plausibility_warnings(t, current, np.gradient(theta, t), theta, 0.04, 1e-4, 3.0)
+    []
+    """
+    found = [
+        step_against_motion(time, omega_m, theta_m),
+        torque_balance(time, i_a, theta_m, k_t, J_m, lowest),
+        record_length(time, lowest),
+    ]
+    return [text for text in found if text]

@@ -1,0 +1,13 @@
+"""``cosim/identification/excitation/`` installed as ``arcosim.identification.excitation``:
+what the excitation is, the band it shows modes in, and the one to play.
+
+Modules:
+
+spectrum        -- what the excitation is: lines (leakage-aware), harmonics of one period,
+                   or broadband with its band (excitation_spectrum)
+harmonics       -- lines that are harmonics of one fundamental (a periodic reference)
+line_prominence -- which found lines are lines: the prominence again on their fitted
+                   amplitudes, over the noise and the detrend's remnant
+band            -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band)
+design          -- the multi-sine to play on a drive (design_excitation, LINE_T)
+"""

@@ -1,0 +1,411 @@
+"""What a drive log's excitation is: lines, harmonics of one period, or broadband (offline).
+
+:func:`excitation_spectrum` reads a command or a measured current (any unit, a constant
+step) and says what was played, for the log's check and the fits' decisions
+(:mod:`arcosim.identification.checks.log_decision`) and for the measured frequency response
+(:mod:`arcosim.identification.checks.frf`):
+
+- **lines** (a multi-sine, on or off the record's frequency grid): the peaks of the
+  Hann-windowed periodogram that stand :data:`LINE_PROMINENCE` times above its median
+  *and* above the leakage of every stronger line (the Hann window's sidelobe envelope,
+  :func:`leakage_envelope`), so an off-grid line counts once and not as the dozen
+  sidelobes its leakage leaves; each line's frequency then refined by a least-squares
+  fit of a sine at off-grid frequencies (:func:`refine_lines`), and a line kept only if
+  its fitted amplitude passes the same prominence over the noise and the linear
+  detrend's remnant (:mod:`arcosim.identification.excitation.line_prominence`: that remnant, a
+  ramp, reads as a weak line one to two bins above 0);
+- **periodic** (a square-wave or stepped reference, position-loop steps): lines that all
+  sit on whole multiples of one fundamental whose first harmonics are present, counted
+  as the harmonics of that fundamental
+  (:func:`~arcosim.identification.excitation.harmonics.harmonic_fundamental`);
+- **broadband** (PRBS, noise, steps): lines that carry less than
+  :data:`LINE_SHARE` of the signal's power; the usable band is where the Welch spectrum
+  stays within :data:`BROADBAND_DROP` of its peak (:func:`broadband_band`).
+
+Each kind gives the lowest frequency the excitation carries (the record-length and
+torque-balance checks read it) and its top (the band checks read it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal as sp_signal
+
+from arcosim.identification.excitation.harmonics import (
+    harmonic_fundamental,
+    on_harmonics,
+)
+from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
+
+#: A line stands this many times above the periodogram's median (its noise or
+#: broadband level) and above the leakage envelope of the stronger lines.
+LINE_PROMINENCE = 30.0
+#: Share of the signal's power (dimensionless, 0 … 1) the lines must carry for the
+#: excitation to count as lines; below it, broadband.
+LINE_SHARE = 0.8
+#: More lines than this (a count) are read as broadband (a line fit would be slow and
+#: no multi-sine plays that many).
+MAX_LINES = 2000
+#: Bins (a count) either side of a line its leakage is counted over: beyond, the Hann
+#: envelope is under 1e-15 of the line.
+LEAKAGE_REACH = 256
+#: Lines are refined by least squares (:func:`refine_lines`) up to this many (a count).
+REFINE_LIMIT = 120
+#: Broadband: the usable band is where the Welch spectrum stays above this fraction of
+#: its peak (dimensionless; 0.1: −10 dB).
+BROADBAND_DROP = 0.1
+
+
+@dataclass(frozen=True)
+class ExcitationSpectrum:
+    """What a signal's spectrum shows (see :func:`excitation_spectrum`).
+
+    Attributes
+    ----------
+    kind : str
+        ``"lines"`` (a multi-sine), ``"periodic"`` (harmonics of one fundamental),
+        ``"broadband"`` or ``"none"`` (no excitation found).
+    lines : ndarray
+        The lines played (rad/s), ascending, shape ``(L,)``: the multi-sine's lines, or
+        the harmonics present; empty for broadband.
+    amplitudes : ndarray
+        Each line's amplitude (the signal's unit), shape ``(L,)``.
+    band : tuple of float
+        The lowest and highest frequency the excitation carries (rad/s).
+    fundamental : float
+        The fundamental (rad/s) of a periodic excitation; 0 otherwise.
+    line_share : float
+        Share of the signal's power in the lines (dimensionless, 0 … 1).
+    resolution : float
+        The record's frequency grid 2π/T (rad/s).
+    """
+
+    kind: str
+    lines: np.ndarray = field(default_factory=lambda: np.empty(0))
+    amplitudes: np.ndarray = field(default_factory=lambda: np.empty(0))
+    band: tuple[float, float] = (0.0, 0.0)
+    fundamental: float = 0.0
+    line_share: float = 0.0
+    resolution: float = 0.0
+
+    @property
+    def lowest(self) -> float | None:
+        """The lowest frequency excited (rad/s), or None without excitation."""
+        return self.band[0] if self.kind != "none" else None
+
+    @property
+    def highest(self) -> float | None:
+        """The highest frequency excited (rad/s), or None without excitation."""
+        return self.band[1] if self.kind != "none" else None
+
+    def text(self) -> str:
+        """One line for the user.
+
+        Examples
+        --------
+        >>> ExcitationSpectrum("periodic", np.array([1.0, 3.0, 5.0]), np.ones(3), (1.0, 5.0),
+        ...                    1.0).text()
+        'periodic: 3 harmonics of 1 rad/s (period 6.28 s), 1 … 5 rad/s'
+        """
+        low, high = self.band
+        span = f"{low:.3g} … {high:.4g} rad/s"
+        if self.kind == "lines":
+            return f"multi-sine: {len(self.lines)} lines, {span}"
+        if self.kind == "periodic":
+            period = 2 * np.pi / self.fundamental
+            return (
+                f"periodic: {len(self.lines)} harmonics of {self.fundamental:.4g} rad/s "
+                f"(period {period:.3g} s), {span}"
+            )
+        if self.kind == "broadband":
+            return f"broadband: {span} (the Welch spectrum within 10 dB of its peak)"
+        return "no excitation found"
+
+
+def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
+    """What excitation a signal carries: lines, harmonics of one period, or broadband.
+
+    Parameters
+    ----------
+    x : ndarray
+        The signal (a current or a command, any unit), shape ``(N,)``, step ``h``.
+    h : float
+        Sample step (s).
+
+    Returns
+    -------
+    ExcitationSpectrum
+        The kind, the lines (rad/s) with their amplitudes, the band the excitation
+        carries (rad/s) and, for a periodic excitation, its fundamental.
+
+    Examples
+    --------
+    A multi-sine of 40 lines off the record's grid counts as lines, not as their leakage
+    (the pairs under about 6 rad/s, under two bins apart, merge: 33):
+
+    >>> t = np.arange(20001) * 1e-3
+    >>> lines = np.geomspace(3.0, 150.0, 40)
+    >>> phases = np.random.default_rng(1).uniform(0, 2 * np.pi, 40)
+    >>> current = np.sin(np.outer(t, lines) + phases).sum(axis=1) * 0.075
+    >>> found = excitation_spectrum(current, 1e-3)
+    >>> found.kind, len(found.lines), round(found.band[1], 1)
+    ('lines', 33, 150.0)
+    """
+    x = np.asarray(x, dtype=float)
+    if len(x) < 16 or not np.all(np.isfinite(x)):
+        return ExcitationSpectrum("none")
+    t = np.arange(len(x)) * h
+    x = x - np.polyval(np.polyfit(t, x, 1), t)
+    resolution = 2.0 * np.pi / (len(x) * h)
+    if not np.any(x):
+        return ExcitationSpectrum("none", resolution=resolution)
+    lines, amplitudes, share = spectral_lines(x, h)
+    if len(lines) and share >= LINE_SHARE:
+        fundamental = harmonic_fundamental(lines, resolution)
+        kind = "periodic" if fundamental else "lines"
+        band = (float(lines[0]), float(lines[-1]))
+        return ExcitationSpectrum(kind, lines, amplitudes, band, fundamental, share, resolution)
+    band = broadband_band(x, h)
+    if band is None:
+        return ExcitationSpectrum("none", line_share=share, resolution=resolution)
+    return ExcitationSpectrum("broadband", band=band, line_share=share, resolution=resolution)
+
+
+def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """The lines of a detrended signal, leakage-aware.
+
+    Peaks of the Hann-windowed periodogram above :data:`LINE_PROMINENCE` times its
+    median and above the leakage of every stronger peak (:func:`leakage_envelope`);
+    then, unless they are harmonics of one fundamental, their frequencies refined
+    together by least squares (:func:`refine_lines`) on the signal decimated to the
+    lines' band, and the residual searched once more for lines the window merged
+    (lines closer than two bins, 4π/T).
+
+    Parameters
+    ----------
+    x : ndarray
+        The signal, trend removed, shape ``(N,)``.
+    h : float
+        Sample step (s).
+
+    Returns
+    -------
+    lines : ndarray
+        Frequencies (rad/s), ascending, shape ``(L,)``.
+    amplitudes : ndarray
+        Amplitudes (the signal's unit), shape ``(L,)``.
+    share : float
+        Share of the signal's power in the lines (dimensionless).
+
+    Examples
+    --------
+    >>> t = np.arange(4000) * 1e-3
+    >>> lines, amplitudes, share = spectral_lines(np.sin(10.3 * t) + 0.5 * np.sin(40.1 * t), 1e-3)
+    >>> np.round(lines, 2), np.round(amplitudes, 2), round(share, 2)
+    (array([10.29, 40.08]), array([1. , 0.5]), 1.0)
+    """
+    n = len(x)
+    bins, power = _peaks(x)
+    if not len(bins):
+        return np.empty(0), np.empty(0), 0.0
+    near = np.zeros(len(power), dtype=bool)
+    for d in range(-2, 3):
+        near[np.clip(bins + d, 1, len(power) - 1)] = True
+    share = float(power[near].sum() / max(power[1:].sum(), 1e-300))
+    if share < LINE_SHARE or len(bins) > MAX_LINES:
+        return np.empty(0), np.empty(0), share
+    resolution = 2.0 * np.pi / (n * h)
+    amplitude = 2.0 * np.sqrt(power[bins]) / np.sum(np.hanning(n))
+    position = _interpolated(power, bins)
+    keep = position >= 1.0  # under one period in the record: a trend, not a line
+    if not np.any(keep):
+        return np.empty(0), np.empty(0), share
+    coarse = position[keep] * resolution
+    # lines under two periods of the record are told from a trend's remnant poorly:
+    # the harmonic test leaves them out, and a periodic excitation keeps its harmonics
+    low = coarse >= 2 * resolution
+    w0 = harmonic_fundamental(coarse[low], resolution, amplitude[keep][low])
+    if w0:
+        on = on_harmonics(coarse, w0, resolution)
+        return np.rint(coarse[on] / w0) * w0, amplitude[keep][on], share
+    if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
+        return coarse, amplitude[keep], share
+    q = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
+    y = sp_signal.resample_poly(x, 1, q) if q > 1 else x
+    lines, amplitudes, _ = refine_lines(y, q * h, coarse)
+    noise = noise_amplitude(_floor(power), n)
+    prominent = prominent_lines(y, q * h, lines, noise, LINE_PROMINENCE)
+    order = np.argsort(lines[prominent])
+    return lines[prominent][order], amplitudes[prominent][order], share
+
+
+#: The lines' refinement decimates the signal to this many times their top frequency's
+#: share of the Nyquist band (dimensionless, > 1: the decimating filter's margin).
+DECIMATE_MARGIN = 2.5
+
+
+def _peaks_power(x: np.ndarray) -> np.ndarray:
+    """The Hann-windowed periodogram of ``x`` (its unit squared), shape ``(N//2 + 1,)``."""
+    return np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
+
+
+def _floor(power: np.ndarray) -> float:
+    """The periodogram's median (its noise or broadband level)."""
+    return max(float(np.median(power[1:])), 1e-300)
+
+
+def _peaks(x: np.ndarray, floor: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Bins of the lines in ``x`` (shape ``(N,)``): peaks of the Hann periodogram
+    :data:`LINE_PROMINENCE` times above ``floor`` (default its median) and above the
+    leakage envelope of every stronger peak; with the periodogram."""
+    power = _peaks_power(x)
+    floor = _floor(power) if floor is None else floor
+    peak = np.zeros(len(power), dtype=bool)
+    peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
+    candidates = np.flatnonzero(peak & (power > LINE_PROMINENCE * floor))
+    accepted: list[int] = []
+    leak = np.zeros(len(power))
+    reach = np.arange(-LEAKAGE_REACH, LEAKAGE_REACH + 1)
+    envelope = leakage_envelope(reach)
+    for j in candidates[np.argsort(-power[candidates])]:
+        if power[j] <= LINE_PROMINENCE * (floor + leak[j]):
+            continue
+        accepted.append(int(j))
+        near = (j + reach >= 0) & (j + reach < len(power))
+        leak[j + reach[near]] += power[j] * envelope[near]
+    return np.sort(np.array(accepted, dtype=int)), power
+
+
+def leakage_envelope(distance: np.ndarray) -> np.ndarray:
+    """Upper bound of the Hann window's leakage, relative to a line's peak bin, at
+    ``distance`` bins from it (dimensionless power ratio; 1 within the main lobe).
+
+    The Hann window's transform falls as sinc(d)/(1 − d²); over every offset of a line
+    from the grid (scalloping up to 1.42 dB) its magnitude stays under 1/(π·d·(d² − 1))
+    at d bins from the line, the line at most half a bin from its peak bin.
+
+    Parameters
+    ----------
+    distance : ndarray
+        Distance from the line's peak bin (bins), any shape.
+
+    Returns
+    -------
+    ndarray
+        The power ratio bound, same shape.
+
+    Examples
+    --------
+    >>> np.round(leakage_envelope(np.array([0, 1, 3, 10])), 6)
+    array([1.00e+00, 1.00e+00, 8.17e-04, 0.00e+00])
+    """
+    d = np.maximum(np.abs(np.asarray(distance, dtype=float)) - 0.5, 1.5)
+    bound = (1.0 / (np.pi * d * (d**2 - 1.0))) ** 2 / 0.72  # 0.72: the worst scalloping
+    return np.where(np.abs(distance) <= 1, 1.0, np.minimum(bound, 1.0))
+
+
+def _interpolated(power: np.ndarray, bins: np.ndarray) -> np.ndarray:
+    """Peak positions (fractional bins) by a parabola through the log power."""
+    left, mid, right = (np.log(np.maximum(power[bins + d], 1e-300)) for d in (-1, 0, 1))
+    curvature = left - 2 * mid + right
+    shift = 0.5 * (left - right) / np.where(curvature == 0, -1.0, curvature)
+    return bins + np.clip(shift, -0.5, 0.5)
+
+
+def refine_lines(
+    x: np.ndarray, h: float, lines: np.ndarray, sweeps: int = 4
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lines' frequencies refined by least squares at off-grid frequencies.
+
+    Every line's sine and cosine amplitude and its frequency are fitted together by
+    ``sweeps`` Gauss–Newton steps, each frequency held within half a bin (π/T) of its
+    start (lines the window merged would otherwise wander).
+
+    Parameters
+    ----------
+    x : ndarray
+        The signal, trend removed, shape ``(N,)``, step ``h`` (s).
+    h : float
+        Sample step (s).
+    lines : ndarray
+        Starting frequencies (rad/s), shape ``(L,)``.
+    sweeps : int
+        Gauss–Newton steps (a count).
+
+    Returns
+    -------
+    lines : ndarray
+        Refined frequencies (rad/s), in the order given, shape ``(L,)``.
+    amplitudes : ndarray
+        Their amplitudes (the signal's unit), shape ``(L,)``.
+    residual : ndarray
+        The signal less the fitted lines, shape ``(N,)``.
+
+    Examples
+    --------
+    >>> t = np.arange(3000) * 1e-3
+    >>> lines, amplitudes, rest = refine_lines(np.cos(7.77 * t + 1.0), 1e-3, np.array([7.9]))
+    >>> round(float(lines[0]), 4), round(float(amplitudes[0]), 4), float(np.abs(rest).max()) < 1e-6
+    (7.77, 1.0, True)
+    """
+    t = np.arange(len(x)) * h
+    t = t - t.mean()  # the derivative columns then stay uncorrelated with the sines
+    start = np.asarray(lines, dtype=float)
+    w = start.copy()
+    limit = np.pi / (len(x) * h)  # a frequency moves at most half a bin in all
+    c, s = _fit(x, t, w)
+    for _ in range(sweeps):
+        # one Gauss–Newton step on every amplitude and frequency together: lines a bin
+        # apart pull on each other, so no line is moved with the others held
+        phase = np.outer(t, w)
+        cos, sin = np.cos(phase), np.sin(phase)
+        residual = x - cos @ c - sin @ s
+        slope = t[:, None] * (-sin * c + cos * s)
+        step = np.linalg.lstsq(np.hstack([cos, sin, slope]), residual, rcond=None)[0]
+        w = np.clip(w + step[2 * len(w) :], start - limit, start + limit)
+        c, s = _fit(x, t, w)
+    phase = np.outer(t, w)
+    residual = x - np.cos(phase) @ c - np.sin(phase) @ s
+    return w, np.hypot(c, s), residual
+
+
+def _fit(x: np.ndarray, t: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares cosine and sine amplitudes at ``w`` (rad/s) over ``t`` (s)."""
+    phase = np.outer(t, w)
+    X = np.hstack([np.cos(phase), np.sin(phase)])
+    coef = np.linalg.lstsq(X, x, rcond=None)[0]
+    return coef[: len(w)], coef[len(w) :]
+
+
+def broadband_band(x: np.ndarray, h: float) -> tuple[float, float] | None:
+    """The band (rad/s) a broadband signal carries: where its Welch spectrum stays above
+    :data:`BROADBAND_DROP` of its peak, the lowest and the highest such frequency.
+
+    Parameters
+    ----------
+    x : ndarray
+        The signal, trend removed, shape ``(N,)``.
+    h : float
+        Sample step (s).
+
+    Returns
+    -------
+    tuple of float or None
+        ``(low, high)`` (rad/s); None for a signal with no power.
+
+    Examples
+    --------
+    >>> noise = np.random.default_rng(0).standard_normal(20000)
+    >>> low, high = broadband_band(noise, 1e-3)
+    >>> low < 10.0, high > 3000.0   # white: the whole band up to π/h
+    (True, True)
+    """
+    segment = int(min(len(x), 2 ** int(np.log2(max(len(x) // 8, 16)))))
+    frequency, psd = sp_signal.welch(x, fs=1.0 / h, nperseg=segment)
+    if not np.any(psd[1:] > 0):
+        return None
+    above = np.flatnonzero(psd[1:] >= BROADBAND_DROP * psd[1:].max()) + 1
+    omega = 2.0 * np.pi * frequency
+    return float(omega[above[0]]), float(omega[above[-1]])
