@@ -22,6 +22,7 @@ identify_drive      -- every J_i, k_i, B_i (and n) from a log, k_t and J_m known
 DriveIdentification -- its result: the chain, standard errors, assumptions, evidence
 Verdict             -- whether a fit is trusted, and the reasons when not (its .verdict)
 check_log           -- can a log support identification? (before any fit)
+identify_link       -- a flexible link's EI, ρA, damping and modes from its hub's log
 design_excitation   -- the multi-sine to play on the drive for identification
 Actuator            -- the motor's terms: J_mo, k_to, Δk_t, ΔJ, D_m, f_c
 motor_record        -- a log as the reaction-torque record the fits use
@@ -127,6 +128,7 @@ _API = {
     "DriveIdentification": "arcosim.identification.drive_identification",
     "Verdict": "arcosim.identification.checks.verdict",
     "check_log": "arcosim.identification.checks.log_check",
+    "identify_link": "arcosim.identification.link.link_identification",
     "design_excitation": "arcosim.identification.excitation.design",
     "estimate_load_torque": "arcosim.identification.load_torque",
     "ObserverSettings": "arcosim.fmu.flexchain.observer",
