@@ -35,7 +35,7 @@ from pathlib import Path
 import arcosim
 from arcosim.errors import UserError
 from arcosim.experiments.report import markdown_table
-from arcosim.fleet.drift import DriftReport
+from arcosim.fleet.drift import AxisDrift, DriftReport
 from arcosim.fleet.store import read_store, write_store
 from benchmarks.simulators.fleet_sample import MONITORING, write_monitoring_fleet
 
@@ -81,6 +81,7 @@ def score_fleet(seed: int, seconds: float, workers: int, folder: Path) -> dict:
                 }
     ok = [r for r in rows if r["status"] == "ok"]
     trusted = [r for r in ok if r["verdict"] == "trusted"]
+    healthy = [report.axes[a] for a, plan in MONITORING.items() if not plan.expect]
     return {
         "seed": seed,
         "logs": run.total,
@@ -88,6 +89,8 @@ def score_fleet(seed: int, seconds: float, workers: int, folder: Path) -> dict:
         "found": sorted(found & expected),
         "missed": sorted(expected - found),
         "false": sorted(found - expected),
+        "healthy_comparisons": sum(comparisons(drift) for drift in healthy),
+        "healthy_false": sum(len(drift.alarms) for drift in healthy),
         "failed": [f"{f['axis']} {f['date']}: {f['reason']}" for f in report.failed],
         "untrusted": [
             f"{r['axis']} {r['date']}: {r['verdict_reasons']}" for r in ok if r not in trusted
@@ -104,6 +107,28 @@ def score_fleet(seed: int, seconds: float, workers: int, folder: Path) -> dict:
     }
 
 
+def comparisons(drift: AxisDrift) -> int:
+    """The comparisons the rule made on one axis: each parameter compared, or the one
+    of n when it differed (then no parameter is compared); none without a latest fit."""
+    return len(drift.changes) + sum(1 for a in drift.alarms if a["kind"] == "structure")
+
+
+def false_alarm_rate(fleets: list[dict]) -> str:
+    """The false alarms on the unchanged axes per comparison, over ``fleets``, with the
+    one-sided 95 % upper bound of the rate (exact binomial, Clopper–Pearson)."""
+    from scipy.stats import beta
+
+    count = sum(f["healthy_comparisons"] for f in fleets)
+    false = sum(f["healthy_false"] for f in fleets)
+    if not count:
+        return "false alarms on unchanged axes: no comparison made"
+    upper = float(beta.ppf(0.95, false + 1, count - false))
+    return (
+        f"false alarms on unchanged axes: {false} of {count} parameter comparisons "
+        f"({false / count:.2%}; 95 % upper bound {upper:.2%}) over {len(fleets)} fleets"
+    )
+
+
 def accuracy_table(fleets: list[dict]) -> str:
     """The markdown table of :func:`score_fleet`'s results, a row per fleet."""
     head = [
@@ -111,6 +136,8 @@ def accuracy_table(fleets: list[dict]) -> str:
         "logs",
         "alarms found",
         "false alarms",
+        "unchanged axes' comparisons",
+        "false on them",
         "failed logs",
         "untrusted",
         "n wrong",
@@ -122,6 +149,8 @@ def accuracy_table(fleets: list[dict]) -> str:
             str(f["logs"]),
             f"{len(f['found'])}/{len(f['expected'])}",
             str(len(f["false"])),
+            str(f["healthy_comparisons"]),
+            str(f["healthy_false"]),
             str(len(f["failed"])),
             str(len(f["untrusted"])),
             str(len(f["n_wrong"])),
@@ -287,8 +316,11 @@ def _execute(args: argparse.Namespace) -> int:
             for seed in range(args.first_seed, args.first_seed + args.fleets):
                 fleets.append(score_fleet(seed, args.seconds, args.workers, folder / f"{seed}"))
                 print(_fleet_text(fleets[-1]), flush=True)
+                if args.out:  # after each fleet: a long run stopped keeps what it scored
+                    args.out.write_text(json.dumps({"fleets": fleets}, indent=1, default=str))
             result = {"fleets": fleets}
             print(accuracy_table(fleets))
+            print(false_alarm_rate(fleets))
     if args.out:
         args.out.write_text(json.dumps(result, indent=1, default=str))
         print(f"wrote {args.out}")
