@@ -3,11 +3,11 @@
 :func:`identify_fleet` reads the fleet's folder (:mod:`arcosim.fleet.layout`), leaves
 out the logs the store in ``out`` already holds, and sends each other log to a Dask
 worker (:func:`identify_log`: the log is read there, BLAS limited to one thread). Each
-result is appended to the store (:mod:`arcosim.fleet.store`) as it arrives, so an
-interrupted run keeps every finished log and the next run does only the rest. A log
-that cannot be read or identified is recorded as failed with its reason in one line,
-and the fleet goes on. One writer per ``out``: the run holds the folder's lock
-(:func:`arcosim.sweeps.runner.lock_folder`).
+result is appended to the store (:func:`arcosim.fleet.store.append_store`: one line,
+synced to disk) as it arrives, so an interrupted run keeps every finished log and the
+next run does only the rest. A log that cannot be read or identified is recorded as
+failed with its reason in one line, and the fleet goes on. One writer per ``out``: the
+run holds the folder's lock (:func:`arcosim.sweeps.runner.lock_folder`).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from threadpoolctl import threadpool_limits
 
 from arcosim.errors import ArcosimError, UserError
 from arcosim.fleet.layout import Axis, FleetLog, read_fleet
-from arcosim.fleet.store import STD, read_store, store_path, write_store
+from arcosim.fleet.store import STD, append_store, read_store, store_path, write_store
 from arcosim.sweeps.runner import dask_client, lock_folder
 from arcosim.version import __version__
 
@@ -136,7 +136,7 @@ def identify_fleet(
         pending = [log for log in logs if (log.axis, log.path.name) not in done]
         added: list[dict[str, object]] = []
         if pending:
-            _run(pending, axes, rows, added, out, scheduler, workers, progress)
+            _run(pending, axes, added, out, scheduler, workers, progress)
         elif not store_path(out).exists():
             write_store(out, rows)
     return FleetRun(
@@ -215,14 +215,13 @@ def _options(axis: Axis) -> dict[str, object]:
 def _run(
     pending: list[FleetLog],
     axes: Mapping[str, Axis],
-    rows: list[dict[str, object]],
     added: list[dict[str, object]],
     out: Path,
     scheduler: str | None,
     workers: int,
     progress: TextIO | None,
 ) -> None:
-    """Send the pending logs to Dask; write the store after each result."""
+    """Send the pending logs to Dask; add each result to the store as it arrives."""
     from dask.distributed import as_completed
 
     _say(progress, _starting(len(pending), scheduler, workers))
@@ -241,9 +240,8 @@ def _run(
         started = time.perf_counter()
         for future in as_completed(futures):
             row = _result(future, futures[future])
-            rows.append(row)
+            append_store(out, row)
             added.append(row)
-            write_store(out, sorted(rows, key=lambda r: (str(r["axis"]), str(r["date"]))))
             _say(progress, _progress_line(added, len(pending), time.perf_counter() - started))
 
 

@@ -1,11 +1,27 @@
 """The fleet's store: one row per identified log, in ``OUT/fleet.csv``.
 
-A CSV, rewritten whole through a temporary file and ``os.replace`` after every row, so
-that a reader (or a run that is interrupted) only ever sees a complete file; the parameter
-columns are the union of every row's, so a fit with another n adds its columns. The
-columns: :data:`FIXED`, then each parameter and its standard error (``k[1]``,
-``k[1]_std``), sorted by name. A units sidecar ``fleet.units.json`` names each column's
-unit, as every CSV the project writes has.
+A CSV, one line per row, in the order the logs were identified. The columns:
+:data:`FIXED`, then each parameter and its standard error (``k[1]``, ``k[1]_std``),
+sorted by name; a units sidecar ``fleet.units.json`` names each column's unit, as every
+CSV the project writes has.
+
+How a row is added (:func:`append_store`), so that a crash loses no finished row and the
+cost of a row does not grow with the store:
+
+* a row whose columns the header has is appended as one line, in one ``write`` on a file
+  opened for appending, then ``fsync``-ed: once :func:`append_store` returns, the row
+  survives a crash of the process or the machine;
+* a row with a column the header lacks (the first fit of another n) rewrites the whole
+  file with the new header through a temporary file and ``os.replace``
+  (:func:`write_store`): a reader sees the old file or the new one. This happens once
+  per new set of columns, not per row;
+* a crash during an append can leave a last line without its newline (a torn row).
+  :func:`read_store` ignores it (a reader running beside the writer may meet a line
+  being written the same way), and the next :func:`append_store` cuts it off before
+  writing, so its log, not being in the store, is identified again by the next run.
+
+One writer at a time: the caller holds the folder's lock
+(:func:`arcosim.sweeps.runner.lock_folder`); readers need none.
 """
 
 from __future__ import annotations
@@ -14,6 +30,7 @@ import csv
 import io
 import json
 import math
+import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -70,13 +87,67 @@ def read_store(out: Path) -> list[dict[str, object]]:
     if not path.exists():
         return []
     try:
-        with open(path, newline="", encoding="utf-8") as f:
-            reader = csv.DictReader(f)
-            if reader.fieldnames is None or tuple(reader.fieldnames[: len(FIXED)]) != FIXED:
-                raise UserError(f"{path}: not a fleet store (its columns differ); choose another")
-            return [_typed(row) for row in reader]
+        text = path.read_bytes().decode("utf-8")
+        reader = csv.DictReader(io.StringIO(text[: text.rfind("\n") + 1]))  # no torn row
+        if reader.fieldnames is None or tuple(reader.fieldnames[: len(FIXED)]) != FIXED:
+            raise UserError(f"{path}: not a fleet store (its columns differ); choose another")
+        return [_typed(row) for row in reader]
     except (UnicodeDecodeError, csv.Error) as error:
         raise UserError(f"{path}: not a fleet store ({error}); choose another folder") from None
+    except OSError as error:
+        raise UserError(f"{path}: cannot read it ({error.strerror})") from None
+
+
+def append_store(out: Path, row: Mapping[str, object]) -> Path:
+    """Add one row to the store in ``out``, durably (the module's docstring says how).
+
+    Parameters
+    ----------
+    out : Path
+        The output folder; the caller holds its lock (one writer).
+    row : mapping
+        :data:`FIXED`'s columns (those missing are written empty), parameters and their
+        ``_std``.
+
+    Returns
+    -------
+    Path
+        The store's file.
+
+    Raises
+    ------
+    UserError
+        The store cannot be written (a full disk, no permission), or is not a fleet store.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> row = {"axis": "a1", "date": "2026-01-05", "status": "ok", "n": 1, "k[1]": 0.3}
+    >>> _ = append_store(Path("store-out"), row)
+    >>> _ = append_store(Path("store-out"), {**row, "date": "2026-02-05", "k[1]": 0.27})
+    >>> [(r["date"], r["k[1]"]) for r in read_store(Path("store-out"))]
+    [('2026-01-05', 0.3), ('2026-02-05', 0.27)]
+    """
+    path = store_path(out)
+    columns = _header(path)
+    if columns is None or any(key not in columns for key in row):
+        return write_store(out, [*read_store(out), row])
+    text = io.StringIO()
+    writer = csv.DictWriter(text, fieldnames=columns, restval="", lineterminator="\n")
+    writer.writerow({k: _cell(v) for k, v in row.items()})
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_APPEND)
+        try:
+            _cut_torn_row(fd)
+            data = text.getvalue().encode("utf-8")
+            while data:  # one write in practice; a short write goes on where it stopped
+                data = data[os.write(fd, data) :]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as error:
+        raise UserError(f"{path}: cannot add a row ({error.strerror})") from None
+    return path
 
 
 def write_store(out: Path, rows: Iterable[Mapping[str, object]]) -> Path:
@@ -108,6 +179,41 @@ def write_store(out: Path, rows: Iterable[Mapping[str, object]]) -> Path:
     return path
 
 
+def _header(path: Path) -> list[str] | None:
+    """The store's columns from its first line; None when there is no store yet."""
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            first = f.readline()
+    except FileNotFoundError:
+        return None
+    except (OSError, UnicodeDecodeError) as error:
+        raise UserError(f"{path}: not a readable fleet store ({error}); choose another") from None
+    columns = next(csv.reader([first]), [])
+    if tuple(columns[: len(FIXED)]) != FIXED or not first.endswith("\n"):
+        raise UserError(f"{path}: not a fleet store (its columns differ); choose another")
+    return columns
+
+
+#: Bytes read at a time from the end of the store, looking for the last newline: a
+#: page, which holds several rows (any size finds it; this one in one read, usually).
+_TAIL = 4096
+
+
+def _cut_torn_row(fd: int) -> None:
+    """Cut a last line without its newline (a row torn by a crash) off the file ``fd``."""
+    end = size = os.fstat(fd).st_size
+    if not size or os.pread(fd, 1, size - 1) == b"\n":
+        return
+    while end > 0:
+        start = max(0, end - _TAIL)
+        at = os.pread(fd, end - start, start).rfind(b"\n")
+        if at >= 0:
+            os.ftruncate(fd, start + at + 1)
+            return
+        end = start
+    raise OSError(0, "no complete line, not even the header")
+
+
 def parameter_names(row: Mapping[str, object]) -> list[str]:
     """The parameters a row holds a value of (every column but :data:`FIXED` and the errors)."""
     return [
@@ -129,8 +235,12 @@ def _unit(column: str) -> str:
 
 
 def _cell(value: object) -> object:
+    """A value as the store writes it: empty for None and NaN, text on one line (a row
+    is one line, which is what tells a torn row)."""
     if isinstance(value, float) and not math.isfinite(value):
         return ""
+    if isinstance(value, str):
+        return " ".join(value.splitlines())
     return "" if value is None else value
 
 
