@@ -3,8 +3,9 @@ monitoring of many axes (:mod:`arcosim.fleet`).
 
 ``identify`` identifies every log of the fleet's folder that the store in ``--out``
 does not hold yet, on a local Dask cluster of ``--workers`` processes or the cluster at
-``--scheduler``; ``drift`` compares each axis's latest trusted fit with its baseline and
-exits 1 when any alarm is raised. Both only parse, call the library and print.
+``--scheduler``; ``drift`` compares each axis's latest trusted fit with its baseline,
+exits 1 when any alarm is raised and with ``--plot PLOTDIR`` draws the drift
+(:mod:`arcosim.fleet.figures`). Both only parse, call the library and print.
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ import sys
 from pathlib import Path
 
 from arcosim.cli.options import add_command, number, whole_number
+from arcosim.errors import UserError
 from arcosim.fleet.drift import THRESHOLD, fleet_drift
+from arcosim.fleet.figures import write_drift_figures
 from arcosim.fleet.identify import identify_fleet
 
 #: Exit status of ``drift`` when any axis has an alarm.
@@ -93,11 +96,14 @@ def _add_drift(commands: argparse._SubParsersAction) -> argparse.ArgumentParser:
 Compare each axis's latest trusted identification in the store DIR with its baseline
 (its first trusted one, or the first from --baseline). An alarm: a parameter changed
 by more than --threshold (relative) and by more than 3 standard errors of the
-difference, or a different number of masses.
+difference, or a different number of masses. With --plot PLOTDIR: overview.png (every
+axis's parameters, change from the baseline) and axis-<axis>.png per alarmed axis
+(each parameter's history with its σ band and the threshold band).
 
 Exit status: 0 when no alarm, 1 when any alarm, 2 for a refusal.""",
         examples="""
 arcosim fleet drift fleet-out
+arcosim fleet drift fleet-out --plot drift-figures --force
 arcosim fleet drift fleet-out --json --threshold 0.1 --baseline 2026-01-01""",
     )
     p.add_argument(
@@ -116,6 +122,15 @@ arcosim fleet drift fleet-out --json --threshold 0.1 --baseline 2026-01-01""",
         type=_iso_date,
         metavar="DATE",
         help="ISO date: each axis's baseline is its first trusted fit from then on",
+    )
+    p.add_argument(
+        "--plot",
+        type=Path,
+        metavar="PLOTDIR",
+        help="draw overview.png and axis-<axis>.png per alarmed axis into this folder",
+    )
+    p.add_argument(
+        "--force", action="store_true", help="with --plot: replace figures of an earlier run"
     )
     p.set_defaults(execute=_drift)
     return p
@@ -154,6 +169,11 @@ def _identify(args: argparse.Namespace) -> int:
 
 
 def _drift(args: argparse.Namespace) -> int:
+    if args.force and args.plot is None:
+        raise UserError("--force goes with --plot PLOTDIR (it replaces figures)")
     report = fleet_drift(args.out, threshold=args.threshold, baseline=args.baseline)
+    figures = [] if args.plot is None else write_drift_figures(report, args.plot, force=args.force)
     print(report.to_json() if args.json else report.text())
+    for path in figures:  # beside JSON on stdout, on stderr
+        print(f"wrote {path}", file=sys.stderr if args.json else sys.stdout)
     return ALARM if report.alarmed else 0

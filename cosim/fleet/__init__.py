@@ -5,8 +5,9 @@ Modules, in the order data flows:
 
 layout   -- a fleet's folder read and checked: its axes, their ``axis.toml``, logs by date
 identify -- every log not yet in the store identified on Dask, one row each
-store    -- the rows in ``OUT/fleet.csv``, written atomically after each log
+store    -- the rows in ``OUT/fleet.csv``, one appended and synced per log
 drift    -- each axis's parameters against its baseline, and the alarms
+figures  -- the drift drawn: a figure per alarmed axis, an overview of every axis
 
 Sits above :mod:`arcosim.identification` and :mod:`arcosim.sweeps` (the folder's lock).
 """

@@ -53,7 +53,8 @@ class AxisDrift:
         The changes that alarm, and a ``"structure"`` alarm when n differs.
     history : list of dict
         Every fit of the axis by date: ``date``, ``log``, ``status``, ``verdict``,
-        ``n`` and its parameters' values.
+        ``n``, its parameters' values (``parameters``) and their standard errors
+        (``std``, NaN where a fit gives none).
     untrusted : list of dict
         The untrusted fits: ``date``, ``log``, ``reasons``.
     """
@@ -255,6 +256,7 @@ def _change(
 def _history(row: Mapping[str, object]) -> dict:
     entry = {k: row.get(k) for k in ("date", "log", "status", "verdict", "n")}
     entry["parameters"] = {p: row[p] for p in parameter_names(row)}
+    entry["std"] = {p: float(row.get(p + STD, math.nan)) for p in entry["parameters"]}
     return entry
 
 

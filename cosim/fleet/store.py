@@ -174,7 +174,7 @@ def write_store(out: Path, rows: Iterable[Mapping[str, object]]) -> Path:
         writer.writerow({k: _cell(v) for k, v in row.items()})
     path = store_path(out)
     write_text(path, text.getvalue(), force=True)
-    units = json.dumps({c: _unit(c) for c in columns}, indent=1) + "\n"
+    units = json.dumps({c: column_unit(c) for c in columns}, indent=1) + "\n"
     write_text(units_path(path), units, force=True)
     return path
 
@@ -223,7 +223,14 @@ def parameter_names(row: Mapping[str, object]) -> list[str]:
     ]
 
 
-def _unit(column: str) -> str:
+def column_unit(column: str) -> str:
+    """The unit of a column of the store (``""`` for text, ``"1"`` for n).
+
+    Examples
+    --------
+    >>> column_unit("k[2]_std"), column_unit("seconds"), column_unit("verdict")
+    ('N*m/rad', 's', '')
+    """
     name = column.removesuffix(STD)
     if column == "seconds":
         return "s"
