@@ -62,6 +62,7 @@ Condition monitoring of a fleet of axes (Dask)
 ----------------------------------------------
 identify_fleet      -- every new log of every axis identified, one row each in a store
 fleet_drift         -- each axis's parameters against its baseline; alarms on drift
+fleet_figures       -- the drift drawn: an overview of every axis, a figure per alarmed one
 
 Building and checking FMUs
 --------------------------
@@ -156,6 +157,7 @@ _API = {
     "filtered_random": "arcosim.experiments.current_commands",
     "identify_fleet": "arcosim.fleet.identify",
     "fleet_drift": "arcosim.fleet.drift",
+    "fleet_figures": "arcosim.fleet.figures",
     "build_all": "arcosim.build.builder",
     "ensure_built": "arcosim.build.builder",
     "validate": "arcosim.host.validate",

@@ -84,3 +84,26 @@ def test_the_fmpy_example_estimates_the_reaction_torque(build_fmus, tmp_path) ->
     assert result.returncode == 0, result.stderr
     error, torque = (float(x) for x in re.findall(r"([0-9.]+e[-+][0-9]+) N\.m", result.stdout))
     assert error < 0.3 * torque, result.stdout
+
+
+@pytest.mark.system
+@pytest.mark.slow
+def test_the_fleet_example_alarms_on_the_slack_belt_alone(tmp_path) -> None:
+    """Three conveyors of the example's own simulator, k[1] 12 % lower on conveyor-2 by
+    the last date: one alarm, that one, with its sign and size (the fits resolve k[1] to
+    about 0.1 %, so 1 % is far outside their spread), and the figures it draws."""
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / "monitor_a_fleet.py")],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**os.environ, "ARCOSIM_EXAMPLE_OUT": str(tmp_path)},
+    )
+    assert result.returncode == 0, result.stderr
+    alarms = [line for line in result.stdout.splitlines() if line.startswith("ALARM")]
+    assert len(alarms) == 1 and alarms[0].startswith("ALARM conveyor-2: k[1] -")
+    change = float(re.search(r"k\[1\] ([-+0-9.]+)%", alarms[0]).group(1))
+    assert abs(change - -12.0) < 1.0
+    assert "identified 9 logs (0 failed)" in result.stdout
+    figures = tmp_path / "fleet-example" / "figures"
+    assert sorted(p.name for p in figures.iterdir()) == ["axis-conveyor-2.png", "overview.png"]

@@ -12,7 +12,7 @@ import pytest
 
 from arcosim.cli import main
 from arcosim.fleet.drift import drift_of
-from arcosim.fleet.figures import write_drift_figures
+from arcosim.fleet.figures import fleet_figures
 from arcosim.fleet.store import write_store
 
 K1 = 0.3  # N·m/rad
@@ -105,7 +105,7 @@ def test_the_history_carries_each_fits_standard_error(tmp_path: Path) -> None:
     assert [h["std"]["k[1]"] for h in history] == [1e-3] * 3
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no left-over figure, no matplotlib warning
-        paths = write_drift_figures(drift_of(rows, threshold=0.2), tmp_path / "f")
+        paths = fleet_figures(drift_of(rows, threshold=0.2), tmp_path / "f")
     assert [p.name for p in paths] == ["overview.png", "axis-rebuilt.png"]  # 12 % < 20 %
 
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from arcosim.cli.options import add_command, number, whole_number
 from arcosim.errors import UserError
 from arcosim.fleet.drift import THRESHOLD, fleet_drift
-from arcosim.fleet.figures import write_drift_figures
+from arcosim.fleet.figures import fleet_figures
 from arcosim.fleet.identify import identify_fleet
 
 #: Exit status of ``drift`` when any axis has an alarm.
@@ -172,7 +172,7 @@ def _drift(args: argparse.Namespace) -> int:
     if args.force and args.plot is None:
         raise UserError("--force goes with --plot PLOTDIR (it replaces figures)")
     report = fleet_drift(args.out, threshold=args.threshold, baseline=args.baseline)
-    figures = [] if args.plot is None else write_drift_figures(report, args.plot, force=args.force)
+    figures = [] if args.plot is None else fleet_figures(report, args.plot, force=args.force)
     print(report.to_json() if args.json else report.text())
     for path in figures:  # beside JSON on stdout, on stderr
         print(f"wrote {path}", file=sys.stderr if args.json else sys.stdout)

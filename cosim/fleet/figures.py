@@ -1,6 +1,6 @@
 """The fleet's drift drawn: a figure per alarmed axis, and an overview of every axis.
 
-:func:`write_drift_figures` draws a :class:`~arcosim.fleet.drift.DriftReport`
+:func:`fleet_figures` draws a :class:`~arcosim.fleet.drift.DriftReport`
 (``arcosim fleet drift DIR --plot PLOTDIR``):
 
 * ``axis-<axis>.png``, one per alarmed axis: a panel per parameter, its history by
@@ -46,14 +46,14 @@ DPI = 100
 
 
 def figure_paths(report: DriftReport, folder: str | Path) -> list[Path]:
-    """The files :func:`write_drift_figures` writes: the overview, then one per
+    """The files :func:`fleet_figures` writes: the overview, then one per
     alarmed axis, in the report's order."""
     folder = Path(folder)
     alarmed = [name for name, drift in report.axes.items() if drift.alarms]
     return [folder / OVERVIEW, *(folder / f"{AXIS_PREFIX}{name}.png" for name in alarmed)]
 
 
-def write_drift_figures(
+def fleet_figures(
     report: DriftReport, folder: str | Path, *, force: bool = False, option: str = "--plot"
 ) -> list[Path]:
     """Draw ``report`` into ``folder``: the overview and one figure per alarmed axis.
@@ -88,7 +88,7 @@ def write_drift_figures(
     >>> fit = {"axis": "a1", "status": "ok", "verdict": "trusted", "n": 1, "k[1]_std": 1e-3}
     >>> rows = [{**fit, "date": "2026-01-05", "log": "a.csv", "k[1]": 0.3},
     ...         {**fit, "date": "2026-02-05", "log": "b.csv", "k[1]": 0.264}]
-    >>> [p.name for p in write_drift_figures(drift_of(rows), "drift-figures")]
+    >>> [p.name for p in arcosim.fleet_figures(drift_of(rows), "drift-figures")]
     ['overview.png', 'axis-a1.png']
     """
     folder = check_output_folder(folder, option)
