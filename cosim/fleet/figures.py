@@ -139,7 +139,7 @@ def _axis_figure(plt, report: DriftReport, name: str) -> object:
     if structure:
         title += f"; n changed from {structure[0]['baseline']} to {structure[0]['latest']}"
     figure.suptitle(title, color="C3")
-    figure.tight_layout()
+    figure.tight_layout(rect=(0, 0, 1, 1 - 0.3 / figure.get_figheight()))  # the title's room
     return figure
 
 
