@@ -9,12 +9,13 @@
   line inside the threshold band, baseline × (1 ± threshold); a failed log as a red
   dotted line across every panel. An alarmed parameter's panel is titled with its
   change, in red.
-* ``overview.png``: a panel per axis, every parameter's change relative to the
-  axis's baseline, (x − x_baseline) / |x_baseline|, against date, with its σ band
-  (σ / |x_baseline|) and the threshold band ±threshold around 0. The alarmed
-  parameters are drawn in colour and named, the others in grey; a change off the
-  panel's scale (which the alarms set) is drawn at its edge as a triangle. An axis
-  without a trusted baseline shows its logs' dates only.
+* ``overview.png``: a panel per axis (the alarmed first), every parameter's change
+  relative to the axis's baseline, (x − x_baseline) / |x_baseline|, against date, with
+  its σ band (σ / |x_baseline|) and the threshold band ±threshold around 0. The
+  alarmed parameters are drawn in colour and named, the others in grey; a change off
+  the panel's scale (which the alarms set) is drawn at its edge as a triangle. An axis
+  without a trusted baseline shows its logs' dates only. A fleet so large that the
+  page would pass :data:`MAX_PIXELS` in height is drawn at fewer dots per inch.
 
 Matplotlib draws them with the Agg backend (no display needed); each file is written
 atomically, and an existing one only with ``force``.
@@ -43,6 +44,9 @@ COLUMNS = 4
 SCALE_THRESHOLDS = 4.0
 #: Dots per inch of every figure: a screen's, as the project's other figures.
 DPI = 100
+#: The most pixels a figure may have in height: Agg draws under 2**16; the overview of
+#: a fleet that would be taller is drawn at fewer dots per inch instead.
+MAX_PIXELS = 60_000
 
 
 def figure_paths(report: DriftReport, folder: str | Path) -> list[Path]:
@@ -106,7 +110,8 @@ def fleet_figures(
     figures += [(_axis_figure(plt, report, name), p) for name, p in zip(alarmed, paths[1:])]
     for figure, path in figures:
         try:
-            save_figure(figure, path, dpi=DPI, force=force, option=option)
+            dpi = min(DPI, MAX_PIXELS / figure.get_figheight())
+            save_figure(figure, path, dpi=dpi, force=force, option=option)
         finally:
             plt.close(figure)
     return paths
@@ -197,7 +202,7 @@ def _parameter_panel(panel, drift, parameter: str, threshold: float, alarm: Mapp
 
 def _overview(plt, report: DriftReport) -> object:
     """A panel per axis: every parameter's relative change from the axis's baseline."""
-    names = list(report.axes) or ["(no axis)"]
+    names = sorted(report.axes, key=lambda a: not report.axes[a].alarms) or ["(no axis)"]
     rows = math.ceil(len(names) / COLUMNS)
     columns = min(COLUMNS, len(names))
     figure, panels = plt.subplots(
