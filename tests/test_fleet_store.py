@@ -55,6 +55,17 @@ def test_a_torn_last_row_is_ignored_then_cut_before_the_next_append(tmp_path: Pa
     assert text.startswith(whole) and b"2.csv" not in text and text.endswith(b"\n")
 
 
+def test_a_torn_row_longer_than_one_read_is_cut_whole(tmp_path: Path) -> None:
+    from arcosim.fleet.store import _TAIL
+
+    append_store(tmp_path, row(0))
+    with open(store_path(tmp_path), "ab") as f:
+        f.write(b"a1," + b"x" * (3 * _TAIL))  # the newline is three reads back
+    append_store(tmp_path, row(1))
+    assert [r["k[1]"] for r in read_store(tmp_path)] == [0.0, 1.0]
+    assert b"xxx" not in store_path(tmp_path).read_bytes()
+
+
 def test_a_row_with_new_columns_rewrites_the_header_and_keeps_every_row(tmp_path: Path) -> None:
     append_store(tmp_path, row(0))
     append_store(tmp_path, row(1, n=2, **{"k[2]": 7.0, "k[2]_std": 1e-3}))
