@@ -42,6 +42,8 @@ COLUMNS = 4
 #: The overview's scale, in thresholds either side of 0, when no alarm sets a larger
 #: one: the threshold band and a change a few times over it stay visible.
 SCALE_THRESHOLDS = 4.0
+#: Room above an alarmed axis's panels for its title (inches): one line of its font.
+TITLE_INCHES = 0.3
 #: Dots per inch of every figure: a screen's, as the project's other figures.
 DPI = 100
 #: The most pixels a figure may have in height: Agg draws under 2**16; the overview of
@@ -144,7 +146,7 @@ def _axis_figure(plt, report: DriftReport, name: str) -> object:
     if structure:
         title += f"; n changed from {structure[0]['baseline']} to {structure[0]['latest']}"
     figure.suptitle(title, color="C3")
-    figure.tight_layout(rect=(0, 0, 1, 1 - 0.3 / figure.get_figheight()))  # the title's room
+    figure.tight_layout(rect=(0, 0, 1, 1 - TITLE_INCHES / figure.get_figheight()))
     return figure
 
 
