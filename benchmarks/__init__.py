@@ -31,7 +31,8 @@ The rows and their parts:
   (``arcosim bench control``); :mod:`benchmarks.control_margins`, the controller's margins;
   :mod:`benchmarks.bank_reach`, how far the estimator bank reaches;
 - :mod:`benchmarks.fleet_accuracy`: the fleet's drift alarms and its scaling
-  (``arcosim bench fleet``);
+  (``arcosim bench fleet``); :mod:`benchmarks.fleet_store`, the rows per second its
+  store takes (``python -m benchmarks.fleet_store``);
 - :mod:`benchmarks.public_loaders`, :mod:`benchmarks.public_figure`: the public records'
   readers and the motor bench's figure;
 - :mod:`benchmarks.sample_log`: writes the sample drive log the examples identify;

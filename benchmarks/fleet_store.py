@@ -5,7 +5,7 @@ before (the whole store rewritten through a temporary file after each log,
 :func:`arcosim.fleet.store.write_store`).
 
 The rows are those of a three-mass fit (J, k, B of each mass, D_m, f_c, each with its
-standard error; a verdict's reasons), as :mod:`benchmarks.fleet_sample`'s fleets give
+standard error; a verdict's reasons), as :mod:`benchmarks.simulators.fleet_sample`'s fleets give
 them. Both ways sync the file to disk (``fsync``), so the figures depend on the disk;
 the run prints the folder it wrote to.
 

@@ -128,7 +128,7 @@ def test_a_writer_killed_mid_run_loses_no_finished_row(tmp_path: Path) -> None:
 @pytest.mark.system
 @pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX) end the workers")
 def test_a_run_killed_mid_fleet_is_finished_by_the_next_run_alone(tmp_path: Path) -> None:
-    from benchmarks.fleet_sample import write_fleet
+    from benchmarks.simulators.fleet_sample import write_fleet
 
     fleet, out = tmp_path / "fleet", tmp_path / "out"
     write_fleet(fleet, axes=2, seconds=5.0)  # 5 logs, one of them corrupt
