@@ -176,7 +176,23 @@ def write_store(out: Path, rows: Iterable[Mapping[str, object]]) -> Path:
     write_text(path, text.getvalue(), force=True)
     units = json.dumps({c: column_unit(c) for c in columns}, indent=1) + "\n"
     write_text(units_path(path), units, force=True)
+    _sync_folder(out)
     return path
+
+
+def _sync_folder(folder: Path) -> None:
+    """Sync the folder's entries, so the renames that published the files survive a
+    power cut as the rows appended later do (POSIX; elsewhere the rename stands alone)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # a file system that cannot sync a folder: the rename stands alone
+    finally:
+        os.close(fd)
 
 
 def _header(path: Path) -> list[str] | None:
