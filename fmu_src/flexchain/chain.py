@@ -84,6 +84,18 @@ class Chain:
     f_c_std: float | None = None
 
     def __post_init__(self) -> None:
+        self._coerce()
+        self._check_shapes()
+        _sign(_labelled("J", self.J), positive=True)
+        _sign(_labelled("k", self.k), positive=True)
+        if self.J_m is not None:
+            _sign([("J_m", self.J_m)], positive=True)
+        _sign([*_labelled("B", self.B), ("D_m", self.D_m), ("f_c", self.f_c)])
+        stds = [s for p in INDEXED for s in _labelled(f"{p}_std", getattr(self, f"{p}_std"))]
+        _sign([*stds, ("D_m_std", self.D_m_std), ("f_c_std", self.f_c_std)])
+
+    def _coerce(self) -> None:
+        """Every value as a float (sequences as tuples), or a ValueError naming it."""
         for name in ("J", "k", "B", "J_std", "k_std", "B_std"):
             values = getattr(self, name)
             if isinstance(values, (str, bytes)) or not isinstance(values, Sequence):
@@ -98,6 +110,9 @@ class Chain:
             value = getattr(self, name)
             if value is not None:
                 object.__setattr__(self, name, _number(name, None, value))
+
+    def _check_shapes(self) -> None:
+        """n ≥ 1, and J, k, B (and each σ given) of n values, or a ValueError."""
         n = len(self.J)
         if n < 1:
             raise ValueError("Chain: give at least one load mass (J, k, B of length n ≥ 1)")
@@ -113,13 +128,6 @@ class Chain:
                     f"Chain: {name} has {len(getattr(self, name))} values for {n} masses: "
                     f"give one per mass (None where unknown) or none"
                 )
-        _sign(_labelled("J", self.J), positive=True)
-        _sign(_labelled("k", self.k), positive=True)
-        if self.J_m is not None:
-            _sign([("J_m", self.J_m)], positive=True)
-        _sign([*_labelled("B", self.B), ("D_m", self.D_m), ("f_c", self.f_c)])
-        stds = [s for p in INDEXED for s in _labelled(f"{p}_std", getattr(self, f"{p}_std"))]
-        _sign([*stds, ("D_m_std", self.D_m_std), ("f_c_std", self.f_c_std)])
 
     @property
     def n(self) -> int:
