@@ -213,13 +213,8 @@ def hold_discretize(A: Matrix, b: Sequence[float], h: float) -> tuple[Matrix, li
     tuple of (Matrix, list of float)
         ``F``, shape ``(m, m)``, and ``g``, shape ``(m,)``.
     """
-    m = len(A)
-    M = linalg.zeros(m + 1, m + 1)
-    for r in range(m):
-        M[r][:m] = [h * a for a in A[r]]
-        M[r][m] = h * b[r]
-    X = linalg.expm(M)
-    return [row[:m] for row in X[:m]], [row[m] for row in X[:m]]
+    F, G = linalg.hold(A, [[x] for x in b], h)
+    return F, [row[0] for row in G]
 
 
 def regulator_gain(F: Matrix, g: Sequence[float], Q: Matrix, r: float) -> list[float]:
