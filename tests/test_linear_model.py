@@ -21,7 +21,8 @@ import numpy as np
 import pytest
 
 from arcosim.fmu.flexchain import linalg, riccati
-from arcosim.fmu.flexchain.control.design import cost_weights, plant_matrices
+from arcosim.fmu.flexchain.chain import state_space
+from arcosim.fmu.flexchain.control.design import cost_weights
 from arcosim.identification.fit import linear_model
 
 EPS = float(np.finfo(float).eps)
@@ -35,7 +36,7 @@ def chains(seed: int, count: int):
         J = [10 ** rng.uniform(-5, -2) for _ in range(n)]
         k = [10 ** rng.uniform(-2, 3) for _ in range(n)]
         B = [10 ** rng.uniform(-6, -2) for _ in range(n)]
-        A, b = plant_matrices(2.09e-5, 0.0406, 2e-5, J, k, B)
+        A, b = state_space(2.09e-5, 0.0406, 2e-5, J, k, B)
         yield J, k, A, b, rng.choice([2.5e-4, 1e-3, 1e-2])
 
 

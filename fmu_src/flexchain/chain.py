@@ -141,6 +141,25 @@ class Chain:
             raise ValueError("Chain: J_m is not known: give the motor inertia (J_m)")
         return math.fsum((self.J_m, *self.J))
 
+    def state_space(self, gain: float = 1.0) -> tuple[Matrix, list[float]]:
+        """``ẋ = A x + b u`` of the motor and this chain (:func:`state_space`); needs
+        ``J_m``, and ``D_m`` (an unknown friction is taken as 0).
+
+        Parameters
+        ----------
+        gain : float
+            The motor torque per unit of u: k_t (N·m/A) for a current, 1 for a torque.
+
+        Returns
+        -------
+        tuple of (Matrix, list of float)
+            ``A``, shape ``(2n + 2, 2n + 2)``, and ``b``, shape ``(2n + 2,)``.
+        """
+        if self.J_m is None:
+            raise ValueError("Chain: J_m is not known: give the motor inertia (J_m)")
+        D_m = 0.0 if self.D_m is None else self.D_m
+        return state_space(self.J_m, gain, D_m, self.J, self.k, self.B)
+
     def parameters(self, motor: str = MOTOR_INERTIA) -> dict[str, float]:
         """The values under the FMUs' parameter names, as ``--set`` and the FMUs take them.
 
@@ -339,6 +358,55 @@ def _sign(values: Sequence[tuple[str, float | None]], positive: bool = False) ->
             raise ValueError(f"Chain: {label} = {value:g} must be > 0")
         if not value >= 0.0:
             raise ValueError(f"Chain: {label} = {value:g} must be >= 0")
+
+
+def state_space(
+    J_m: float, gain: float, D_m: float, J: Sequence[float], k: Sequence[float], B: Sequence[float]
+) -> tuple[Matrix, list[float]]:
+    """``ẋ = A x + b u`` for the motor and its chain, Coulomb friction left out: the
+    chain's one state space (the controller's design, its margins; numpy's twin with a
+    load torque and a slow load is :func:`arcosim.identification.fit.kalman.discrete_drive`).
+
+    State ``x = [θ_0 … θ_n, ω_0 … ω_n]`` (body 0 the motor; rad, rad/s).
+
+    Parameters
+    ----------
+    J_m : float
+        Motor inertia (kg·m²).
+    gain : float
+        The motor torque per unit of the input u: the torque constant k_t (N·m/A) for a
+        current, 1 for a torque (N·m).
+    D_m : float
+        Motor viscous friction (N·m·s/rad).
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape ``(n,)``.
+
+    Returns
+    -------
+    tuple of (Matrix, list of float)
+        ``A``, shape ``(2n + 2, 2n + 2)`` (1/s, 1/s²), and ``b``, shape ``(2n + 2,)``
+        (rad/s² per unit of u in the motor's row).
+
+    Examples
+    --------
+    >>> A, b = state_space(1.0, 2.0, 0.0, [1.0], [4.0], [0.0])
+    >>> A[2][:2], b[2]  # the motor's acceleration: −k (θ_0 − θ_1) / J_m, gain / J_m
+    ([-4.0, 4.0], 2.0)
+    """
+    n = len(J)
+    m = n + 1
+    inertia = [J_m, *J]
+    Ks, Cs = spring_matrix(k), spring_matrix(B)
+    Cs[0][0] += D_m
+    A = zeros(2 * m, 2 * m)
+    for i in range(m):
+        A[i][m + i] = 1.0
+        for j in range(m):
+            A[m + i][j] = -Ks[i][j] / inertia[i]
+            A[m + i][m + j] = -Cs[i][j] / inertia[i]
+    b = [0.0] * (2 * m)
+    b[m] = gain / J_m
+    return A, b
 
 
 def spring_matrix(gains: Sequence[float]) -> Matrix:

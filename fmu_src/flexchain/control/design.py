@@ -162,40 +162,6 @@ class ControllerDesign:
         return x, -d / self.k_t
 
 
-def plant_matrices(
-    J_m: float, k_t: float, D_m: float, J: Sequence[float], k: Sequence[float], B: Sequence[float]
-) -> tuple[Matrix, list[float]]:
-    """``ẋ = A x + b i`` for the motor and its chain, Coulomb friction left out.
-
-    Parameters
-    ----------
-    J_m, k_t, D_m : float
-        Motor inertia (kg·m²), torque constant (N·m/A), viscous friction (N·m·s/rad).
-    J, k, B : Sequence[float]
-        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape ``(n,)``.
-
-    Returns
-    -------
-    tuple of (Matrix, list of float)
-        ``A``, shape ``(2n + 2, 2n + 2)`` (1/s, 1/s²), and ``b``, shape ``(2n + 2,)``
-        (rad/s² per A in the motor's row).
-    """
-    n = len(J)
-    m = n + 1
-    inertia = [J_m, *J]
-    Ks, Cs = spring_matrix(k), spring_matrix(B)
-    Cs[0][0] += D_m
-    A = linalg.zeros(2 * m, 2 * m)
-    for i in range(m):
-        A[i][m + i] = 1.0
-        for j in range(m):
-            A[m + i][j] = -Ks[i][j] / inertia[i]
-            A[m + i][m + j] = -Cs[i][j] / inertia[i]
-    b = [0.0] * (2 * m)
-    b[m] = k_t / J_m
-    return A, b
-
-
 def hold_discretize(A: Matrix, b: Sequence[float], h: float) -> tuple[Matrix, list[float]]:
     """``x ← F x + g u`` for ``ẋ = A x + b u`` with u held over a step of ``h`` s.
 
@@ -412,7 +378,7 @@ def design_controller(
     if not (math.isfinite(hold_dither) and hold_dither >= 0.0):
         raise ValueError(f"parameter hold_dither = {hold_dither!r} counts must be ≥ 0 (0 = off)")
     J_m, D_m = chain.J_m, chain.D_m
-    A, b = plant_matrices(J_m, k_t, D_m, J, k, B)
+    A, b = chain.state_space(k_t)
     F, g = hold_discretize(A, b, h)
     grow = math.exp(DECAY_RATIO * wc * h)
     Q = cost_weights(J_m, k_t, J, k, L, wc)
