@@ -14,7 +14,8 @@ Drive logs
 read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
-read_chain          -- the chain (J_i, k_i, B_i) of a whole-chain report file
+read_chain          -- the Chain of a whole-chain report file
+Chain               -- a chain's values: n, J_m, every J_i, k_i, B_i, the friction, σ where known
 
 Identifying the drive from a log (numpy/scipy, no FMU needed)
 -------------------------------------------------------------
@@ -125,6 +126,7 @@ _API = {
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
     "read_chain": "arcosim.chainfile",
+    "Chain": "arcosim.fmu.flexchain.chain",
     "identify_drive": "arcosim.identification.drive_identification",
     "DriveIdentification": "arcosim.identification.drive_identification",
     "Verdict": "arcosim.identification.checks.verdict",

@@ -3,9 +3,11 @@
 ``arcosim identify LOG.csv --method whole-chain --out chain.json`` (or ``--json``) writes
 every load inertia ``J[i]``, stiffness ``k[i]`` and damping ``B[i]`` under the observer's
 own parameter names, with ``masses`` and, when fitted, the motor friction ``D_m``,
-``f_c``. :func:`read_chain` reads those values back (``arcosim identify --method
-load-torque --chain chain.json`` does), ignoring the rest of the report (standard
-errors, evidence, assumptions).
+``f_c``, and their standard errors under ``std``. :func:`read_chain` reads those values
+back as a :class:`~arcosim.fmu.flexchain.chain.Chain` (``arcosim identify --method
+load-torque --chain chain.json`` does), ignoring the rest of the report (evidence,
+assumptions); a chain's :meth:`~arcosim.fmu.flexchain.chain.Chain.to_json` writes the
+same keys.
 """
 
 from __future__ import annotations
@@ -17,34 +19,37 @@ from pathlib import Path
 
 from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.chain import INDEXED, Chain
 from arcosim.logs import read_text_file
 
 #: The chain's parameters, ``J[i]``, ``k[i]``, ``B[i]``, by their name before ``[``.
-CHAIN_PARAMETERS = ("J", "k", "B")
-#: The other values a chain file may carry: the number of masses and the motor friction.
-OTHER_VALUES = ("masses", "D_m", "f_c")
+CHAIN_PARAMETERS = INDEXED
+#: The other values a chain file may carry: the number of masses, the motor inertia and
+#: friction.
+OTHER_VALUES = ("masses", "J_m", "D_m", "f_c")
 
 
 class ChainFileError(UserError):
     """A chain file that is not a JSON object of finite numbers with every J[i], k[i], B[i]."""
 
 
-def read_chain(path: str | Path) -> dict[str, float]:
+def read_chain(path: str | Path) -> Chain:
     """The chain of a whole-chain report: ``J[i]``, ``k[i]``, ``B[i]`` and ``masses``.
 
     Parameters
     ----------
     path : str or Path
         A UTF-8 JSON file holding one object, as ``arcosim identify --method whole-chain
-        --out FILE.json`` writes it: ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]``
-        (N·m·s/rad) for i = 1 … n, and optionally ``masses`` (n, a count) and the motor
-        friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m). Other keys are ignored.
+        --out FILE.json`` (or :meth:`Chain.to_json <arcosim.fmu.flexchain.chain.Chain.to_json>`)
+        writes it: ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad) for i = 1 …
+        n, and optionally ``masses`` (n, a count), the motor inertia ``J_m`` (kg·m²), the
+        motor friction ``D_m`` (N·m·s/rad), ``f_c`` (N·m) and ``std``, their standard
+        errors by the same names. Other keys are ignored.
 
     Returns
     -------
-    dict of str to float
-        The values kept, as floats in SI units under the observer's parameter names, in
-        the file's order, and ``masses`` (n, an int; counted from the ``J[i]`` when the
+    Chain
+        The values, copied exactly; n from ``masses`` (counted from the ``J[i]`` when the
         file does not give it).
 
     Raises
@@ -52,10 +57,11 @@ def read_chain(path: str | Path) -> dict[str, float]:
     ChainFileError
         When the file is not JSON, not an object, a value is not a finite number, or
         ``masses`` is not a whole number or not a supported number of masses (1 to
-        20), or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing, or a ``J[i]`` or ``k[i]`` is
-        not positive or a ``B[i]``, ``D_m`` or ``f_c`` negative, or ``masses = 0`` beside
-        ``J[i]``, or the report is a rigid drive's (masses = 0: the message gives the ``--set``
-        for the observer instead), or it holds no ``J[i]`` at all (an output-error
+        20), or a ``J[i]``, ``k[i]`` or ``B[i]`` is missing, or a ``J[i]``, ``k[i]`` or
+        ``J_m`` is not positive or a ``B[i]``, ``D_m`` or ``f_c`` negative, or ``masses =
+        0`` beside ``J[i]``, or a standard error is not a number ≥ 0, or the report is a
+        rigid drive's (masses = 0: the message gives the ``--set`` for the observer
+        instead), or it holds no ``J[i]`` at all (an output-error
         report: the message names the whole-chain fit that writes a chain); the message
         starts with the file's name.
     UserError
@@ -69,8 +75,9 @@ def read_chain(path: str | Path) -> dict[str, float]:
     >>> path = Path(tempfile.mkdtemp()) / "chain.json"
     >>> report = {"J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3, "std": {"J[1]": 1e-6}}
     >>> _ = path.write_text(json.dumps(report))
-    >>> arcosim.read_chain(path)
-    {'J[1]': 0.0001, 'k[1]': 50.0, 'B[1]': 0.001, 'masses': 1}
+    >>> chain = arcosim.read_chain(path)
+    >>> chain.n, chain.J, chain.k, chain.B, chain.J_std
+    (1, (0.0001,), (50.0,), (0.001,), (1e-06,))
     """
     path = Path(path)
     try:
@@ -79,8 +86,7 @@ def read_chain(path: str | Path) -> dict[str, float]:
         raise ChainFileError(f"{path}: cannot read it as JSON ({error})") from None
     if not isinstance(data, dict):
         raise ChainFileError(f"{path}: expected a JSON object with J[i], k[i], B[i]")
-    # a report written with --tool-names: J_1 for J[1]
-    data = {re.sub(r"^([JkB])_(\d+)$", r"\1[\2]", k): v for k, v in data.items()}
+    data = _bracketed(data)
     chain = {k: v for k, v in data.items() if _is_chain_value(k)}
     for key, value in chain.items():
         _check_number(path, key, value)
@@ -116,7 +122,16 @@ def read_chain(path: str | Path) -> dict[str, float]:
         raise ChainFileError(f"{path}: missing {', '.join(missing)}")
     for key, value in chain.items():
         _check_sign(path, key, value)
-    return {**{k: float(v) for k, v in chain.items()}, "masses": n}
+    std = _bracketed(data["std"]) if isinstance(data.get("std"), dict) else {}
+    try:
+        return Chain.from_json({**chain, "masses": n, "std": std})
+    except ValueError as error:  # a standard error that is not a number >= 0
+        raise ChainFileError(f"{path}: std: {str(error).removeprefix('Chain: ')}") from None
+
+
+def _bracketed(data: dict) -> dict:
+    """A report written with ``--tool-names`` under the observer's names: J_1 as J[1]."""
+    return {re.sub(r"^([JkB])_(\d+)$", r"\1[\2]", k): v for k, v in data.items()}
 
 
 def _no_chain(data: dict) -> str:
@@ -150,6 +165,8 @@ def _check_sign(path: Path, key: str, value: float) -> None:
     damping or friction below zero."""
     name = key.split("[")[0]
     if name in ("J", "k") and not value > 0:
+        raise ChainFileError(f"{path}: {key} = {value:g} must be > 0")
+    if name == "J_m" and not value > 0:
         raise ChainFileError(f"{path}: {key} = {value:g} must be > 0")
     if name in ("B", "D_m", "f_c") and not value >= 0:
         raise ChainFileError(f"{path}: {key} = {value:g} must be >= 0")

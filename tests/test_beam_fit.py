@@ -108,7 +108,7 @@ def test_identify_method_beam_json_and_out(capsys, tmp_path):
     assert report["modes_rad_s"][0] == pytest.approx(case.modes(1).frequency[0], rel=0.01)
     assert {"EI", "rhoA"} <= set(report["std"]) and "model" in report["assumptions"]
     chain = read_chain(report_file)
-    assert chain["masses"] == report["equivalent_chain"]["masses"] >= 2
+    assert chain.n == report["equivalent_chain"]["masses"] >= 2
     states = tmp_path / "tip.csv"
     code = main(["identify", str(path), *given, "--method", "beam", "--out", str(states)])
     assert code == 0

@@ -11,6 +11,7 @@ import pytest
 
 from arcosim.chainfile import read_chain
 from arcosim.cli import main
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.logs import (
     DriveLog,
     read_log,
@@ -73,7 +74,7 @@ def test_a_chain_report_with_tool_names_is_still_a_chain(tmp_path: Path) -> None
     path = tmp_path / "chain.json"
     report = {"J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3, "masses": 1, "std": {"J[1]": 1e-6}}
     path.write_text(json.dumps(tool_keys(report)))
-    assert read_chain(path) == {"J[1]": 1e-4, "k[1]": 50.0, "B[1]": 1e-3, "masses": 1}
+    assert read_chain(path) == Chain(J=(1e-4,), k=(50.0,), B=(1e-3,), J_std=(1e-6,))
 
 
 def test_excite_writes_units_and_tool_names(tmp_path: Path, capsys) -> None:

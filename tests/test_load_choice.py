@@ -56,7 +56,7 @@ def test_an_unmodelled_slow_load_is_chosen_fitted_and_said(slow_load_log) -> Non
     assert "chosen by the selection rule" in result.assumptions["load"]
     assert any("chosen by the selection rule" in w for w in result.warnings), result.warnings
     assert result.masses == 3
-    chain = result.chain()
+    chain = result.chain.parameters()
     truth = dict(zip([f"{p}[{i}]" for p in "Jk" for i in (1, 2, 3)], d.J + d.k))
     errors = {name: chain[name] / t - 1.0 for name, t in truth.items()}
     assert max(abs(e) for e in errors.values()) < 5e-3, errors

@@ -14,13 +14,13 @@ import pytest
 import scipy.linalg
 
 from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.chain import state_space
 from arcosim.fmu.flexchain.control.controller import shaped_step
 from arcosim.fmu.flexchain.control.design import (
     DECAY_RATIO,
     design_controller,
     goals,
     hold_discretize,
-    plant_matrices,
     regulator_gain,
 )
 from arcosim.fmu.flexchain.riccati import solve_doubling
@@ -35,7 +35,7 @@ FOUR = {key: getattr(CHAINS[-1], key) for key in ("J", "k", "B")}
 
 def _true_loop(design, chain: dict) -> np.ndarray:
     """``F − g K`` of the plant ``chain`` under the design's gain (full state)."""
-    A, b = plant_matrices(
+    A, b = state_space(
         ACTUATOR["J_m"], ACTUATOR["k_t"], ACTUATOR["D_m"], chain["J"], chain["k"], chain["B"]
     )
     F, g = hold_discretize(A, b, H)

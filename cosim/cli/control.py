@@ -26,6 +26,7 @@ from arcosim.control.margins import controller_margins
 from arcosim.control.model_errors import ERROR, RANDOM_MODELS
 from arcosim.errors import UserError
 from arcosim.fmu.arcontroller.fmu import ActionReactionController
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.defaults import STEP
 from arcosim.host.overrides import check_name, parse_assignment, typed_value
 
@@ -101,7 +102,7 @@ arcosim control --masses 2 --set move_time=0.8 --json""",
 
 
 def _execute(args: argparse.Namespace) -> int:
-    chain = chain_option(args.chain) if args.chain else {}
+    chain = chain_option(args.chain) if args.chain else None
     n = _masses(args, chain)
     assignments = [*chain_assignments(chain, args.set), *args.set]
     values = controller_parameters(n, assignments)
@@ -142,13 +143,12 @@ def _status(n: int) -> None:
     )
 
 
-def _masses(args: argparse.Namespace, chain: dict[str, float]) -> int:
-    """n from the chain file (removed from it), else ``--masses``, else 3; refuse both
-    disagreeing."""
+def _masses(args: argparse.Namespace, chain: Chain | None) -> int:
+    """n from the chain file, else ``--masses``, else 3; refuse both disagreeing."""
     given = None if args.masses is None else masses_option(args.masses)
-    if not chain:
+    if chain is None:
         return 3 if given is None else given
-    n = int(chain.pop("masses"))
+    n = chain.n
     if given is not None and given != n:
         raise UserError(f"--masses {given} but --chain {args.chain} holds {n}: give one of them")
     return n

@@ -13,11 +13,11 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from arcosim.fmu.flexchain.chain import state_space
 from arcosim.fmu.flexchain.control.design import (
     ControllerDesign,
     hold_discretize,
     indexed_values,
-    plant_matrices,
 )
 
 #: Frequencies the loop gain is evaluated at, log-spaced up to Nyquist (a count).
@@ -68,7 +68,7 @@ def closed_loop(design: ControllerDesign, truth: Mapping[str, float] | None = No
         F, g = np.array(design.F), np.array(design.g)
     else:
         J, k, B = (indexed_values(truth, name) for name in ("J", "k", "B"))
-        A, b = plant_matrices(truth["J_mo"], truth["k_to"], truth["D_m"], J, k, B)
+        A, b = state_space(truth["J_mo"], truth["k_to"], truth["D_m"], J, k, B)
         F_, g_ = hold_discretize(A, b, design.h)
         F, g = np.array(F_), np.array(g_)
     return F - np.outer(g, design.K)

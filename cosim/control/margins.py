@@ -20,6 +20,7 @@ import numpy as np
 from arcosim.control import full_state
 from arcosim.control.model_errors import ERROR, RANDOM_MODELS, ModelError, model_errors
 from arcosim.control.sensorless_loop import sensorless_decay
+from arcosim.fmu.flexchain.chain import state_space
 from arcosim.fmu.flexchain.control import design as control_design
 from arcosim.fmu.flexchain.control.controller import REFERENCE_SHARE, shaped_step
 from arcosim.fmu.flexchain.control.design import (
@@ -27,7 +28,6 @@ from arcosim.fmu.flexchain.control.design import (
     design_controller,
     goals,
     indexed_values,
-    plant_matrices,
 )
 
 #: Smaller errors tried, in turn, when the loop is not stable at the error asked for.
@@ -431,7 +431,7 @@ def _check_step(params: Mapping[str, float], h: float, move_time: float, bandwid
         )
     J, k, B = (indexed_values(params, name) for name in ("J", "k", "B"))
     try:
-        A, _ = plant_matrices(params["J_mo"], params["k_to"], params["D_m"], J, k, B)
+        A, _ = state_space(params["J_mo"], params["k_to"], params["D_m"], J, k, B)
         fastest = float(np.abs(np.linalg.eigvals(np.array(A))).max())
     except (ArithmeticError, ValueError, np.linalg.LinAlgError, ZeroDivisionError):
         return  # the design names what is wrong with the chain
@@ -445,6 +445,6 @@ def _check_step(params: Mapping[str, float], h: float, move_time: float, bandwid
 
 def _modes(design: ControllerDesign) -> tuple[float, ...]:
     """The chain's modes with the motor free (rad/s), ascending."""
-    A, _ = plant_matrices(design.J_m, design.k_t, design.D_m, design.J, design.k, design.B)
+    A, _ = state_space(design.J_m, design.k_t, design.D_m, design.J, design.k, design.B)
     ev = np.linalg.eigvals(np.array(A))
     return tuple(sorted({round(float(abs(e)), 3) for e in ev if abs(e.imag) > 1e-6}))

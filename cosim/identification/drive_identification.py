@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.checks.log_decision import LogDecision, decide_log
 from arcosim.identification.checks.noise_floor import (
@@ -79,8 +80,8 @@ class DriveIdentification:
     >>> from arcosim.identification.drive_identification import DriveIdentification
     >>> result = DriveIdentification(1, {"J[1]": 1e-3, "k[1]": 0.5, "B[1]": 1e-4},
     ...                              {"J[1]": 2e-6, "k[1]": 1e-3, "B[1]": 3e-6}, {})
-    >>> result.chain()["k[1]"], result.std["k[1]"]  # N·m/rad
-    (0.5, 0.001)
+    >>> result.chain.k, result.chain.k_std  # N·m/rad
+    ((0.5,), (0.001,))
     """
 
     masses: int
@@ -93,9 +94,18 @@ class DriveIdentification:
     friction: dict[str, float] = field(default_factory=dict)
     verdict: Verdict = field(default_factory=Verdict)
 
-    def chain(self) -> dict[str, float]:
-        """``J[i]``, ``k[i]``, ``B[i]`` only: the chain's parameters, by the observer's names."""
-        return {k: v for k, v in self.parameters.items() if k[0] in "JkB" and "[" in k}
+    @property
+    def chain(self) -> Chain | None:
+        """The identified chain: every J_i, k_i, B_i and the motor friction the result
+        rests on, with their standard errors; None for a rigid drive (n = 0).
+
+        The motor inertia ``J_m`` is not in it: it was given (the datasheet's), not
+        identified. Written as the report (:meth:`report`) and read back
+        (:func:`arcosim.read_chain`), it is this chain again.
+        """
+        if self.masses == 0 or RIGID_LOAD in self.parameters:
+            return None
+        return Chain.from_parameters({**self.friction, **self.parameters}, self.std, self.masses)
 
     def observer_parameters(self) -> dict[str, float]:
         """The observer FMU's parameters that estimate every load angle with this chain.
@@ -116,7 +126,7 @@ class DriveIdentification:
         """
         if RIGID_LOAD in self.parameters:  # a rigid drive: its load is motor inertia
             return {"dJm": self.parameters[RIGID_LOAD], **self.friction}
-        return {**self.chain(), **self.friction, "estimator": 1}
+        return {**self.chain.parameters(), "estimator": 1}
 
     def report(self) -> dict[str, object]:
         """Everything, JSON-able (what ``arcosim identify --json`` prints)."""

@@ -13,8 +13,9 @@ Settings
 Foundations
 
 * :mod:`~arcosim.fmu.flexchain.linalg` — small dense matrices as lists of lists, the
-  matrix exponential.
-* :mod:`~arcosim.fmu.flexchain.chain` — the motor–spring–mass chain as a linear model.
+  matrix exponential and the zero-order hold.
+* :mod:`~arcosim.fmu.flexchain.chain` — the motor–spring–mass chain: its values
+  (``Chain``) and its linear model.
 * :mod:`~arcosim.fmu.flexchain.driven_chain` — the load chain driven by the motor angle,
   exact over each step.
 * :mod:`~arcosim.fmu.flexchain.filters` — G(s) = g/(s + g), exact for the step taken.

@@ -173,3 +173,44 @@ def expm(a: Matrix) -> Matrix:
     for _ in range(s):
         e = matmul(e, e)
     return e
+
+
+def hold(A: Matrix, E: Matrix, h: float) -> tuple[Matrix, Matrix]:
+    """The zero-order hold: ``s ← F s + Γ w`` for ``ṡ = A s + E w`` with w held over a step.
+
+    ``F = e^{A h}`` and its input integral ``Γ = ∫_0^h e^{A t} dt · E`` from one matrix
+    exponential of the augmented ``[[A h, E h], [0, 0]]`` (Van Loan 1978); the one
+    pure-Python home of the hold (numpy's:
+    :func:`arcosim.identification.fit.linear_model.hold`).
+
+    Parameters
+    ----------
+    A : Matrix
+        Shape ``(m, m)``, per second (1/s, 1/s², …).
+    E : Matrix
+        Shape ``(m, p)``, the state's rate per unit of each input.
+    h : float
+        Step (s). Give 1 when ``A`` and ``E`` carry the step already (``A h``, ``E h``):
+        the products by 1 are exact.
+
+    Returns
+    -------
+    tuple of (Matrix, Matrix)
+        ``F``, shape ``(m, m)`` (dimensionless), and ``Γ``, shape ``(m, p)`` (the state's
+        unit per unit of input).
+
+    Examples
+    --------
+    A rigid body (θ, ω) under a torque held for 0.1 s: Γ = [h²/2, h].
+
+    >>> F, G = hold([[0.0, 1.0], [0.0, 0.0]], [[0.0], [1.0]], 0.1)
+    >>> F[0][1], [round(g[0], 15) for g in G]
+    (0.1, [0.005, 0.1])
+    """
+    m, p = len(A), len(E[0])
+    M = zeros(m + p, m + p)
+    for r in range(m):
+        M[r][:m] = [h * a for a in A[r]]
+        M[r][m:] = [h * e for e in E[r]]
+    X = expm(M)
+    return [row[:m] for row in X[:m]], [row[m:] for row in X[:m]]

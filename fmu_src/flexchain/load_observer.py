@@ -111,12 +111,11 @@ def load_column(
     A, _ = continuous_matrices(J, k, B)
     m = len(A)
     n = m // 2
-    M = linalg.zeros(m + 1, m + 1)
-    for r in range(m):
-        M[r][:m] = [h * a for a in A[r]]
-    M[n + load_mass - 1][m] = h / J[load_mass - 1]
-    X = linalg.expm(M)
-    return [X[r][m] for r in range(m)]
+    Ah = [[h * a for a in row] for row in A]
+    Eh = [[0.0] for _ in range(m)]
+    Eh[n + load_mass - 1][0] = h / J[load_mass - 1]  # h / J_L as it was: not h · (1 / J_L)
+    _, G = linalg.hold(Ah, Eh, 1.0)
+    return [row[0] for row in G]
 
 
 @dataclass(frozen=True)
@@ -145,13 +144,9 @@ def smoothing_filter(bandwidth: float, h: float) -> tuple[Matrix, list[float]]:
         state z = [value, rate] and the input u held over the step.
     """
     w = bandwidth
-    M = [
-        [0.0, h, 0.0],
-        [-w * w * h, -math.sqrt(2.0) * w * h, w * w * h],
-        [0.0, 0.0, 0.0],
-    ]
-    X = linalg.expm(M)
-    return [X[0][:2], X[1][:2]], [X[0][2], X[1][2]]
+    Ah = [[0.0, h], [-w * w * h, -math.sqrt(2.0) * w * h]]  # the step in, as it was
+    Phi, G = linalg.hold(Ah, [[0.0], [w * w * h]], 1.0)
+    return Phi, [row[0] for row in G]
 
 
 def smooth(Phi: Matrix, phi: Sequence[float], z: Sequence[float], u: float) -> list[float]:

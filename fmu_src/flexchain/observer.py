@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 from . import defaults
+from .chain import Chain
 from .codes import ESTIMATOR_NAMES, MODE_NAMES, Estimator, Mode, choice_problem
 from .dob import Actuator, ReactionObserver
 from .link_observer import LinkObserver, StarLink
@@ -103,6 +104,76 @@ class ObserverSettings:
     load_mass: int = defaults.LOAD_MASS
     load_torque_bandwidth: float = defaults.LOAD_TORQUE_BANDWIDTH
     link: StarLink | None = None
+
+    @classmethod
+    def for_chain(
+        cls,
+        chain: Chain,
+        *,
+        k_to: float | None = None,
+        actuator: Actuator | None = None,
+        mode: int = defaults.MODE,
+        g_dist: float = defaults.G_DIST,
+        g_lpf: float = defaults.G_LPF,
+        **settings: object,
+    ) -> ObserverSettings:
+        """The settings that observe a chain: its J, k, B and its motor.
+
+        Parameters
+        ----------
+        chain : Chain
+            The chain; its ``J_m`` (kg·m²), ``D_m`` (N·m·s/rad) and ``f_c`` (N·m) are
+            the actuator's nominal inertia and friction unless ``actuator`` is given
+            (an unknown friction is taken as 0).
+        k_to : float or None
+            The nominal torque constant (N·m/A); needed unless ``actuator`` is given.
+        actuator : Actuator or None
+            The actuator's terms as they are (J_mo, k_to, Δk_t, ΔJ, D_m, f_c), in place
+            of the chain's motor; None: from the chain and ``k_to``.
+        mode : int
+            A :class:`~arcosim.fmu.flexchain.codes.Mode` (an index).
+        g_dist, g_lpf : float
+            The DOB's and the recursion filter's bandwidths (rad/s).
+        **settings
+            Any other field of :class:`ObserverSettings` (``estimator``, ``encoder_cpr``,
+            the noise levels, ``load_mass`` …).
+
+        Returns
+        -------
+        ObserverSettings
+            The settings; their :attr:`chain` is ``chain`` without its standard errors.
+
+        Raises
+        ------
+        ValueError
+            Without ``actuator``, when ``k_to`` is not given or the chain's ``J_m`` is
+            not known.
+
+        Examples
+        --------
+        >>> chain = arcosim.Chain(J=(1e-3,), k=(0.5,), B=(1e-4,), J_m=2.09e-5, D_m=0.0, f_c=0.0)
+        >>> settings = arcosim.ObserverSettings.for_chain(chain, k_to=0.0406, estimator=1)
+        >>> settings.chain == chain, settings.actuator.J_mo  # kg·m²
+        (True, 2.09e-05)
+        """
+        if actuator is None:
+            if k_to is None or chain.J_m is None:
+                raise ValueError(
+                    "give the motor: k_to (N·m/A) and a chain with J_m, or an actuator"
+                )
+            friction = {name: getattr(chain, name) or 0.0 for name in ("D_m", "f_c")}
+            actuator = Actuator(J_mo=chain.J_m, k_to=k_to, **friction)
+        return cls(mode, actuator, g_dist, g_lpf, chain.J, chain.k, chain.B, **settings)
+
+    @property
+    def chain(self) -> Chain | None:
+        """The chain observed: J, k, B, the motor inertia J_mo + ΔJ (kg·m²) and the
+        friction D_m (N·m·s/rad), f_c (N·m); None without load masses (a link's modes
+        alone)."""
+        if not self.J:
+            return None
+        a = self.actuator
+        return Chain(self.J, self.k, self.B, J_m=a.J_mo + a.dJm, D_m=a.D_m, f_c=a.f_c)
 
     def angle_offset(self) -> float:
         """Half a count of the encoder.

@@ -24,7 +24,7 @@ import math
 from collections.abc import Sequence
 
 from ...fmu.flexchain.chain import spring_matrix
-from ...fmu.flexchain.linalg import Matrix, Vector, expm, zeros
+from ...fmu.flexchain.linalg import Matrix, Vector, hold, zeros
 
 _MAX_EVENTS_PER_STEP = 16
 _CACHE_SIZE = 16
@@ -190,7 +190,7 @@ class PlantPhysics:
             if len(self._cache) >= _CACHE_SIZE:
                 self._cache.clear()
             a, b = (self.a_stuck, self.b_stuck) if stuck else (self.a, self.b)
-            found = _zoh(a, b, tau)
+            found = hold(a, b, tau)
             self._cache[key] = found
         return found
 
@@ -260,17 +260,6 @@ def _continuous_matrices(
     a[q_tau][0], a[q_tau][1] = k[0], -k[0]
     a[q_tau][n + 1], a[q_tau][n + 2] = B[0], -B[0]
     return a, b
-
-
-def _zoh(a: Matrix, b: Matrix, tau: float) -> tuple[Matrix, Matrix]:
-    """Exact zero-order-hold discretization: Φ = e^{Aτ}, Γ = ∫₀^τ e^{As} ds B."""
-    size, m = len(a), len(b[0])
-    big = zeros(size + m, size + m)
-    for r in range(size):
-        big[r][:size] = [tau * p for p in a[r]]
-        big[r][size:] = [tau * q for q in b[r]]
-    e = expm(big)
-    return [row[:size] for row in e[:size]], [row[size:] for row in e[:size]]
 
 
 def _hermite(y0: float, d0: float, y1: float, d1: float, tau: float, s: float) -> float:

@@ -224,7 +224,7 @@ def _execute(args: argparse.Namespace) -> int:
             "--chain is for the methods that use a chain (observer, output-error, "
             f"load-torque); --method {args.method} fits it"
         )
-    chain = chain_option(args.chain) if args.chain else {}
+    chain = chain_option(args.chain) if args.chain else None
     log = read_log(args.log, parse_scales(args.scale))
     if args.method == "beam":
         return run_beam(args, log)
@@ -234,7 +234,7 @@ def _execute(args: argparse.Namespace) -> int:
         text = (args.masses or "auto").strip()
         masses = {"auto": "auto", "0": 0}.get(text)
         return run_whole_chain(args, log, masses if masses is not None else masses_option(text))
-    n = int(chain.pop("masses")) if chain else masses_option(args.masses or "3")
+    n = chain.n if chain else masses_option(args.masses or "3")
     args.set = chain_assignments(chain, args.set) + list(args.set)  # --set wins
     if args.method == "load-torque":
         return run_load_torque(args, log, n)

@@ -19,6 +19,7 @@ from arcosim.cli.parameters import (
     set_names,
 )
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.codes import Estimator, Mode
 from arcosim.fmu.flexchain.observer import ObserverSettings
 from arcosim.identification import load_torque
@@ -91,14 +92,16 @@ def _settings(values: dict[str, float], n: int) -> ObserverSettings:
             f"--method load-torque needs the load mass: --set load_mass=I with I in 1 … {n} "
             f"(got {load_mass})"
         )
-    settings = ObserverSettings(
-        mode=Mode.STATE_ESTIMATION,
+    try:
+        chain = Chain.from_parameters(values, n=n)
+    except ValueError as error:
+        raise UserError(str(error).removeprefix("Chain: ")) from None
+    settings = ObserverSettings.for_chain(
+        chain,
         actuator=actuator_of(values),
+        mode=Mode.STATE_ESTIMATION,
         g_dist=values["g_dist"],
         g_lpf=values["g_lpf"],
-        J=tuple(values[f"J[{i}]"] for i in range(1, n + 1)),
-        k=tuple(values[f"k[{i}]"] for i in range(1, n + 1)),
-        B=tuple(values[f"B[{i}]"] for i in range(1, n + 1)),
         estimator=Estimator.MODEL_BASED,
         encoder_cpr=int(values["encoder_cpr"]),
         torque_noise_std=values["torque_noise_std"],
@@ -106,9 +109,6 @@ def _settings(values: dict[str, float], n: int) -> ObserverSettings:
         load_mass=load_mass,
         load_torque_bandwidth=values["load_torque_bandwidth"],
     )
-    for name in ("J", "k"):
-        if any(not x > 0 for x in getattr(settings, name)):
-            raise UserError(f"every {name}[i] must be > 0, got {getattr(settings, name)}")
     if not settings.load_torque_bandwidth > 0:
         raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
     return settings

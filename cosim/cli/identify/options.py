@@ -16,6 +16,7 @@ from arcosim.build.recipes import check_masses
 from arcosim.chainfile import ChainFileError, read_chain
 from arcosim.cli.parameters import set_names
 from arcosim.errors import UserError
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.logs import tool_keys
 from arcosim.outputs import check_output, write_text
 
@@ -49,7 +50,7 @@ def check_method_options(args: argparse.Namespace) -> None:
     if args.mode is not None and args.method != "observer":
         raise UserError(f"--mode is for --method observer (not {args.method})")
     if args.chain and args.masses is not None and args.method not in ("whole-chain", "beam"):
-        n = chain_option(args.chain)["masses"]
+        n = chain_option(args.chain).n
         if masses_option(args.masses) != n:
             raise UserError(
                 f"--masses {args.masses} but --chain {args.chain} holds {n}: give one of them"
@@ -88,7 +89,7 @@ def masses_option(text: str) -> int:
     return check_masses(n)
 
 
-def chain_option(path: Path) -> dict[str, float]:
+def chain_option(path: Path) -> Chain:
     """``--chain FILE``: the chain of a whole-chain report (:func:`arcosim.read_chain`).
 
     Parameters
@@ -98,9 +99,9 @@ def chain_option(path: Path) -> dict[str, float]:
 
     Returns
     -------
-    dict of str to float
-        ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad), ``masses`` (a
-        count) and, when there, ``D_m`` (N·m·s/rad) and ``f_c`` (N·m).
+    Chain
+        The file's chain: n, every ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad), ``B[i]``
+        (N·m·s/rad) and, when there, ``D_m`` (N·m·s/rad) and ``f_c`` (N·m).
 
     Raises
     ------
@@ -114,14 +115,14 @@ def chain_option(path: Path) -> dict[str, float]:
         raise UserError(f"--chain {error}") from None
 
 
-def chain_assignments(chain: Mapping[str, float], assignments: Sequence[str]) -> list[str]:
+def chain_assignments(chain: Chain | None, assignments: Sequence[str]) -> list[str]:
     """The ``--set`` assignments of a chain's values that ``assignments`` do not give.
 
     Parameters
     ----------
-    chain : mapping of str to float
-        The chain of :func:`chain_option` without ``masses``: ``J[i]`` (kg·m²),
-        ``k[i]`` (N·m/rad), ``B[i]`` (N·m·s/rad), ``D_m`` (N·m·s/rad), ``f_c`` (N·m).
+    chain : Chain or None
+        The chain of :func:`chain_option`, set as the observer's and the controller's
+        parameters (:meth:`~arcosim.fmu.flexchain.chain.Chain.parameters`); None: none.
     assignments : sequence of str
         The user's ``--set`` texts, which win.
 
@@ -132,11 +133,14 @@ def chain_assignments(chain: Mapping[str, float], assignments: Sequence[str]) ->
 
     Examples
     --------
-    >>> chain_assignments({"J[1]": 3e-4, "k[1]": 0.45}, ["k[1]=0.5"])
-    ['J[1]=0.0003']
+    >>> from arcosim.fmu.flexchain.chain import Chain
+    >>> chain_assignments(Chain(J=(3e-4,), k=(0.45,), B=(1e-4,)), ["k[1]=0.5"])
+    ['J[1]=0.0003', 'B[1]=0.0001']
     """
+    if chain is None:
+        return []
     given = set_names(assignments)
-    return [f"{name}={value!r}" for name, value in chain.items() if name not in given]
+    return [f"{name}={value!r}" for name, value in chain.parameters().items() if name not in given]
 
 
 def check_out(args: argparse.Namespace, fmus: Sequence[Path]) -> None:

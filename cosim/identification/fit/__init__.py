@@ -3,6 +3,8 @@ the chain's parameters fitted to a record, and its structure chosen.
 
 Modules:
 
+linear_model    -- the linear-model numerics on numpy: expm, the zero-order hold, the
+                   Riccati equation by doubling (the FMU package's, on numpy)
 newey_west      -- standard errors of a fit whose residuals are coloured
 modal_recursion -- linear recursions over a whole record in modal coordinates
 output_error    -- the output-error fit every chain fit shares: predict τ̂_reac, fit it,

@@ -18,6 +18,7 @@ import numpy as np
 import scipy.linalg
 
 from arcosim.fmu.flexchain.chain import spring_matrix, star_matrix
+from arcosim.identification.fit.linear_model import ConvergenceError, hold, solve_doubling
 from arcosim.identification.fit.modal_recursion import linear_recursion, output_recursion
 from arcosim.identification.records.record import EncoderRecord
 
@@ -151,28 +152,20 @@ def filter_riccati(A: np.ndarray, Q: np.ndarray, R: float, iterations: int = 80)
     """Prior covariance P of the steady-state Kalman filter that reads the first state
     with noise variance R: ``P = A P Aᵀ − A P h (hᵀ P h + R)⁻¹ hᵀ P Aᵀ + Q`` (h = e_1).
 
-    Structure-preserving doubling (Chu, Fan, Lin, *Linear Algebra Appl.* 396, 2005):
-    quadratic convergence, a few small solves per step, ~20× faster here than
+    Structure-preserving doubling (:func:`~arcosim.identification.fit.linear_model.
+    solve_doubling`, Chu, Fan, Lin, *Linear Algebra Appl.* 396, 2005): quadratic
+    convergence, a few small solves per step, ~20× faster here than
     ``scipy.linalg.solve_discrete_are`` (whose balancing and QZ step dominated the fit at
     4 kHz); it falls back on that when doubling does not converge.
     """
     size = len(A)
-    Ak = A.T.copy()
     G = np.zeros((size, size))
     G[0, 0] = 1.0 / R
-    X = Q.copy()
+    try:
+        return solve_doubling(A.T, G, Q, iterations)
+    except ConvergenceError:
+        pass
     eye = np.eye(size)
-    for _ in range(iterations):
-        W = eye + G @ X
-        AW = np.linalg.solve(W.T, Ak.T).T  # A_k (I + G X)⁻¹
-        G_next = G + AW @ G @ Ak.T
-        X_next = X + Ak.T @ X @ np.linalg.solve(W, Ak)
-        Ak = AW @ Ak
-        G = 0.5 * (G_next + G_next.T)
-        done = np.max(np.abs(X_next - X)) <= 1e-13 * max(np.max(np.abs(X_next)), 1e-300)
-        X = 0.5 * (X_next + X_next.T)
-        if done and np.all(np.isfinite(X)):
-            return X
     H = np.zeros((size, 1))
     H[0, 0] = 1.0
     return scipy.linalg.solve_discrete_are(A.T, H, Q + 1e-300 * eye, np.array([[R]]))
@@ -206,9 +199,7 @@ def discrete_drive(record: EncoderRecord, drive: Drive) -> tuple[np.ndarray, np.
     Ac[m : 2 * m, m : 2 * m] = -inverse[:, None] * C
     if slow:
         Ac[2 * m - 1, 2 * m] = -inverse[-1]
-    augmented = np.zeros((size + 2, size + 2))
-    augmented[:size, :size] = Ac
-    augmented[m, size] = inverse[0]
-    augmented[2 * m - 1, size + 1] = -inverse[-1]  # the load torque opposes the motion
-    X = scipy.linalg.expm(augmented * record.h)
-    return X[:size, :size], X[:size, size:]
+    E = np.zeros((size, 2))
+    E[m, 0] = inverse[0]
+    E[2 * m - 1, 1] = -inverse[-1]  # the load torque opposes the motion
+    return hold(Ac, E, record.h)

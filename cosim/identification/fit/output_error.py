@@ -26,12 +26,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 from scipy import optimize, signal
 
 from arcosim.fmu.flexchain.driven_chain import discretize
 from arcosim.fmu.flexchain.filters import lowpass_pole
 from arcosim.identification.errors import IdentificationError
+from arcosim.identification.fit.linear_model import expm
 from arcosim.identification.fit.modal_recursion import linear_recursion
 from arcosim.identification.fit.newey_west import newey_west_covariance, newey_west_lag
 from arcosim.identification.records.record import MotorRecord, motor_opening
@@ -43,10 +43,6 @@ def through_g(x: np.ndarray, g: float, h: float) -> np.ndarray:
     (:func:`~arcosim.fmu.flexchain.filters.lowpass_pole`)."""
     a = lowpass_pole(g, h)
     return signal.lfilter([1.0 - a], [1.0, -a], x)
-
-
-def _expm(a: list[list[float]]) -> list[list[float]]:
-    return scipy.linalg.expm(np.asarray(a)).tolist()
 
 
 def predict(
@@ -69,7 +65,7 @@ def predict(
     ndarray
         The predicted τ̂_reac (N·m), shape ``(N,)``.
     """
-    chain = discretize(J, k, B, record.h, expm=_expm)
+    chain = discretize(J, k, B, record.h, expm=expm)
     Ad, Bd = np.asarray(chain.Ad), np.asarray(chain.Bd)
     c, d = (np.asarray(r) for r in chain.torque_row())
     u = record.theta_m - record.theta_m[0]  # a common offset of all angles is an equilibrium

@@ -30,6 +30,7 @@ from functools import partial
 
 import numpy as np
 
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.fit.encoder_fit import refine
 from arcosim.identification.fit.motor_friction import friction_cleaned, without_friction
@@ -188,6 +189,17 @@ class ChainChoice:
     seen: int | None = None
     singular_values: np.ndarray | None = None
     leaner: ParameterFit | None = None
+
+    @property
+    def chain(self) -> Chain | None:
+        """The chosen chain: every J_i, k_i, B_i and, when fitted, the motor friction,
+        with their standard errors (none for a value at its bound); None for a rigid
+        drive (n = 0)."""
+        if self.n == 0:
+            return None
+        bounds = self.fit.extra.get("bounds", {})
+        std = {k: v for k, v in self.fit.std_dict().items() if k not in bounds}
+        return Chain.from_parameters(self.fit.as_dict(), std, self.n)
 
 
 @single_threaded

@@ -49,7 +49,7 @@ from collections.abc import Sequence
 
 from .. import defaults
 from ..codes import Estimator, Mode
-from ..dob import Actuator, clamp, settle_sticking, sign
+from ..dob import clamp, settle_sticking, sign
 from ..observer import Observer, ObserverSettings
 from .design import ControllerDesign, design_controller
 from .encoder_edge import CrossedEdge
@@ -176,14 +176,12 @@ class MotionController:
         """Start at rest with the motor and every mass at ``theta_m0`` (rad), target there."""
         d = self.design
         n = d.n
-        settings = ObserverSettings(
+        settings = ObserverSettings.for_chain(
+            d.chain,
+            k_to=d.k_t,
             mode=Mode.STATE_ESTIMATION,
-            actuator=Actuator(d.J_m, d.k_t, D_m=d.D_m, f_c=d.f_c),
             g_dist=d.g_dist,
             g_lpf=defaults.G_LPF,
-            J=d.J,
-            k=d.k,
-            B=d.B,
             estimator=Estimator.MODEL_BASED,
             encoder_cpr=d.encoder_cpr,
             load_mass=d.control_mass,
@@ -376,12 +374,11 @@ class MotionController:
         found = self._designs.get(h)
         if found is None:
             d = self.design
-            params = {"J_mo": d.J_m, "k_to": d.k_t, "D_m": d.D_m, "f_c": d.f_c}
-            for name, values in (("J", d.J), ("k", d.k), ("B", d.B)):
-                params.update({f"{name}[{i + 1}]": v for i, v in enumerate(values)})
-            params.update(g_dist=d.g_dist, encoder_cpr=d.encoder_cpr)
             found = design_controller(
-                params,
+                d.chain,
+                k_t=d.k_t,
+                g_dist=d.g_dist,
+                encoder_cpr=d.encoder_cpr,
                 h=h,
                 control_mass=d.control_mass,
                 move_time=d.move_time,

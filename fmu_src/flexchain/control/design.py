@@ -28,7 +28,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from .. import defaults, linalg
-from ..chain import spring_matrix
+from ..chain import MOTOR_INERTIA, Chain, spring_matrix
 from ..linalg import Matrix
 from ..riccati import solve_doubling
 
@@ -110,6 +110,11 @@ class ControllerDesign:
         return len(self.J)
 
     @property
+    def chain(self) -> Chain:
+        """The chain the design is for: J_m, every J_i, k_i, B_i, D_m and f_c."""
+        return Chain(self.J, self.k, self.B, J_m=self.J_m, D_m=self.D_m, f_c=self.f_c)
+
+    @property
     def dither_steps(self) -> int:
         """The hold's dither period P in steps of h: ``defaults.HOLD_DITHER_PERIOD`` as a
         multiple of four steps, at least four."""
@@ -157,40 +162,6 @@ class ControllerDesign:
         return x, -d / self.k_t
 
 
-def plant_matrices(
-    J_m: float, k_t: float, D_m: float, J: Sequence[float], k: Sequence[float], B: Sequence[float]
-) -> tuple[Matrix, list[float]]:
-    """``ẋ = A x + b i`` for the motor and its chain, Coulomb friction left out.
-
-    Parameters
-    ----------
-    J_m, k_t, D_m : float
-        Motor inertia (kg·m²), torque constant (N·m/A), viscous friction (N·m·s/rad).
-    J, k, B : Sequence[float]
-        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape ``(n,)``.
-
-    Returns
-    -------
-    tuple of (Matrix, list of float)
-        ``A``, shape ``(2n + 2, 2n + 2)`` (1/s, 1/s²), and ``b``, shape ``(2n + 2,)``
-        (rad/s² per A in the motor's row).
-    """
-    n = len(J)
-    m = n + 1
-    inertia = [J_m, *J]
-    Ks, Cs = spring_matrix(k), spring_matrix(B)
-    Cs[0][0] += D_m
-    A = linalg.zeros(2 * m, 2 * m)
-    for i in range(m):
-        A[i][m + i] = 1.0
-        for j in range(m):
-            A[m + i][j] = -Ks[i][j] / inertia[i]
-            A[m + i][m + j] = -Cs[i][j] / inertia[i]
-    b = [0.0] * (2 * m)
-    b[m] = k_t / J_m
-    return A, b
-
-
 def hold_discretize(A: Matrix, b: Sequence[float], h: float) -> tuple[Matrix, list[float]]:
     """``x ← F x + g u`` for ``ẋ = A x + b u`` with u held over a step of ``h`` s.
 
@@ -208,13 +179,8 @@ def hold_discretize(A: Matrix, b: Sequence[float], h: float) -> tuple[Matrix, li
     tuple of (Matrix, list of float)
         ``F``, shape ``(m, m)``, and ``g``, shape ``(m,)``.
     """
-    m = len(A)
-    M = linalg.zeros(m + 1, m + 1)
-    for r in range(m):
-        M[r][:m] = [h * a for a in A[r]]
-        M[r][m] = h * b[r]
-    X = linalg.expm(M)
-    return [row[:m] for row in X[:m]], [row[m] for row in X[:m]]
+    F, G = linalg.hold(A, [[x] for x in b], h)
+    return F, [row[0] for row in G]
 
 
 def regulator_gain(F: Matrix, g: Sequence[float], Q: Matrix, r: float) -> list[float]:
@@ -328,9 +294,12 @@ def indexed_values(params: Mapping[str, float], name: str) -> tuple[float, ...]:
 
 
 def design_controller(
-    params: Mapping[str, float],
+    chain: Chain | Mapping[str, float],
     *,
     h: float,
+    k_t: float | None = None,
+    g_dist: float = defaults.G_DIST,
+    encoder_cpr: int = defaults.ENCODER_CPR,
     control_mass: int | None = None,
     move_time: float = defaults.MOVE_TIME,
     bandwidth: float = defaults.BANDWIDTH,
@@ -341,13 +310,20 @@ def design_controller(
 
     Parameters
     ----------
-    params : Mapping[str, float]
-        The chain under the observer FMU's names: ``J_mo`` (kg·m²), ``k_to`` (N·m/A),
-        ``D_m`` (N·m·s/rad), ``f_c`` (N·m), ``J[1]`` … ``J[n]`` (kg·m²), ``k[1]`` …
-        (N·m/rad), ``B[1]`` … (N·m·s/rad); optionally ``g_dist`` (rad/s, default
-        ``defaults.G_DIST``) and ``encoder_cpr`` (counts, default ``defaults.ENCODER_CPR``).
+    chain : Chain or Mapping[str, float]
+        The chain, with its motor inertia ``J_m`` (kg·m²) and friction ``D_m``
+        (N·m·s/rad), ``f_c`` (N·m) known. At the controller FMU's boundary, its
+        parameters by name instead: ``J_mo``, ``k_to`` (N·m/A), ``D_m``, ``f_c``,
+        ``J[1]`` … ``J[n]``, ``k[1]`` …, ``B[1]`` …, optionally ``g_dist`` and
+        ``encoder_cpr`` (which then replace the arguments of those names).
     h : float
         The control step (s), > 0.
+    k_t : float or None
+        The motor's torque constant (N·m/A), > 0; with a Chain it must be given.
+    g_dist : float
+        The observer's DOB bandwidth (rad/s).
+    encoder_cpr : int
+        Encoder counts per revolution (a count; 0 = exact angle).
     control_mass : int or None
         The load mass to move, 1 … n (an index); None = the last.
     move_time : float
@@ -363,7 +339,7 @@ def design_controller(
     Returns
     -------
     ControllerDesign
-        The discrete model, the gain and the settings.
+        The discrete model, the gain and the settings; its ``chain`` is the chain given.
 
     Raises
     ------
@@ -372,21 +348,37 @@ def design_controller(
 
     Examples
     --------
-    >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3,
-    ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
-    >>> design = arcosim.design_controller(chain, h=1e-3)
+    >>> chain = arcosim.Chain(J=(5e-4,), k=(0.16,), B=(1e-5,), J_m=2.09e-5, D_m=2e-5, f_c=2e-3)
+    >>> design = arcosim.design_controller(chain, k_t=0.0406, h=1e-3)
     >>> design.bandwidth, design.move_time, len(design.K)  # rad/s, s, states
     (8.0, 1.0, 4)
+    >>> design.chain == chain
+    True
     """
     T, wc = goals(move_time, bandwidth)
-    J, k, B = (indexed_values(params, name) for name in ("J", "k", "B"))
+    if not isinstance(chain, Chain):  # the FMU's parameters
+        params = chain
+        g_dist = float(params.get("g_dist", g_dist))
+        encoder_cpr = int(params.get("encoder_cpr", encoder_cpr))
+        chain, k_t = _chain_of(params), float(params["k_to"])
+    if k_t is None:
+        raise ValueError("give the torque constant k_t (N·m/A) with the chain")
+    for name in ("J_m", "D_m", "f_c"):
+        if getattr(chain, name) is None:
+            raise ValueError(f"the chain's {name} is not known: give it (Chain({name}=…))")
+    J, k, B = chain.J, chain.k, chain.B
     n = len(J)
     L = n if control_mass is None else int(control_mass)
-    _check_chain(params, J, k, B, L, h, i_max)
+    if not 1 <= L <= n:
+        raise ValueError(f"parameter control_mass = {L} is not allowed (use a load mass 1 … {n})")
+    if not k_t > 0.0:
+        raise ValueError(f"parameter k_to = {k_t!r} must be > 0")
+    if not (h > 0.0 and i_max > 0.0):
+        raise ValueError(f"step h = {h!r} s and i_max = {i_max!r} A must be > 0")
     if not (math.isfinite(hold_dither) and hold_dither >= 0.0):
         raise ValueError(f"parameter hold_dither = {hold_dither!r} counts must be ≥ 0 (0 = off)")
-    J_m, k_t, D_m = float(params["J_mo"]), float(params["k_to"]), float(params["D_m"])
-    A, b = plant_matrices(J_m, k_t, D_m, J, k, B)
+    J_m, D_m = chain.J_m, chain.D_m
+    A, b = chain.state_space(k_t)
     F, g = hold_discretize(A, b, h)
     grow = math.exp(DECAY_RATIO * wc * h)
     Q = cost_weights(J_m, k_t, J, k, L, wc)
@@ -396,12 +388,12 @@ def design_controller(
         J_m=J_m,
         k_t=k_t,
         D_m=D_m,
-        f_c=float(params["f_c"]),
+        f_c=chain.f_c,
         J=J,
         k=k,
         B=B,
-        g_dist=float(params.get("g_dist", defaults.G_DIST)),
-        encoder_cpr=int(params.get("encoder_cpr", defaults.ENCODER_CPR)),
+        g_dist=g_dist,
+        encoder_cpr=encoder_cpr,
         control_mass=L,
         move_time=T,
         bandwidth=wc,
@@ -419,25 +411,17 @@ def design_controller(
     return design
 
 
-def _check_chain(
-    params: Mapping[str, float],
-    J: Sequence[float],
-    k: Sequence[float],
-    B: Sequence[float],
-    L: int,
-    h: float,
-    i_max: float,
-) -> None:
-    """Refuse what the design cannot use, naming the parameter (ValueError)."""
+def _chain_of(params: Mapping[str, float]) -> Chain:
+    """The chain in the controller FMU's parameters; refuse what the design cannot use,
+    naming the parameter (ValueError)."""
+    J, k, B = (indexed_values(params, name) for name in ("J", "k", "B"))
     n = len(J)
     if n == 0 or len(k) != n or len(B) != n:
         raise ValueError("give J[1] … J[n], k[1] … k[n] and B[1] … B[n] for the same n ≥ 1")
-    if not 1 <= L <= n:
-        raise ValueError(f"parameter control_mass = {L} is not allowed (use a load mass 1 … {n})")
     for name in ("J_mo", "k_to"):
         if not float(params[name]) > 0.0:
             raise ValueError(f"parameter {name} = {params[name]!r} must be > 0")
     if min(J) <= 0.0 or min(k) <= 0.0 or min(B) < 0.0:
         raise ValueError("every J[i] and k[i] must be > 0 and every B[i] ≥ 0")
-    if not (h > 0.0 and i_max > 0.0):
-        raise ValueError(f"step h = {h!r} s and i_max = {i_max!r} A must be > 0")
+    J_m, D_m, f_c = (float(params[name]) for name in (MOTOR_INERTIA, "D_m", "f_c"))
+    return Chain(J, k, B, J_m=J_m, D_m=D_m, f_c=f_c)

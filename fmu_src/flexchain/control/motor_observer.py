@@ -18,17 +18,6 @@ from ..linalg import Matrix
 from .design import ControllerDesign
 
 
-def _hold_inputs(A: Matrix, E: Matrix, h: float) -> tuple[Matrix, Matrix]:
-    """``s ← F s + Γ w`` for ``ṡ = A s + E w`` with w held over ``h`` s."""
-    m, p = len(A), len(E[0])
-    M = linalg.zeros(m + p, m + p)
-    for r in range(m):
-        M[r][:m] = [h * a for a in A[r]]
-        M[r][m:] = [h * e for e in E[r]]
-    X = linalg.expm(M)
-    return [row[:m] for row in X[:m]], [row[m:] for row in X[:m]]
-
-
 def observer_gain(F: Matrix, poles: Sequence[float]) -> list[float]:
     """Gain L of ``s ← F s + L (y − c F s)`` (c = [0, 0, 1]) that puts the three poles of
     the estimation error at ``poles`` (Ackermann's formula for the current estimator).
@@ -105,7 +94,7 @@ class MotorObserver:
                 [d.k_t / Jm, k1 / Jm, B1 / Jm, -1.0 / Jm],
                 [0.0, 0.0, 0.0, 0.0],
             ]
-            F, Gamma = _hold_inputs(A, E, h)
+            F, Gamma = linalg.hold(A, E, h)
             p = math.exp(-self.bandwidth * h)
             found = (F, Gamma, observer_gain(F, (p, p, math.exp(-self.friction_bandwidth * h))))
             self._models[h] = found
