@@ -20,6 +20,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.checks.log_check import log_plausibility
@@ -85,10 +86,11 @@ class LinkIdentification:
     encoder: EncoderRecord = field(repr=False)
 
     @property
-    def chain(self) -> dict[str, float]:
-        """The equivalent lumped chain: ``masses``, ``J[i]`` (kg·m²), ``k[i]`` (N·m/rad),
-        ``B[i]`` (N·m·s/rad), what ``--chain`` reads."""
-        return dict(self.fit.extra["chain"])
+    def chain(self) -> Chain:
+        """The equivalent lumped chain and the hub's friction, as ``--chain`` reads the
+        report (:func:`~arcosim.chainfile.read_chain`)."""
+        values = {**self.fit.extra["chain"], "D_m": self.D_m, "f_c": self.f_c}
+        return Chain.from_parameters(values, n=int(values["masses"]))
 
     def with_assumption(self, key: str, text: str) -> LinkIdentification:
         """This result with one more assumption ``key``: ``text`` (e.g. the defaults)."""
@@ -164,7 +166,7 @@ class LinkIdentification:
             lines.append(f"  assumption, {key}: {text}")
         for text in self.warnings:
             lines.append(f"  warning: {text}")
-        chain = self.chain
+        chain = report["equivalent_chain"]
         values = " ".join(f"{k}={v:.4g}" for k, v in chain.items() if k != "masses")
         lines.append(f"  equivalent chain ({chain['masses']} masses, --chain reads it): {values}")
         return "\n".join(lines)
