@@ -189,12 +189,19 @@ def simulate(
     current: Callable[[np.ndarray], np.ndarray] | None = None,
     speed_loop: SpeedLoop | None = None,
     seed: int = 0,
+    drift: Callable[[float], Drive] | None = None,
+    drift_interval: float = 0.1,
 ) -> Log:
     """Simulate ``duration`` s sampled every ``h`` s; open loop (``current``: reference
-    current, A, of time) or closed loop (``speed_loop``). The motor starts at rest."""
+    current, A, of time) or closed loop (``speed_loop``). The motor starts at rest.
+
+    ``drift``: the drive at time t (s), taken every ``drift_interval`` s (its springs,
+    dampers and friction may change; its masses, sensors and load may not), for a plant
+    that wears while it runs; None: ``drive`` throughout."""
     if (current is None) == (speed_loop is None):
         raise ValueError("give either a current reference or a speed loop")
     model = _Model(drive)
+    every = max(1, round(drift_interval / h)) if drift is not None else 0
     m = model.m
     count = round(duration / h) + 1
     time = np.arange(count) * h
@@ -221,6 +228,9 @@ def simulate(
     stuck_steps = 0
     speed_ref = None if speed_loop is None else np.asarray(speed_loop.reference(time), float)
     for k in range(1, count):
+        if every and (k - 1) % every == 0:
+            worn = drift(float(time[k - 1]))
+            model, f_c = _Model(worn), worn.f_c
         if refs is not None:
             i_ref = float(refs[k - 1])
         else:
