@@ -124,11 +124,11 @@ def test_tracks_a_two_mass_chain_in_moves():
 @pytest.mark.slow
 def test_constant_speed_cannot_resolve_friction():
     """At constant speed the Coulomb friction is one more constant torque, like τ_0:
-    not resolved, so not valid, and no alarm on it."""
-    plant = drive(D_m=defaults.D_M, f_c=2 * defaults.F_C, counts=2000, current_noise=0.005)
+    not resolved, so not valid, and no alarm."""
+    plant = drive(D_m=defaults.D_M, f_c=defaults.F_C, counts=2000, current_noise=0.005)
     ramp = lambda t: np.minimum(np.asarray(t, float), 1.0) * 5.0  # noqa: E731 (rad/s)
     log = log_of(plant, 20.0, reference=ramp, position_gain=0.0)
-    tr = tracker(drive(D_m=defaults.D_M, f_c=defaults.F_C, counts=2000))
+    tr = tracker(plant)
     replay(tr, plant, log)
     assert not tr.valid
     assert 3.0 * tr.stds()[4] > 0.05 * tr.scale[4]
