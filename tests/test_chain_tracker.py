@@ -1,5 +1,5 @@
 """The chain tracker (arcosim.fmu.flexchain.chain_tracker) on logs of the independent
-drive simulator (benchmarks.field_sim)."""
+drive simulator (benchmarks.simulators.field_sim)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from arcosim.fmu.flexchain.chain_tracker import PRIOR_STD, ChainTracker
 from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver
 from arcosim.fmu.flexchain.model_observer import NoiseModel
 from arcosim.fmu.fmukit.state import restore, snapshot
-from benchmarks import field_sim
+from benchmarks.simulators import field_sim
 
 H = 1e-3
 G = defaults.G_DIST

@@ -54,7 +54,7 @@ What it reports:
   the prior its estimate would otherwise alarm on any model error.
 
 Which way the motor slides comes from the encoder's edges
-(:meth:`~arcosim.fmu.flexchain.encoder_edge.CrossedEdge.sliding`): below a count per step
+(:meth:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge.sliding`): below a count per step
 its backward difference reads 0 on most steps, and a move of 1 rad in 1 s on 2000 counts
 at 1 ms is mostly there. While the edges show no slide the motor may stand still, and
 static friction (unknown within ±f_c) acts; the G-filtered measurement remembers it for
@@ -71,7 +71,7 @@ from collections.abc import Sequence
 from operator import mul
 
 from . import defaults
-from .encoder_edge import CrossedEdge
+from .control.encoder_edge import CrossedEdge
 from .filters import lowpass_pole
 from .linalg import Matrix
 from .model_observer import NoiseModel, filtered_chain, step_model
