@@ -224,8 +224,9 @@ class ReactionTorqueObserver(FmuSlave):
                 "tracking",
                 defaults.TRACKING,
                 "",
-                "Mode 2, estimator 1, on a chain: 0 = off; 1 = track k, B, f_c and D_m while "
-                "the drive works (theta_hat and omega_hat then come from the tracked chain)",
+                "Mode 2 on a chain: 0 = off; 1 = track k, B, f_c and D_m while the drive "
+                "works; theta_hat and omega_hat then come from the tracked chain (the "
+                "model-based observer's predictor, whatever estimator says)",
             ),
             par(
                 "tracking_time",

@@ -180,7 +180,7 @@ class ObserverSettings:
             choice_problem("mode", self.mode, MODE_NAMES),
             choice_problem("estimator", self.estimator, ESTIMATOR_NAMES),
         ]
-        if noise and self.model_based:
+        if noise and (self.model_based or self.tracking):
             found.append(noise_problem(self.torque_noise_std, self.tau_noise_std))
         found.append(load_mass_problem(self.load_mass, len(self.J), self.model_based))
         found.append(link_problem(self.link is not None, self.model_based, self.load_mass))
@@ -283,9 +283,10 @@ def link_problem(link: bool, model_based: bool, load_mass: int) -> str | None:
 
 
 def tracking_problem(settings: ObserverSettings) -> str | None:
-    """A sentence if tracking is asked for where the tracker cannot run: it runs on the
-    model-based observer of a chain, without a load torque state (its own constant
-    torque takes a steady load).
+    """A sentence if tracking is asked for where the tracker cannot run: in mode 2 on a
+    chain, without a load torque state (its own constant torque takes a steady load). It
+    is then the state estimator, whatever ``estimator`` says (its predictor is the
+    model-based observer's, on the tracked chain).
 
     Parameters
     ----------
@@ -300,11 +301,10 @@ def tracking_problem(settings: ObserverSettings) -> str | None:
     s = settings
     if not s.tracking:
         return None
-    if not s.model_based or s.link is not None or s.load_mass:
+    if s.mode != Mode.STATE_ESTIMATION or s.link is not None or s.load_mass:
         return (
-            f"parameter tracking = 1 needs mode = {int(Mode.STATE_ESTIMATION)}, estimator = "
-            f"{int(Estimator.MODEL_BASED)} (the model-based observer), link_modes = 0 and "
-            "load_mass = 0; set tracking = 0 otherwise"
+            f"parameter tracking = 1 needs mode = {int(Mode.STATE_ESTIMATION)} (state "
+            "estimation), link_modes = 0 and load_mass = 0; set tracking = 0 otherwise"
         )
     return None
 
@@ -358,19 +358,6 @@ class Observer:
             self.identifier = RigidChainIdentifier(
                 s.J, s.g_dist, s.kappa_correction, theta0, s.actuator.f_c
             )
-        elif s.estimator == Estimator.MODEL_BASED and s.load_mass > 0:
-            self.estimator = LoadTorqueObserver(
-                s.J,
-                s.k,
-                s.B,
-                s.g_dist,
-                s.noise(),
-                theta0 + self.offset,
-                s.load_mass,
-                s.load_torque_bandwidth,
-            )
-        elif s.estimator == Estimator.MODEL_BASED and s.link is not None:
-            self.estimator = LinkObserver(s.link, s.g_dist, s.noise(), theta0 + self.offset)
         elif s.tracking:
             self.estimator = ChainTracker(
                 s.J,
@@ -385,6 +372,19 @@ class Observer:
                 s.tracking_time,
                 s.drift_threshold,
             )
+        elif s.estimator == Estimator.MODEL_BASED and s.load_mass > 0:
+            self.estimator = LoadTorqueObserver(
+                s.J,
+                s.k,
+                s.B,
+                s.g_dist,
+                s.noise(),
+                theta0 + self.offset,
+                s.load_mass,
+                s.load_torque_bandwidth,
+            )
+        elif s.estimator == Estimator.MODEL_BASED and s.link is not None:
+            self.estimator = LinkObserver(s.link, s.g_dist, s.noise(), theta0 + self.offset)
         elif s.estimator == Estimator.MODEL_BASED:
             self.estimator = ModelObserver(s.J, s.k, s.B, s.g_dist, s.noise(), theta0 + self.offset)
         else:

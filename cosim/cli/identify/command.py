@@ -194,7 +194,9 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         type=Path,
         metavar="FILE.png",
         help="whole-chain: the measured response torque → motor speed with its coherence, "
-        "the model's over it, the residual against the noise floor; and FILE.csv",
+        "the model's over it, the residual against the noise floor; and FILE.csv. "
+        "observer with --set tracking=1: the tracked parameters over time with their σ "
+        "band and the commissioning values",
     )
     p.add_argument(
         "--reference",
@@ -216,8 +218,11 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
-    if args.plot is not None and args.method != "whole-chain":
-        raise UserError(f"--plot is for --method whole-chain (not {args.method})")
+    if args.plot is not None and args.method not in ("whole-chain", "observer"):
+        raise UserError(
+            "--plot is for --method whole-chain, or the observer with --set tracking=1 "
+            f"(not {args.method})"
+        )
     check_plot(args)
     if args.chain and args.method in ("whole-chain", "beam"):
         raise UserError(
