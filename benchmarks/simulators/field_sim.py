@@ -196,12 +196,13 @@ def simulate(
     current, A, of time) or closed loop (``speed_loop``). The motor starts at rest.
 
     ``drift``: the drive at time t (s), taken every ``drift_interval`` s (its springs,
-    dampers and friction may change; its masses, sensors and load may not), for a plant
-    that wears while it runs; None: ``drive`` throughout."""
+    dampers, friction and constant load torque may change; its masses and sensors may
+    not), for a plant that wears or is loaded while it runs; None: ``drive`` throughout."""
     if (current is None) == (speed_loop is None):
         raise ValueError("give either a current reference or a speed loop")
     model = _Model(drive)
     every = max(1, round(drift_interval / h)) if drift is not None else 0
+    load_step = 0.0  # the drift's change of the constant load torque (N·m)
     m = model.m
     count = round(duration / h) + 1
     time = np.arange(count) * h
@@ -231,6 +232,7 @@ def simulate(
         if every and (k - 1) % every == 0:
             worn = drift(float(time[k - 1]))
             model, f_c = _Model(worn), worn.f_c
+            load_step = worn.load_torque - drive.load_torque
         if refs is not None:
             i_ref = float(refs[k - 1])
         else:
@@ -244,7 +246,7 @@ def simulate(
             if i_ref == unclamped:
                 integral += speed_loop.ki * h * error
         start_integral = x[-1]
-        x, stuck = _advance(model, x, stuck, i_ref, float(load[k]), f_c, h)
+        x, stuck = _advance(model, x, stuck, i_ref, float(load[k]) + load_step, f_c, h)
         stuck_steps += stuck
         theta[k] = x[:m]
         omega[k] = x[m]
