@@ -281,7 +281,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--operations", nargs="+", choices=OPERATIONS, default=["position"],
                    help="operations for the k, friction and healthy rows (default position; "
                    "the constant row always runs the conveyor)")  # fmt: skip
-    p.add_argument("--rows", nargs="+", choices=ROWS, default=list(ROWS))
+    p.add_argument("--rows", nargs="*", choices=ROWS, default=list(ROWS),
+                   help="rows to run (default all; none with --cost: the cost alone)")  # fmt: skip
     p.add_argument("--healthy", type=float, default=HEALTHY,
                    help=f"a healthy run's length (s, default {HEALTHY:g})")  # fmt: skip
     p.add_argument("--cost", action="store_true", help="also the per-step cost, n = 2, 3, 5")

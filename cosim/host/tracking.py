@@ -103,7 +103,7 @@ def replay_tracking(
     log : DriveLog
         The samples (SI units).
     parameters : mapping of str to value
-        Observer parameters by name; ``tracking`` is set to 1.
+        Observer parameters by name; ``tracking`` is 1 unless they say otherwise.
     n : int
         Number of load masses (a count).
 
@@ -119,7 +119,7 @@ def replay_tracking(
     """
     given, tracked, stds = tracking_outputs(n)
     flags = ["drift_alarm", "tracking_valid"]
-    run = replay_log(observer, log, {**parameters, "tracking": 1}, [*tracked, *stds, *flags])
+    run = replay_log(observer, log, {"tracking": 1, **parameters}, [*tracked, *stds, *flags])
 
     def block(names: list[str]) -> np.ndarray:
         return np.column_stack([run.signals[f"observer.{name}"] for name in names])
