@@ -70,6 +70,7 @@ def test_at_rest_it_learns_nothing():
     assert tr.values()[:2] == list(K2)
 
 
+@pytest.mark.slow
 def test_gradient_is_the_innovations_derivative():
     """ψ_j, from the sensitivity equations, against a central difference of the
     innovation over 1.5 s of a move (learning off): the difference's own error is of
@@ -93,6 +94,7 @@ def test_gradient_is_the_innovations_derivative():
         assert np.linalg.norm(numeric - psi) <= 0.01 * np.linalg.norm(psi), j
 
 
+@pytest.mark.slow
 def test_memory_is_constant_and_state_round_trips():
     plant = drive(f_c=defaults.F_C, counts=2000, current_noise=0.005)
     log = log_of(plant, 3.0)

@@ -32,6 +32,7 @@ def test_plot_without_tracking_is_refused(tmp_path, capsys) -> None:
     assert "--set tracking=1" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_tracking_writes_draws_and_prints(build_fmus, tmp_path, capsys) -> None:
     log = moving_log(tmp_path / "log.csv")
     out, plot = tmp_path / "tracked.csv", tmp_path / "tracked.png"
