@@ -22,15 +22,15 @@ covariance ``P``:
 
     λ = 1 − h / tracking_time,   L = P ψ̃ / (λ + ψ̃ᵀ P ψ̃),   p ← p + L ẽ,   P ← (P − L ψ̃ᵀ P) / λ
 
-with ψ̃ and ẽ prefiltered (:data:`PREFILTER_RATIO`), each parameter's step capped
-(:data:`RATE_MAX`), and in units of the innovation's running standard deviation, so ``P`` is the
-covariance of ``p`` for white innovations. A sample weighs ``λ^age``: the memory's time
-constant is ``tracking_time``. The prior (the commissioning values, σ :data:`PRIOR_STD`)
-is forgotten and renewed at the same rate (stabilized forgetting, Kulhavý 1987):
-``p ← p + (1 − λ) P P₀⁻¹ (p₀ − p)`` each step, so a parameter the operation does not
-resolve returns to its commissioning value over ``tracking_time`` instead of wandering
-on the errors of the others, and ``P``'s diagonal is capped at the prior's. Dampers and
-frictions are kept ≥ 0, stiffnesses within :data:`STIFFNESS_RANGE` of their scale.
+with ψ̃ and ẽ prefiltered (:data:`PREFILTER_RATIO`), and in units of the innovation's
+running standard deviation, so ``P`` is the covariance of ``p`` for white innovations. A
+sample weighs ``λ^age``: the memory's time constant is ``tracking_time``. The prior (the
+commissioning values, σ :data:`PRIOR_STD`) is forgotten and renewed at the same rate
+(stabilized forgetting, Kulhavý 1987): ``p ← p + (1 − λ) P P₀⁻¹ (p₀ − p)`` each step,
+so a parameter the operation does not resolve returns to its commissioning value over
+``tracking_time`` instead of wandering on the errors of the others, and ``P``'s diagonal
+is capped at the prior's. Dampers and frictions are kept ≥ 0, stiffnesses within
+:data:`STIFFNESS_RANGE` of their scale.
 ``F``, ``Γ`` and their derivatives (central differences of the exact discretization) are
 designed at a point ``p_d`` and redesigned when a chain parameter has moved
 :data:`REDESIGN_STEP` from it; in between the predictor uses the first-order expansion
@@ -117,12 +117,6 @@ DIFFERENCE_STEP = 1e-4
 #: and the predictor's input speed share (errors in variables: without it the two-mass
 #: chain's k_1 crept to 1.04 in 60 s of moves and f_c to 1.06; with it both within 0.5 %).
 PREFILTER_RATIO = 0.5
-#: The most a parameter moves per tracking_time, in units of its scale (dimensionless):
-#: wear is slow (the tracked drifts are 10 % over minutes), and a sample's update is capped
-#: at this rate times h / tracking_time, so the first seconds' coloured errors cannot throw
-#: the estimates far (unlimited, the two-mass chain's k_1 went to 1.18 within 2 s and the
-#: path then depended on the last digit of the step).
-RATE_MAX = 1.0
 #: Steps that differ by less than this (relative) share a design: a log's time column
 #: read back gives steps a few ulps apart, and the discrete model differs by as little.
 STEP_TOLERANCE = 1e-9
@@ -425,10 +419,8 @@ class ChainTracker:
         # (stabilized forgetting): each step pulls p towards p0 by (1 − λ) P P0⁻¹ (p0 − p)
         pull = (1.0 - lam) / PRIOR_STD**2
         offset = [a - b for a, b in zip(self.p0, p)]
-        most = RATE_MAX * h / self.tracking_time
         for i in range(size):
-            step = gain[i] * e_n + pull * fsum_dot(P[i], offset)
-            p[i] += max(-most, min(most, step))
+            p[i] += gain[i] * e_n + pull * fsum_dot(P[i], offset)
         cap = PRIOR_STD**2
         for i in range(size):
             row, gi = P[i], gain[i]

@@ -196,8 +196,7 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         metavar="FILE.png",
         help="whole-chain: the measured response torque → motor speed with its coherence, "
         "the model's over it, the residual against the noise floor; and FILE.csv. "
-        "observer with --set tracking=1: the tracked parameters over time with their σ "
-        "band and the commissioning values",
+        "Observer, tracking=1: the tracked chain",
     )
     p.add_argument(
         "--reference",
