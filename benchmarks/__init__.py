@@ -33,6 +33,8 @@ The rows and their parts:
 - :mod:`benchmarks.fleet_accuracy`: the fleet's drift alarms and its scaling
   (``arcosim bench fleet``); :mod:`benchmarks.fleet_store`, the rows per second its
   store takes (``python -m benchmarks.fleet_store``);
+- :mod:`benchmarks.tracking_accuracy`: the observer FMU's tracker on drives that wear
+  while they work, and its per-step cost (``arcosim bench tracking``);
 - :mod:`benchmarks.public_loaders`, :mod:`benchmarks.public_figure`: the public records'
   readers and the motor bench's figure;
 - :mod:`benchmarks.sample_log`: writes the sample drive log the examples identify;

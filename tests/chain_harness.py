@@ -20,6 +20,30 @@ COMPONENTS = {
 }
 
 
+#: A second observer that tracks the chain (``tracking = 1``), fed as the observer is: the
+#: hosts run the tracker beside the bench's observer when ``fmus`` names it.
+TRACKER = "tracker"
+TRACKER_PARAMETERS = {**BENCH["observer"], "tracking": 1}
+
+
+def parameters_of(component: str) -> dict:
+    """A component's parameters: the bench's, the tracker's for :data:`TRACKER`."""
+    return TRACKER_PARAMETERS if component == TRACKER else BENCH[component.rstrip("2")]
+
+
+def connections_of(fmus: dict[str, Path]) -> list[list[str]]:
+    """The bench's connections, and the observer's inputs to ``observer2`` and
+    :data:`TRACKER` when ``fmus`` has them."""
+    extra = [
+        [a, o, other, i]
+        for other in ("observer2", TRACKER)
+        if other in fmus
+        for a, o, b, i in CONNECTIONS
+        if b == "observer"
+    ]
+    return [list(c) for c in CONNECTIONS] + extra
+
+
 def chain_fmus(folder: Path) -> dict[str, Path]:
     """The bench's FMUs in ``folder``, by component."""
     return {c: folder / f"{name}.fmu" for c, name in COMPONENTS.items()}
@@ -27,16 +51,12 @@ def chain_fmus(folder: Path) -> dict[str, Path]:
 
 def chain_spec(fmus: dict[str, Path], stop: float, h: float, shadow: Path | None = None) -> dict:
     """chain_run.py's SPEC: the bench's parameters and connections, for ``stop`` s in steps
-    of ``h`` s; a component ``observer2`` gets the observer's parameters and inputs."""
+    of ``h`` s; a component ``observer2`` gets the observer's parameters and inputs, and
+    :data:`TRACKER` the observer's inputs and its own parameters."""
     return {
         "components": {c: str(p) for c, p in fmus.items()},
-        "parameters": {c: BENCH[c.rstrip("2")] for c in fmus},
-        "connections": [list(c) for c in CONNECTIONS]
-        + [
-            [a, o, "observer2", i]
-            for a, o, b, i in CONNECTIONS
-            if b == "observer" and "observer2" in fmus
-        ],
+        "parameters": {c: parameters_of(c) for c in fmus},
+        "connections": connections_of(fmus),
         "stop": stop,
         "h": h,
         "shadow": str(shadow) if shadow else None,

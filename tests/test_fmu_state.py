@@ -41,6 +41,7 @@ CASES = [
     ("ReactionTorqueObserver", {"mode": 2}),
     ("ReactionTorqueObserver", {"mode": 2, "estimator": 1, "load_mass": 3}),
     ("ReactionTorqueObserver", {"mode": 2, "estimator": 1, "link_modes": 2}),
+    ("ReactionTorqueObserver", {"mode": 2, "tracking": 1}),
     ("ExcitationSource", {"signal": 3}),
     ("ExcitationSource", {"signal": 1}),
     ("ActionReactionController", {}),

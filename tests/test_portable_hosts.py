@@ -34,8 +34,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from arcosim.build.ssp import BENCH, CONNECTIONS
-from tests.chain_harness import chain_fmus, chain_spec, compile_c_host, run_chain
+from arcosim.build.ssp import BENCH
+from tests.chain_harness import (
+    TRACKER,
+    chain_fmus,
+    chain_spec,
+    compile_c_host,
+    connections_of,
+    parameters_of,
+    run_chain,
+)
 from tests.foreign_hosts import HIDDEN, WANTED, bare_env, hidden
 
 pytestmark = [
@@ -53,7 +61,9 @@ RTOL = 1e-9
 
 @pytest.fixture(scope="session")
 def fmus(build_fmus) -> dict[str, Path]:
-    return chain_fmus(build_fmus(3))
+    """The bench's FMUs, and the observer again as the chain's tracker (tracking = 1)."""
+    bench = chain_fmus(build_fmus(3))
+    return {**bench, TRACKER: bench["observer"]}
 
 
 @pytest.fixture(scope="module")
@@ -158,21 +168,20 @@ def host_spec(fmus: dict[str, Path], folder: Path) -> str:
         variables[component] = {v.name: v for v in md.modelVariables}
         lines.append(f"fmu {component} {target} {md.coSimulation.modelIdentifier} {md.guid}")
     kinds = {"Real": "real", "Integer": "int", "Boolean": "bool", "String": "string"}
-    for component, values in BENCH.items():
-        for name, value in values.items() if component in fmus else ():
+    for component in fmus:
+        for name, value in parameters_of(component).items():
             v = variables[component][name]
             lines.append(f"{kinds[v.type]} {component} {v.valueReference} {value}")
-    for a, out, b, inp in (c for c in CONNECTIONS if c[0] in fmus and c[2] in fmus):
+    for a, out, b, inp in (c for c in connections_of(fmus) if c[0] in fmus and c[2] in fmus):
         lines.append(
             f"link {a} {variables[a][out].valueReference} {b} {variables[b][inp].valueReference}"
         )
     order = []
     for component in fmus:
         outs = [v for v in variables[component].values() if v.causality == "output"]
-        for v in [v for v in outs if v.type == "Real"] + [v for v in outs if v.type == "Boolean"]:
-            lines.append(
-                f"out {component} {v.valueReference} {'b' if v.type == 'Boolean' else 'r'}"
-            )
+        letters = {"Real": "r", "Boolean": "b", "Integer": "i"}
+        for v in sorted(outs, key=lambda v: list(letters).index(v.type)):
+            lines.append(f"out {component} {v.valueReference} {letters[v.type]}")
             order.append((component, v.name))
     lines.append(f"run {STOP} {H}")
     (folder / "spec.txt").write_text("\n".join(lines) + "\n")
@@ -266,31 +275,39 @@ def test_chain_in_ecos_with_a_bare_path(fmus, reference, tmp_path, declared_outp
     if ecos is None:
         pytest.skip(why)
     folder = next(iter(fmus.values())).parent
+    # the bench, and the bench with its observer tracking the chain (the tracker's run)
+    sets = {
+        "trace": {c: BENCH[c] for c in BENCH},
+        "tracking": {c: parameters_of(TRACKER) if c == "observer" else BENCH[c] for c in BENCH},
+    }
     traced = {
-        "trace": {c: {**BENCH[c], "trace_file": str(tmp_path / f"trace_{c}.csv")} for c in BENCH}
+        name: {c: {**values[c], "trace_file": str(tmp_path / f"{name}_{c}.csv")} for c in values}
+        for name, values in sets.items()
     }
     ssp = write_ssp(tmp_path / "traced.ssp", folder, traced, stop=STOP)
-    command = [
-        str(ecos),
-        "simulate",
-        "--path",
-        str(ssp),
-        "--stopTime",
-        repr(STOP),
-        "--stepSize",
-        repr(H),
-        "--noParallel",
-        "--parameterSet",
-        "trace",
-    ]
-    result = hidden(command, bare_env(), tmp_path)
-    assert result.returncode == 0, result.stderr[-3000:]
     produced = {}
-    for component in BENCH:
-        trace = tmp_path / f"trace_{component}.csv"
-        names = trace.read_text().splitlines()[0].split(",")[1:]
-        data = np.loadtxt(trace, delimiter=",", skiprows=1)
-        produced[component] = {n: data[:, j + 1] for j, n in enumerate(names)}
+    for name in sets:
+        command = [
+            str(ecos),
+            "simulate",
+            "--path",
+            str(ssp),
+            "--stopTime",
+            repr(STOP),
+            "--stepSize",
+            repr(H),
+            "--noParallel",
+            "--parameterSet",
+            name,
+        ]
+        result = hidden(command, bare_env(), tmp_path)
+        assert result.returncode == 0, result.stderr[-3000:]
+        for component in BENCH if name == "trace" else ["observer"]:
+            trace = tmp_path / f"{name}_{component}.csv"
+            names = trace.read_text().splitlines()[0].split(",")[1:]
+            data = np.loadtxt(trace, delimiter=",", skiprows=1)
+            as_component = component if name == "trace" else TRACKER
+            produced[as_component] = {n: data[:, j + 1] for j, n in enumerate(names)}
     rows = min(len(v) for o in produced.values() for v in o.values())
     assert rows >= 1000  # ecos sums its time and may stop one step short
     ref = {c: {n: reference[c][n] for n in produced[c]} for c in produced}

@@ -189,12 +189,20 @@ def simulate(
     current: Callable[[np.ndarray], np.ndarray] | None = None,
     speed_loop: SpeedLoop | None = None,
     seed: int = 0,
+    drift: Callable[[float], Drive] | None = None,
+    drift_interval: float = 0.1,
 ) -> Log:
     """Simulate ``duration`` s sampled every ``h`` s; open loop (``current``: reference
-    current, A, of time) or closed loop (``speed_loop``). The motor starts at rest."""
+    current, A, of time) or closed loop (``speed_loop``). The motor starts at rest.
+
+    ``drift``: the drive at time t (s), taken every ``drift_interval`` s (its springs,
+    dampers, friction and constant load torque may change; its masses and sensors may
+    not), for a plant that wears or is loaded while it runs; None: ``drive`` throughout."""
     if (current is None) == (speed_loop is None):
         raise ValueError("give either a current reference or a speed loop")
     model = _Model(drive)
+    every = max(1, round(drift_interval / h)) if drift is not None else 0
+    load_step = 0.0  # the drift's change of the constant load torque (N·m)
     m = model.m
     count = round(duration / h) + 1
     time = np.arange(count) * h
@@ -221,6 +229,10 @@ def simulate(
     stuck_steps = 0
     speed_ref = None if speed_loop is None else np.asarray(speed_loop.reference(time), float)
     for k in range(1, count):
+        if every and (k - 1) % every == 0:
+            worn = drift(float(time[k - 1]))
+            model, f_c = _Model(worn), worn.f_c
+            load_step = worn.load_torque - drive.load_torque
         if refs is not None:
             i_ref = float(refs[k - 1])
         else:
@@ -234,7 +246,7 @@ def simulate(
             if i_ref == unclamped:
                 integral += speed_loop.ki * h * error
         start_integral = x[-1]
-        x, stuck = _advance(model, x, stuck, i_ref, float(load[k]), f_c, h)
+        x, stuck = _advance(model, x, stuck, i_ref, float(load[k]) + load_step, f_c, h)
         stuck_steps += stuck
         theta[k] = x[:m]
         omega[k] = x[m]

@@ -24,6 +24,7 @@ BENCHMARKS = {
     "fleet": "fleet_accuracy",
     "public": "public_records",
     "thirdparty": "thirdparty_chain",
+    "tracking": "tracking_accuracy",
     "verdict": "verdict_accuracy",
 }
 

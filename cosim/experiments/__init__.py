@@ -13,6 +13,7 @@ reproduce        -- the seven experiments, one function each (``reproduce``)
 findings         -- what they found, as tables and as ``report.md``'s text
 reproduce_figures -- Figs. 4–9 from the runs and what they found
 report           -- the figures drawn, and tables as Markdown or text
+tracking_figure  -- a tracked replay drawn: each parameter, its ±σ band, the commissioning value
 control_scenarios -- the closed-loop scenarios: the controller FMU moving the plant's last mass
 closed_loop      -- the plant FMU with a Python controller in the loop (sequential, zero delay)
 motion/          -- experiment 7: a move of the last mass by four controllers (baselines,

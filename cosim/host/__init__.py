@@ -9,6 +9,7 @@ stepping   -- what every fixed-step loop over FMUs needs (the step grid, the rec
 master     -- the fixed-step master of plant and observer (``cosimulate``, ``Recording``)
 control_loop -- a fixed-step master for the closed loop controller → plant → controller
 replay     -- a drive log fed to the observer FMU, sample by sample (``replay_log``)
+tracking   -- a log replayed with the observer tracking the chain (``replay_tracking``)
 ssp        -- an SSP 1.0 system read and run by a Jacobi master (``run_ssp``)
 ecos       -- the ecos C++ engine in a separate process: the FMUs in a host not Python
 validate   -- the checks a strict FMI host runs on an FMU (``arcosim validate``)

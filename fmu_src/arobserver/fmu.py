@@ -51,7 +51,8 @@ class ReactionTorqueObserver(FmuSlave):
         "Action-reaction observer (Khalil & Sabanovic) for a motor driving n masses on "
         "springs, from the motor's current and encoder only: disturbance and reaction "
         "torque observers, actuator self-identification (mode 0), chain stiffness and "
-        "damping from a rigid maneuver (mode 1), load angles (mode 2)."
+        "damping from a rigid maneuver (mode 1), load angles (mode 2), the chain tracked in "
+        "service with a drift alarm (mode 2, tracking = 1)."
     )
 
     @classmethod
@@ -211,6 +212,71 @@ class ReactionTorqueObserver(FmuSlave):
                 "Boolean",
             ),
             *cls.link_variables(),
+            *cls.tracking_variables(n),
+        ]
+
+    @staticmethod
+    def tracking_variables(n: int) -> list[Variable]:
+        """Tracking the chain in service (declared after the link's, so the earlier
+        variables keep their value references)."""
+        return [
+            par(
+                "tracking",
+                defaults.TRACKING,
+                "",
+                "Mode 2 on a chain: 0 = off; 1 = track k, B, f_c and D_m while the drive "
+                "works; theta_hat and omega_hat then come from the tracked chain (the "
+                "model-based observer's predictor, whatever estimator says)",
+            ),
+            par(
+                "tracking_time",
+                defaults.TRACKING_TIME,
+                "s",
+                "Tracking: the memory (samples weigh exp(-age/tracking_time))",
+            ),
+            par(
+                "drift_threshold",
+                defaults.DRIFT_THRESHOLD,
+                "1",
+                "Tracking: the relative change from the commissioning value (J, k, B, f_c, "
+                "D_m) that counts as drift",
+            ),
+            *array(out, "k_track", n, "N.m/rad", lambda i: f"Tracking: stiffness of spring {i}"),
+            *array(
+                out,
+                "k_track_std",
+                n,
+                "N.m/rad",
+                lambda i: f"Tracking: standard deviation of k_track[{i}]",
+            ),
+            *array(out, "B_track", n, "N.m.s/rad", lambda i: f"Tracking: damping of spring {i}"),
+            *array(
+                out,
+                "B_track_std",
+                n,
+                "N.m.s/rad",
+                lambda i: f"Tracking: standard deviation of B_track[{i}]",
+            ),
+            out("f_c_track", "N.m", "Tracking: motor Coulomb friction"),
+            out("f_c_track_std", "N.m", "Tracking: standard deviation of f_c_track"),
+            out("D_m_track", "N.m.s/rad", "Tracking: motor viscous friction"),
+            out("D_m_track_std", "N.m.s/rad", "Tracking: standard deviation of D_m_track"),
+            out(
+                "drift_alarm",
+                "",
+                "Tracking: 1 while a tracked parameter the motion resolves differs from its "
+                "commissioning value by more than drift_threshold of it and 3 standard "
+                "deviations",
+                "Integer",
+            ),
+            out(
+                "tracking_valid",
+                "",
+                "Tracking: 1 when the motion so far resolves every k and f_c (3 standard "
+                "deviations within drift_threshold), 0 while it cannot tell them apart "
+                "(e.g. at rest, or f_c at constant speed)",
+                "Integer",
+            ),
         ]
 
     @staticmethod
@@ -289,6 +355,8 @@ class ReactionTorqueObserver(FmuSlave):
                 *indexed("J", n),
                 *indexed("k", n),
                 "load_torque_bandwidth",
+                "tracking_time",
+                "drift_threshold",
             ],
             non_negative=[
                 "D_m",
@@ -303,6 +371,11 @@ class ReactionTorqueObserver(FmuSlave):
             finite=["dkt", "dJm"],
         )
         problems += self.link_problems()
+        if self.value("tracking") not in (0, 1):
+            problems.append(
+                f"parameter tracking = {self.value('tracking')} is not allowed (use 0 = off, "
+                "1 = track the chain)"
+            )
         if not problems and self.value("J_mo") + self.value("dJm") <= 0.0:
             problems.append("parameters J_mo + dJm must be > 0 (the motor inertia)")
         chain = not self.value("link_modes")
@@ -381,6 +454,9 @@ class ReactionTorqueObserver(FmuSlave):
             load_mass=v("load_mass"),
             load_torque_bandwidth=v("load_torque_bandwidth"),
             link=self.link() if 0 <= v("link_modes") <= defaults.LINK_MODES_MAX else None,
+            tracking=bool(v("tracking")),
+            tracking_time=v("tracking_time"),
+            drift_threshold=v("drift_threshold"),
         )
 
     def initialize(self) -> None:
@@ -406,6 +482,20 @@ class ReactionTorqueObserver(FmuSlave):
         self.out_load = self.vr["tau_load_hat"] if settings.load_mass else None
         self.out_tip = self.indices(["w_tip_hat", "alpha_tip_hat"]) if settings.link else None
 
+        self.out_track = None
+        if settings.tracking:
+            names = ["k_track", "B_track", "f_c_track", "D_m_track"]
+            stds = ["k_track_std", "B_track_std", "f_c_track_std", "D_m_track_std"]
+            values = [*indexed(names[0], n), *indexed(names[1], n), *names[2:]]
+            sigmas = [*indexed(stds[0], n), *indexed(stds[1], n), *stds[2:]]
+            self.out_track = (
+                self.indices(values),
+                self.indices(sigmas),
+                self.vr["drift_alarm"],
+                self.vr["tracking_valid"],
+            )
+            self.write_tracking()
+
         if settings.mode == Mode.STATE_ESTIMATION and not settings.link:
             for i, x in zip(self.out_theta, self.observer.estimator.theta):
                 self.v[i] = x
@@ -429,8 +519,21 @@ class ReactionTorqueObserver(FmuSlave):
             v[w0:w1] = estimator.omega
             if self.out_load is not None:
                 v[self.out_load] = estimator.tau_load
+            elif self.out_track is not None:
+                self.write_tracking()
         else:
             self.stale = True  # identification is solved when an output is read
+
+    def write_tracking(self) -> None:
+        """The tracker's parameters, their standard deviations, alarm and validity."""
+        tracker, v = self.observer.tracker, self.v
+        values, sigmas, alarm, valid = self.out_track
+        for i, x in zip(values, tracker.values()):
+            v[i] = x
+        for i, x in zip(sigmas, tracker.stds()):
+            v[i] = x
+        v[alarm] = int(tracker.alarm)
+        v[valid] = int(tracker.valid)
 
     def refresh(self) -> None:
         obs = self.observer

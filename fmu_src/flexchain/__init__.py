@@ -40,6 +40,9 @@ The observer
 * :mod:`~arcosim.fmu.flexchain.load_observer` — the same with the torque on one load mass.
 * :mod:`~arcosim.fmu.flexchain.link_observer` — the same on a flexible link's modes: the
   tip's deflection.
+* :mod:`~arcosim.fmu.flexchain.chain_tracker` — mode 2, estimator 1, ``tracking``: the
+  chain's springs, dampers and the motor friction tracked in service, their σ, the drift
+  alarm.
 * :mod:`~arcosim.fmu.flexchain.observer` — the settings, their rules
   (``ObserverSettings.problems``) and the observer that runs the configured mode.
 

@@ -45,6 +45,16 @@ LOAD_MASS = 0  #: the load mass whose external torque is estimated (0 = none)
 #: 10 rad/s cuts the lag to 0.34 s but quadruples what a 1 % model error leaks in (a
 #: model error at a frequency inside the bandwidth looks like a load torque).
 LOAD_TORQUE_BANDWIDTH = 5.0
+#: Tracking the chain in service (:mod:`~arcosim.fmu.flexchain.chain_tracker`): 0 = off.
+TRACKING = 0
+#: The tracker's memory (s): samples weigh e^(−age / tracking_time). A minute of the
+#: moves of a position loop resolves each stiffness to about 1 % (σ) on the bench's
+#: two-mass chain, and wear takes weeks: a minute follows it with room to spare.
+TRACKING_TIME = 60.0
+#: The relative change of a tracked parameter that counts as drift (dimensionless): 5 %,
+#: above the tracker's bias on a healthy chain (about 1 % on the stiffnesses) and below
+#: the 10 % that a model-based controller's margins are scored at.
+DRIFT_THRESHOLD = 0.05
 
 # -- the excitation source: the rigid maneuver of mode 1 ---------------------------------
 #: Peak current (A): well above f_c / k_t ≈ 0.05 A (``waveforms.rigid_maneuver``).

@@ -192,6 +192,45 @@ def step_model(
     ValueError
         If the Riccati iteration fails (noise outside :data:`NOISE_RANGE`).
     """
+    F, Gamma = filtered_chain(J, k, B, g_dist, h, star)
+    Q = chain_process_noise(Gamma, J, noise, h)
+    return StepModel(F, Gamma, steady_state_gain(F, Q, measurement_noise(noise)))
+
+
+def filtered_chain(
+    J: Sequence[float],
+    k: Sequence[float],
+    B: Sequence[float],
+    g_dist: float,
+    h: float,
+    star: bool = False,
+) -> tuple[Matrix, Matrix]:
+    """The discrete chain with the DOB's filter as its last state, ``s ← F s + Γ w``.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape
+        ``(n,)`` each.
+    g_dist : float
+        DOB bandwidth (rad/s).
+    h : float
+        Step (s).
+    star : bool
+        The springs as a star from the motor, not a chain.
+
+    Returns
+    -------
+    tuple of Matrix
+        ``F``, shape ``(m, m)`` with m = 2n + 1, and ``Γ``, shape ``(m, 2)``, for
+        ``w = [θ_m,k−1, v_k]`` (rad, rad/s); the last state is the model's τ̂_reac (N·m).
+
+    Examples
+    --------
+    >>> F, Gamma = filtered_chain((5e-4,), (0.16,), (1e-5,), 100.0, 1e-3)
+    >>> len(F), len(Gamma[0])
+    (3, 2)
+    """
     chain = discretize(J, k, B, h, star=star)
     n = chain.n
     m = 2 * n + 1
@@ -204,8 +243,7 @@ def step_model(
     F[m - 1][: 2 * n] = [b * x for x in c]
     F[m - 1][m - 1] = a
     Gamma = [row[:] for row in chain.Bd] + [[b * d[0], b * d[1]]]
-    Q = chain_process_noise(Gamma, J, noise, h)
-    return StepModel(F, Gamma, steady_state_gain(F, Q, measurement_noise(noise)))
+    return F, Gamma
 
 
 def advance(

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from . import defaults
 from .chain import Chain
+from .chain_tracker import ChainTracker
 from .codes import ESTIMATOR_NAMES, MODE_NAMES, Estimator, Mode, choice_problem
 from .dob import Actuator, ReactionObserver
 from .link_observer import LinkObserver, StarLink
@@ -77,6 +78,14 @@ class ObserverSettings:
     link : StarLink or None
         Model-based observer: a flexible link's modal model in place of the chain of
         ``J``, ``k``, ``B`` (:mod:`~arcosim.fmu.flexchain.link_observer`); None: the chain.
+    tracking : bool
+        Model-based observer on a chain: track its springs, dampers and the motor's
+        friction while it runs (:mod:`~arcosim.fmu.flexchain.chain_tracker`); the state
+        estimates then come from the tracked chain.
+    tracking_time : float
+        The tracker's memory (s), > 0.
+    drift_threshold : float
+        The relative change the tracker's alarm counts as drift (dimensionless), > 0.
 
     Examples
     --------
@@ -104,6 +113,9 @@ class ObserverSettings:
     load_mass: int = defaults.LOAD_MASS
     load_torque_bandwidth: float = defaults.LOAD_TORQUE_BANDWIDTH
     link: StarLink | None = None
+    tracking: bool = bool(defaults.TRACKING)
+    tracking_time: float = defaults.TRACKING_TIME
+    drift_threshold: float = defaults.DRIFT_THRESHOLD
 
     @classmethod
     def for_chain(
@@ -239,10 +251,11 @@ class ObserverSettings:
             choice_problem("mode", self.mode, MODE_NAMES),
             choice_problem("estimator", self.estimator, ESTIMATOR_NAMES),
         ]
-        if noise and self.model_based:
+        if noise and (self.model_based or self.tracking):
             found.append(noise_problem(self.torque_noise_std, self.tau_noise_std))
         found.append(load_mass_problem(self.load_mass, len(self.J), self.model_based))
         found.append(link_problem(self.link is not None, self.model_based, self.load_mass))
+        found.append(tracking_problem(self))
         return [problem for problem in found if problem is not None]
 
 
@@ -340,6 +353,33 @@ def link_problem(link: bool, model_based: bool, load_mass: int) -> str | None:
     return None
 
 
+def tracking_problem(settings: ObserverSettings) -> str | None:
+    """A sentence if tracking is asked for where the tracker cannot run: in mode 2 on a
+    chain, without a load torque state (its own constant torque takes a steady load). It
+    is then the state estimator, whatever ``estimator`` says (its predictor is the
+    model-based observer's, on the tracked chain).
+
+    Parameters
+    ----------
+    settings : ObserverSettings
+        The settings.
+
+    Returns
+    -------
+    str or None
+        The sentence, naming the fix; None when the settings can track (or do not).
+    """
+    s = settings
+    if not s.tracking:
+        return None
+    if s.mode != Mode.STATE_ESTIMATION or s.link is not None or s.load_mass:
+        return (
+            f"parameter tracking = 1 needs mode = {int(Mode.STATE_ESTIMATION)} (state "
+            "estimation), link_modes = 0 and load_mass = 0; set tracking = 0 otherwise"
+        )
+    return None
+
+
 def _short(x: float) -> str:
     """``x`` in the shortest scientific notation: 1e-4, 1.5e-3."""
     mantissa, exponent = f"{x:e}".split("e")
@@ -372,11 +412,15 @@ class Observer:
         problem = load_mass_problem(s.load_mass, len(s.J), s.model_based)
         if problem is None:
             problem = link_problem(s.link is not None, s.model_based, s.load_mass)
+        if problem is None:
+            problem = tracking_problem(s)
         if problem is not None:
             raise ValueError(problem)
         self.dob = ReactionObserver(s.actuator, s.g_dist, theta0, omega0)
         self.identifier: ActuatorIdentifier | RigidChainIdentifier | None = None
-        self.estimator: ChainRecursion | ModelObserver | LoadTorqueObserver | None = None
+        self.estimator: (
+            ChainRecursion | ModelObserver | LoadTorqueObserver | ChainTracker | None
+        ) = None
         self.rigid = s.link.J_rigid if s.link is not None else 0.0  # off τ̂_reac, on the hub
         self.offset = s.angle_offset() if s.mode == Mode.STATE_ESTIMATION else 0.0
         if s.mode == Mode.SELF_IDENTIFICATION:
@@ -384,6 +428,20 @@ class Observer:
         elif s.mode == Mode.RIGID_IDENTIFICATION:
             self.identifier = RigidChainIdentifier(
                 s.J, s.g_dist, s.kappa_correction, theta0, s.actuator.f_c
+            )
+        elif s.tracking:
+            self.estimator = ChainTracker(
+                s.J,
+                s.k,
+                s.B,
+                s.actuator.f_c,
+                s.actuator.D_m,
+                s.g_dist,
+                s.noise(),
+                theta0,
+                self.offset,
+                s.tracking_time,
+                s.drift_threshold,
             )
         elif s.estimator == Estimator.MODEL_BASED and s.load_mass > 0:
             self.estimator = LoadTorqueObserver(
@@ -418,13 +476,20 @@ class Observer:
         dob = self.dob
         dob.step(h, i_a, omega, theta)
         estimator = self.estimator
-        if estimator is not None:  # mode 2, the one that runs in control loops: test it first
+        if self.settings.tracking:  # the torque before friction; the tracker has its own
+            estimator.step(h, dob.drive + self.settings.actuator.D_m * dob.velocity, theta)
+        elif estimator is not None:  # mode 2, the one that runs in control loops: test it first
             tau = dob.tau_reac_hat - self.rigid * dob.alpha_hat if self.rigid else dob.tau_reac_hat
             estimator.step(h, tau, theta + self.offset)
         elif self.settings.mode == Mode.SELF_IDENTIFICATION:
             self.identifier.step(h, i_a, dob.velocity, dob.accel, dob.friction_sign, dob.d_hat)
         else:
             self.identifier.step(h, dob.drive, dob.friction_sign, omega, theta, dob.sticking)
+
+    @property
+    def tracker(self) -> ChainTracker | None:
+        """The chain tracker when the settings track (it is then the estimator), else None."""
+        return self.estimator if self.settings.tracking else None
 
     def estimate(self) -> None:
         """Solve the identification's normal equations (modes 0 and 1)."""

@@ -11,7 +11,7 @@
  *   real|int|bool NAME VR VALUE             (a parameter, set before initialization)
  *   string NAME VR VALUE...                 (the rest of the line)
  *   link A VR_OUT B VR_IN                   (Real output of A to Real input of B)
- *   out NAME VR r|b                         (an output to record: Real or Boolean)
+ *   out NAME VR r|b|i                       (an output to record: Real, Boolean or Integer)
  *   run STOP H
  *   sum                                     (optional: sum the time, t += h, as many hosts
  *                                            do; the last step is min(h, STOP - t))
@@ -49,6 +49,7 @@ typedef struct {
     fmi2SetStringTYPE *set_string;
     fmi2GetRealTYPE *get_real;
     fmi2GetBooleanTYPE *get_bool;
+    fmi2GetIntegerTYPE *get_int;
     fmi2DoStepTYPE *do_step;
 } Fmu;
 
@@ -173,6 +174,7 @@ int main(int argc, char **argv) {
         SYM(f, set_string, "fmi2SetString");
         SYM(f, get_real, "fmi2GetReal");
         SYM(f, get_bool, "fmi2GetBoolean");
+        SYM(f, get_int, "fmi2GetInteger");
         SYM(f, do_step, "fmi2DoStep");
         snprintf(uri, sizeof uri, "file://%s/resources", f->dir);
         f->c = f->instantiate(f->name, fmi2CoSimulation, f->guid, uri, &callbacks, fmi2False,
@@ -222,6 +224,10 @@ int main(int argc, char **argv) {
                 fmi2Boolean v;
                 check(f->get_bool(f->c, &vr, 1, &v), "getBoolean", f);
                 x = v ? 1.0 : 0.0;
+            } else if (b[k][0] == 'i') {
+                fmi2Integer v;
+                check(f->get_int(f->c, &vr, 1, &v), "getInteger", f);
+                x = (double)v;
             } else {
                 check(f->get_real(f->c, &vr, 1, &x), "getReal", f);
             }

@@ -83,26 +83,29 @@ def load(name, fmu, parameters):
 
 
 def output_reader(variables):
-    """(Real value references, Boolean value references, their names in that order)."""
+    """(Real, Boolean and Integer value references, their names in that order)."""
     outs = [v for v in variables.values() if v.causality == "output"]
     reals = [v for v in outs if v.type == "Real"]
     bools = [v for v in outs if v.type == "Boolean"]
+    ints = [v for v in outs if v.type == "Integer"]
     return (
         [v.valueReference for v in reals],
         [v.valueReference for v in bools],
-        [v.name for v in reals] + [v.name for v in bools],
+        [v.valueReference for v in ints],
+        [v.name for v in reals] + [v.name for v in bools] + [v.name for v in ints],
     )
 
 
 def simulate(slaves, readers, links, stop, h):
     """Jacobi steps from 0 to ``stop``; every output at every communication point."""
-    log = {name: {out: [] for out in readers[name][2]} for name in slaves}
+    log = {name: {out: [] for out in readers[name][3]} for name in slaves}
 
     def record():
         for name, slave in slaves.items():
-            reals, bools, names = readers[name]
+            reals, bools, ints, names = readers[name]
             values = list(slave.getReal(reals)) if reals else []
             values += [float(b) for b in slave.getBoolean(bools)] if bools else []
+            values += [float(i) for i in slave.getInteger(ints)] if ints else []
             for out, value in zip(names, values):
                 log[name][out].append(value)
 

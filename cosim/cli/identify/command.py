@@ -101,6 +101,7 @@ from arcosim.cli.identify.output_error import run_output_error
 from arcosim.cli.identify.plot import check_plot
 from arcosim.cli.identify.whole_chain import run_whole_chain
 from arcosim.cli.options import add_command, add_fmus_option, force_option, log_options, number
+from arcosim.cli.parameters import set_names
 from arcosim.errors import UserError
 from arcosim.logs import parse_scales, read_log
 
@@ -194,7 +195,8 @@ arcosim identify log.csv $M --chain chain.json --method load-torque --set load_m
         type=Path,
         metavar="FILE.png",
         help="whole-chain: the measured response torque → motor speed with its coherence, "
-        "the model's over it, the residual against the noise floor; and FILE.csv",
+        "the model's over it, the residual against the noise floor; and FILE.csv. "
+        "Observer, tracking=1: the tracked chain",
     )
     p.add_argument(
         "--reference",
@@ -216,8 +218,12 @@ def _execute(args: argparse.Namespace) -> int:
     """Check the options that do not need the log, read it, and run the method."""
     check_method_options(args)
     check_out(args, [])
-    if args.plot is not None and args.method != "whole-chain":
-        raise UserError(f"--plot is for --method whole-chain (not {args.method})")
+    tracking = args.method == "observer" and "tracking" in set_names(args.set)
+    if args.plot is not None and args.method != "whole-chain" and not tracking:
+        raise UserError(
+            "--plot is for --method whole-chain, or the observer with --set tracking=1 "
+            f"(not {args.method} without it)"
+        )
     check_plot(args)
     if args.chain and args.method in ("whole-chain", "beam"):
         raise UserError(

@@ -1,5 +1,7 @@
 """``arcosim identify --method observer`` (the default): the observer FMU replayed over
 the log, sample by sample; its final outputs printed, every output over time written.
+With ``--set tracking=1``: the tracked chain over time written (and drawn with ``--plot``),
+its final values with their σ, the alarm and validity printed.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ from arcosim.build.recipes import OBSERVER
 from arcosim.cli.identify.options import check_out
 from arcosim.cli.options import fmu_folder, fmu_inputs
 from arcosim.cli.parameters import defaults_note, drive_parameters, known_parameters, set_names
+from arcosim.errors import UserError
 from arcosim.fmu.flexchain.codes import Mode
 from arcosim.host.instance import FmuInstance
 from arcosim.host.replay import final_values, observer_parameters, replay_log
+from arcosim.host.tracking import TrackedChain, replay_tracking
 from arcosim.logs import DriveLog, tool_keys, write_csv
 
 
@@ -51,6 +55,13 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     )
     with FmuInstance(folder / f"{OBSERVER.name}.fmu", "observer") as observer:
         parameters = observer_parameters(observer, args.set, args.mode)
+        if parameters.get("tracking"):
+            tracked = replay_tracking(observer, log, parameters, n)
+            return _report_tracking(args, tracked, defaults)
+        if args.plot is not None:
+            raise UserError(
+                "--plot with the observer draws the tracked chain: add --set tracking=1"
+            )
         recording = replay_log(observer, log, parameters)
         final = final_values(observer, recording)
     if args.out:
@@ -66,6 +77,49 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
         _print_summary(final, len(log), args.out)
         if defaults:
             print(f"assumption, defaults: {defaults}")
+    return 0
+
+
+def _report_tracking(args: argparse.Namespace, tracked: TrackedChain, defaults: str) -> int:
+    """Write, draw and print a tracked replay; exit status 0."""
+    from arcosim.experiments.tracking_figure import draw_tracking
+
+    if args.out:
+        columns, units = tracked.columns()
+        write_csv(args.out, columns, units=units, tool_names=args.tool_names, force=args.force)
+    if args.plot is not None:
+        draw_tracking(tracked, args.plot, force=args.force)
+    final = {
+        name: {"value": float(v), "std": float(s), "commissioning": float(c)}
+        for name, v, s, c in zip(
+            tracked.names, tracked.values[-1], tracked.stds[-1], tracked.commissioning
+        )
+    }
+    summary = {
+        "tracked": final,
+        "drift_alarm": int(tracked.alarm[-1]),
+        "tracking_valid": int(tracked.valid[-1]),
+        "first_alarm_time": tracked.first_alarm(),
+    }
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"{len(tracked.time)} samples; the tracked chain at the end (value ± σ, given):")
+        for name, row in final.items():
+            print(
+                f"  {name:8s} {row['value']:.6g} ± {row['std']:.2g}  ({row['commissioning']:.6g})"
+            )
+        alarm = summary["first_alarm_time"]
+        print(
+            f"  drift_alarm {summary['drift_alarm']}, first raised at "
+            + (f"{alarm:g} s" if alarm is not None else "no time")
+        )
+        print(f"  tracking_valid {summary['tracking_valid']}")
+        for path in (args.out, args.plot):
+            if path:
+                print(f"wrote {path}")
+    if defaults:
+        print(f"assumption, defaults: {defaults}", file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

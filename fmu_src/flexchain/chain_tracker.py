@@ -1,0 +1,488 @@
+"""Tracking the chain in service: a recursive prediction-error estimator of the springs,
+the dampers and the motor friction, with their standard deviations and a drift alarm.
+
+The predictor is the model-based observer's (:mod:`~arcosim.fmu.flexchain.model_observer`):
+the chain driven by the measured motor angle, its reaction torque through the DOB's
+``G(s)``, corrected by a Kalman gain. Here the measured output is the torque on the motor
+before friction, ``z = G[k_t i − J_m α]``, and the model adds the motor's friction and a
+constant torque to the chain's:
+
+    ŷ_k = y_k(k, B) + f_c · G[sgn θ̇_m] + D_m · G[θ̇_m] + τ_0
+
+(τ_0: a constant load through the chain and any current-sensor offset, estimated and not
+reported). The parameters ``p = [k_1…k_n, B_1…B_n, f_c, D_m, τ_0]``, each in units of its
+scale (its commissioning value, or a floor where that is zero), follow a recursive
+prediction-error method (Ljung & Söderström, 1983): the gradient ``ψ = ∂ŷ/∂p`` comes from
+the predictor's sensitivity equations,
+
+    S_j ← (I − K eᵀ) (F S_j + ∂F/∂p_j s + ∂Γ/∂p_j w)        (∂K/∂p neglected)
+
+and a recursive least squares with exponential forgetting updates ``p`` and its
+covariance ``P``:
+
+    λ = 1 − h / tracking_time,   L = P ψ̃ / (λ + ψ̃ᵀ P ψ̃),   p ← p + L ẽ,   P ← (P − L ψ̃ᵀ P) / λ
+
+with ψ̃ and ẽ prefiltered (:data:`PREFILTER_RATIO`), and in units of the innovation's
+running standard deviation, so ``P`` is the covariance of ``p`` for white innovations. A
+sample weighs ``λ^age``: the memory's time constant is ``tracking_time``. The prior (the
+commissioning values, σ :data:`PRIOR_STD`) is forgotten and renewed at the same rate
+(stabilized forgetting, Kulhavý 1987): ``p ← p + (1 − λ) P P₀⁻¹ (p₀ − p)`` each step,
+so a parameter the operation does not resolve returns to its commissioning value over
+``tracking_time`` instead of wandering on the errors of the others, and ``P``'s diagonal
+is capped at the prior's. Dampers and frictions are kept ≥ 0, stiffnesses within
+:data:`STIFFNESS_RANGE` of their scale.
+``F``, ``Γ`` and their derivatives (central differences of the exact discretization) are
+designed at a point ``p_d`` and redesigned when a chain parameter has moved
+:data:`REDESIGN_STEP` from it; in between the predictor uses the first-order expansion
+``F(p) ≈ F(p_d) + Σ ∂F/∂p_j (p_j − p_d,j)``. The Kalman gain stays the commissioning
+chain's: the gradient neglects ∂K/∂p, which is then exact (a gain redesigned with the
+parameters took the two-mass chain's k_1 to 1.10 of its true value, 1.03 with it held).
+
+Each step costs a fixed number of operations (one redesign at most, of fixed size), and
+the state is a fixed set of numbers: constant memory, bounded cost.
+
+What it reports:
+
+* the standard deviations ``σ_j = √(P_jj · ν)``, ν the variance inflation of an AR(1)
+  innovation, ``(1 + ρ) / (1 − ρ)`` with ρ its running lag-one correlation (the DOB's
+  filter and the encoder colour the innovation; white innovations give ν = 1);
+* ``valid``: every stiffness and the Coulomb friction resolved, ``3 σ_j`` within
+  ``drift_threshold`` of the parameter's scale: the motion so far tells a drift of the
+  threshold's size from the noise. At constant speed ``sgn θ̇_m`` and ``θ̇_m`` are
+  constants like ``τ_0``, so f_c is not resolved; at rest nothing is;
+* ``alarm``: some tracked parameter (not τ_0) that the motion resolves (as above) differs
+  from its commissioning value by more than ``drift_threshold`` of it and by more than
+  3 σ_j. A parameter the operation does not tell apart raises no alarm: a damper of a
+  lightly damped chain is seldom resolved in ordinary operation, and with σ capped at
+  the prior its estimate would otherwise alarm on any model error.
+
+Which way the motor slides comes from the encoder's edges
+(:meth:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge.sliding`): below a count per step
+its backward difference reads 0 on most steps, and a move of 1 rad in 1 s on 2000 counts
+at 1 ms is mostly there. While the edges show no slide the motor may stand still, and
+static friction (unknown within ±f_c) acts; the G-filtered measurement remembers it for
+:data:`SETTLE` / g_dist s. Over such a step the friction input is the one that makes
+the step's torque the predictor's, clamped to the band (as
+:func:`~arcosim.fmu.flexchain.dob.settle_sticking`), and neither the parameters nor the
+states are corrected until the memory has passed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from operator import mul
+
+from . import defaults
+from .control.encoder_edge import CrossedEdge
+from .filters import lowpass_pole
+from .linalg import Matrix
+from .model_observer import NoiseModel, filtered_chain, step_model
+
+#: The prior's standard deviation of each parameter in units of its scale
+#: (dimensionless): the commissioning chain is known to 10 % (an identification's own σ is
+#: well below). A larger prior lets the first samples, whose errors are coloured, move the
+#: parameters so far that the predictor leaves the region where its sensitivities hold
+#: (measured: at 0.5 the two-mass chain's k went to 1.1–1.2 of a true 1.0 within 2 s of
+#: moves; at 0.1 it stayed within 1 %). Also the cap of ``P``'s diagonal: with forgetting
+#: and no information (the motor at rest), ``P`` grows as λ^−t; capped there, the
+#: estimator never becomes less certain than before it had seen any data.
+PRIOR_STD = 0.1
+#: The chain's parameters are kept within these factors of their scale (a stiffness a
+#: quarter or four times the commissioning one is no drift but a different machine;
+#: the projection keeps the predictor stable, as the recursive prediction-error method
+#: requires, Ljung & Söderström 1983, sec. 6.6).
+STIFFNESS_RANGE = (0.25, 4.0)
+#: Dampers, friction and viscous friction between 0 and this many scales.
+DISSIPATION_MAX = 100.0
+#: A damper's scale where its commissioning value is smaller: the damping of a 1 %
+#: damping ratio of the spring against its own mass, 2 · 0.01 · √(k_i J_i) (N·m·s/rad).
+#: Structural damping ratios lie well below it, so the alarm's relative test is taken
+#: against this, not against a value near zero.
+DAMPING_RATIO_FLOOR = 0.01
+#: The motor speed (rad/s) at which the viscous friction's scale equals the Coulomb
+#: friction's: D_m's scale where it is smaller is (f_c's scale) / this.
+VISCOUS_SPEED = 10.0
+#: The relative move (in units of the scale) of a chain parameter from the design point
+#: after which ``F``, ``Γ`` and their derivatives are redesigned: the first-order
+#: expansion in between errs by the square of it (1e-4, far below the 3 % sought).
+REDESIGN_STEP = 0.01
+#: Relative step of the central differences of the discretization (dimensionless): their
+#: truncation error is of its square, their rounding of 1e-16 over it.
+DIFFERENCE_STEP = 1e-4
+#: The prediction error and its gradient pass a first-order low-pass at this share of
+#: g_dist before the least squares (the prefilter L(q) of the prediction-error method,
+#: Ljung 1999, sec. 14.4): the criterion weighs the band of the chain's modes, which the
+#: DOB passes, over the encoder's quantization noise above it, which the DOB's acceleration
+#: and the predictor's input speed share (errors in variables: without it the two-mass
+#: chain's k_1 crept to 1.04 in 60 s of moves and f_c to 1.06; with it both within 0.5 %).
+PREFILTER_RATIO = 0.5
+#: Steps that differ by less than this (relative) share a design: a log's time column
+#: read back gives steps a few ulps apart, and the discrete model differs by as little.
+STEP_TOLERANCE = 1e-9
+#: Innovations beyond this many running standard deviations are clipped in the update
+#: (Huber's robust least squares): a load step or a missed count moves the parameters by
+#: at most this much evidence.
+CLIP = 4.0
+#: Settling of the DOB's filter after a stuck step, in time constants 1/g_dist: e^−5 of
+#: the static friction left (the self-identification's rule).
+SETTLE = 5.0
+#: The viscous friction's regressor is the motor speed over this many steps (the angle's
+#: difference across them over their time; a count): the encoder's quantization enters
+#: the measured torque through the DOB's acceleration, the difference of two one-step
+#: speeds, and a one-step speed as regressor shares that noise (errors in variables:
+#: on the two-mass chain D_m went to −10 times its value and f_c 20 % high). Over 20 steps
+#: the shared part is a twentieth, and at 1 ms the 10 ms lag is far below a move's time.
+SPEED_STEPS = 20
+#: The AR(1) inflation is kept within [1, this]: ρ near 1 means the innovation is a
+#: slow wander, and σ from it would be meaningless beyond.
+INFLATION_MAX = 1e3
+
+
+def scales(
+    J: Sequence[float],
+    k: Sequence[float],
+    B: Sequence[float],
+    f_c: float,
+    D_m: float,
+    torque_floor: float,
+) -> list[float]:
+    """Each tracked parameter's scale: its commissioning value, or a floor.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        Load inertias (kg·m²), stiffnesses (N·m/rad), dampings (N·m·s/rad), shape
+        ``(n,)`` each.
+    f_c, D_m : float
+        Commissioning Coulomb friction (N·m) and viscous friction (N·m·s/rad).
+    torque_floor : float
+        The least torque the scales resolve (N·m): f_c's and τ_0's floor.
+
+    Returns
+    -------
+    list of float
+        Scales of ``[k_1…k_n, B_1…B_n, f_c, D_m, τ_0]`` in their units, shape ``(2n + 3,)``.
+
+    Examples
+    --------
+    >>> [round(x, 6) for x in scales((5e-4,), (0.16,), (1e-5,), 0.0, 0.0, 1e-3)]
+    [0.16, 0.000179, 0.001, 0.0001, 0.001]
+    """
+    damping = [max(b, 2.0 * DAMPING_RATIO_FLOOR * math.sqrt(kk * j)) for j, kk, b in zip(J, k, B)]
+    friction = max(f_c, torque_floor)
+    return [*k, *damping, friction, max(D_m, friction / VISCOUS_SPEED), torque_floor]
+
+
+class ChainTracker:
+    """The chain's springs, dampers and the motor friction, tracked from the motor side.
+
+    Parameters
+    ----------
+    J, k, B : Sequence[float]
+        The commissioning chain: load inertias (kg·m², known), stiffnesses (N·m/rad, > 0),
+        dampings (N·m·s/rad, ≥ 0), shape ``(n,)`` each.
+    f_c, D_m : float
+        The commissioning motor Coulomb friction (N·m) and viscous friction (N·m·s/rad).
+    g_dist : float
+        The DOB's bandwidth (rad/s).
+    noise : NoiseModel
+        The noise levels of the model-based observer (its Kalman gain, and the floor of
+        the torques: ``tau_noise_std``).
+    theta0 : float
+        The encoder's reading at start (rad); the chain starts at rest, aligned.
+    half_count : float
+        Half an encoder count (rad; 0 for an exact angle): the predictor takes the angle
+        at the middle of the count, as the model-based observer does.
+    tracking_time : float
+        The memory's time constant (s), > 0.
+    drift_threshold : float
+        The relative change that counts as drift (dimensionless), > 0.
+
+    Attributes
+    ----------
+    p : list of float
+        The parameters in units of their scales, shape ``(2n + 3,)``.
+    P : list of list of float
+        Their covariance for white innovations, shape ``(2n + 3, 2n + 3)``.
+    theta, omega : list of float
+        The predictor's load angles (rad) and velocities (rad/s), shape ``(n,)``: the
+        model-based state estimate on the tracked chain.
+    valid, alarm : bool
+        See the module doc.
+
+    Examples
+    --------
+    >>> noise = NoiseModel(1e-3, 1e-4, 1.5e-3)
+    >>> tr = ChainTracker((5e-4,), (0.16,), (1e-5,), 2e-3, 2e-5, 100.0, noise, 0.0, 0.0,
+    ...                   60.0, 0.05)
+    >>> tr.step(1e-3, 0.0, 0.0)  # at rest: nothing learnt
+    >>> tr.values()[0], tr.valid, tr.alarm
+    (0.16, False, False)
+    """
+
+    def __init__(
+        self,
+        J: Sequence[float],
+        k: Sequence[float],
+        B: Sequence[float],
+        f_c: float,
+        D_m: float,
+        g_dist: float,
+        noise: NoiseModel,
+        theta0: float,
+        half_count: float,
+        tracking_time: float,
+        drift_threshold: float,
+    ) -> None:
+        n = len(J)
+        self.n = n
+        self.J = tuple(J)
+        self.g_dist = g_dist
+        self.noise = noise
+        self.theta0 = theta0 + half_count
+        self.edges = CrossedEdge(theta0, half_count)
+        self.tracking_time = tracking_time
+        self.drift_threshold = drift_threshold
+        self.scale = scales(J, k, B, f_c, D_m, noise.tau_noise_std)
+        self.p0 = [x / s for x, s in zip([*k, *B, f_c, D_m, 0.0], self.scale)]
+        size = 2 * n + 3
+        self.p = self.p0[:]
+        self.P = [[PRIOR_STD**2 if i == j else 0.0 for j in range(size)] for i in range(size)]
+        m = 2 * n + 1
+        self.s = [0.0] * m  # chain state [θ, ω] relative to theta0, and its filtered torque
+        self.S = [[0.0] * m for _ in range(size)]  # ∂s/∂p_j
+        self.u_prev = 0.0  # motor angle at the previous sample, relative to theta0
+        self.g_sign = 0.0  # G[sgn θ̇_m]
+        self.g_speed = 0.0  # G[θ̇_m] (rad/s)
+        self.readings = [theta0] * (SPEED_STEPS + 1)  # the last encoder readings (rad)
+        self.times = [0.0] * SPEED_STEPS  # the steps between them (s)
+        self.z = 0.0  # G[k_t i − J_m α] (N·m)
+        self.variance = noise.tau_noise_std**2  # running mean square of the innovation
+        self.lag_product = 0.0  # running mean of e_k e_{k−1}
+        self.e_prev = 0.0
+        self.e_f = 0.0  # the prefiltered innovation (N·m) …
+        self.psi_f = [0.0] * size  # … and gradient (N·m per scale)
+        self.quiet = 0.0  # s left before a stuck step's friction has left the filter
+        self.theta = [self.theta0] * n
+        self.omega = [0.0] * n
+        self.valid = False
+        self.alarm = False
+        # the design: F, Γ and their derivatives at p_d, the gain, for step h_d
+        self.h_d = 0.0
+        self.p_d = self.p[: 2 * n]
+        self.F: Matrix = []
+        self.Gamma: Matrix = []
+        self.dF: list[Matrix] = []
+        self.dGamma: list[Matrix] = []
+        self.K: list[float] = []
+
+    def chain(self, p: Sequence[float]) -> tuple[list[float], list[float]]:
+        """Stiffnesses (N·m/rad) and dampings (N·m·s/rad) of ``p``, shape ``(n,)`` each."""
+        n, sc = self.n, self.scale
+        return (
+            [p[i] * sc[i] for i in range(n)],
+            [p[n + i] * sc[n + i] for i in range(n)],
+        )
+
+    def design(self, h: float) -> None:
+        """Discretize at the present parameters for step ``h`` (s): ``F``, ``Γ`` and their
+        derivatives by each chain parameter (central differences); for a new step, the
+        Kalman gain, at the commissioning chain."""
+        n = self.n
+        if not self.K or not same_step(h, self.h_d):
+            k, B = self.chain(self.p0)
+            self.K = step_model(self.J, k, B, self.g_dist, self.noise, h).K
+        p_d = self.p[: 2 * n]
+        self.F, self.Gamma = filtered_chain(self.J, *self.chain(p_d), self.g_dist, h)
+        self.dF, self.dGamma = [], []
+        for j in range(2 * n):
+            delta = DIFFERENCE_STEP * max(p_d[j], 1.0)
+            sides = []
+            for sign in (1.0, -1.0):
+                q = p_d[:]
+                q[j] += sign * delta
+                sides.append(filtered_chain(self.J, *self.chain(q), self.g_dist, h))
+            (Fp, Gp), (Fm, Gm) = sides
+            self.dF.append(
+                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Fp, Fm)]
+            )
+            self.dGamma.append(
+                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Gp, Gm)]
+            )
+        self.h_d = h
+        self.p_d = p_d
+
+    def step(
+        self,
+        h: float,
+        torque: float,
+        theta_m: float,
+    ) -> None:
+        """Take the sample that ends a step.
+
+        Parameters
+        ----------
+        h : float
+            Time since the previous sample (s), > 0.
+        torque : float
+            The torque on the motor before friction over the step, ``k_t i − J_m α``
+            (N·m; the DOB's, unfiltered).
+        theta_m : float
+            The encoder's reading at the sample (rad).
+        """
+        n = self.n
+        self.edges.step(h, theta_m)
+        self.readings = readings = [*self.readings[1:], theta_m]
+        self.times = times = [*self.times[1:], h]
+        span = math.fsum(times)
+        speed = (readings[-1] - readings[0]) / span if times[0] > 0.0 else 0.0
+        friction_sign = self.edges.sliding(defaults.SLIDING_INTERVAL)
+        sticking = friction_sign == 0.0
+        theta_m += self.edges.half_count
+        if not same_step(h, self.h_d) or any(
+            abs(a - b) > REDESIGN_STEP for a, b in zip(self.p, self.p_d)
+        ):
+            self.design(h)
+        p, sc = self.p, self.scale
+        F, Gamma, K = self.F, self.Gamma, self.K
+        u = theta_m - self.theta0
+        w0, w1 = self.u_prev, (u - self.u_prev) / h
+        s = self.s
+        # the chain's step at p: F(p_d) s + Γ(p_d) w + Σ_j (∂F_j s + ∂Γ_j w) Δp_j
+        chain_terms = [
+            [fsum_dot(row, s) + g[0] * w0 + g[1] * w1 for row, g in zip(dF, dG)]
+            for dF, dG in zip(self.dF, self.dGamma)
+        ]
+        pred = [fsum_dot(row, s) + g[0] * w0 + g[1] * w1 for row, g in zip(F, Gamma)]
+        for j, col in enumerate(chain_terms):
+            dp = p[j] - self.p_d[j]
+            if dp:
+                pred = [x + dp * c for x, c in zip(pred, col)]
+        a = lowpass_pole(self.g_dist, h)
+        b = 1.0 - a
+        f_c, D_m, tau_0 = (p[i] * sc[i] for i in range(2 * n, 2 * n + 3))
+        if sticking:  # static friction: the value that agrees with the predictor, in band
+            chain_torque = (pred[-1] - a * s[-1]) / b
+            rest = torque - D_m * speed - tau_0 - chain_torque
+            friction_sign = max(-1.0, min(1.0, rest / f_c)) if f_c > 0.0 else 0.0
+            self.quiet = SETTLE / self.g_dist
+        else:
+            self.quiet = max(0.0, self.quiet - h)
+        self.z = z = a * self.z + b * torque
+        self.g_sign = a * self.g_sign + b * friction_sign
+        self.g_speed = a * self.g_speed + b * speed
+        e = z - (pred[-1] + f_c * self.g_sign + D_m * self.g_speed + tau_0)
+        # sensitivities of the prediction; ψ_j = ∂ŷ/∂p_j
+        S = [[fsum_dot(row, Sj) for row in F] for Sj in self.S]
+        for j, col in enumerate(chain_terms):
+            S[j] = [x + c for x, c in zip(S[j], col)]
+        psi = [Sj[-1] for Sj in S]
+        psi[2 * n] += sc[2 * n] * self.g_sign
+        psi[2 * n + 1] += sc[2 * n + 1] * self.g_speed
+        psi[2 * n + 2] += sc[2 * n + 2]
+        # the criterion's prefilter (both the error and its gradient)
+        ap = lowpass_pole(PREFILTER_RATIO * self.g_dist, h)
+        bp = 1.0 - ap
+        self.e_f = ap * self.e_f + bp * e
+        self.psi_f = [ap * x + bp * y for x, y in zip(self.psi_f, psi)]
+        correct = self.quiet == 0.0
+        if correct:
+            self.learn(h, self.e_f, self.psi_f)
+            self.s = [x + kk * e for x, kk in zip(pred, K)]
+            self.S = [[x - kk * q for x, kk in zip(Sj, K)] for Sj, q in zip(S, psi)]
+        else:
+            self.s, self.S = pred, S
+        self.u_prev = u
+        t0 = self.theta0
+        self.theta = [t0 + x for x in self.s[:n]]
+        self.omega = self.s[n : 2 * n]
+        self.judge()
+
+    def learn(self, h: float, e: float, psi: list[float]) -> None:
+        """One recursive least-squares step with forgetting on the innovation ``e`` (N·m)
+        and its gradient ``psi`` (N·m per scale), shape ``(2n + 3,)``."""
+        lam = 1.0 - h / self.tracking_time
+        self.lag_product = lam * self.lag_product + (1.0 - lam) * e * self.e_prev
+        self.e_prev = e
+        sd = math.sqrt(self.variance)
+        self.variance = lam * self.variance + (1.0 - lam) * e * e
+        e_n = max(-CLIP, min(CLIP, e / sd))
+        x = [q / sd for q in psi]
+        P = self.P
+        Px = [fsum_dot(row, x) for row in P]
+        denominator = lam + fsum_dot(x, Px)
+        gain = [q / denominator for q in Px]
+        size = len(P)
+        p = self.p
+        # the prior's information, forgotten as the data's, renewed at the same rate
+        # (stabilized forgetting): each step pulls p towards p0 by (1 − λ) P P0⁻¹ (p0 − p)
+        pull = (1.0 - lam) / PRIOR_STD**2
+        offset = [a - b for a, b in zip(self.p0, p)]
+        for i in range(size):
+            p[i] += gain[i] * e_n + pull * fsum_dot(P[i], offset)
+        cap = PRIOR_STD**2
+        for i in range(size):
+            row, gi = P[i], gain[i]
+            for j in range(size):
+                row[j] = (row[j] - gi * Px[j]) / lam
+        shrink = [min(1.0, math.sqrt(cap / P[i][i])) if P[i][i] > cap else 1.0 for i in range(size)]
+        if any(f < 1.0 for f in shrink):
+            for i in range(size):
+                row, fi = P[i], shrink[i]
+                for j in range(size):
+                    row[j] *= fi * shrink[j]
+        self.project()
+
+    def project(self) -> None:
+        """Keep every parameter in its physical range (:data:`STIFFNESS_RANGE`,
+        :data:`DISSIPATION_MAX`)."""
+        n, p = self.n, self.p
+        low, high = STIFFNESS_RANGE
+        for i in range(n):
+            p[i] = min(max(p[i], low * self.p0[i]), high * self.p0[i])
+        for i in range(n, 2 * n + 2):
+            p[i] = min(max(p[i], 0.0), DISSIPATION_MAX)
+
+    def inflation(self) -> float:
+        """The AR(1) variance inflation ``(1 + ρ) / (1 − ρ)`` of the innovation, in
+        [1, :data:`INFLATION_MAX`] (dimensionless)."""
+        rho = self.lag_product / self.variance if self.variance > 0.0 else 0.0
+        if rho >= 1.0:
+            return INFLATION_MAX
+        return min(INFLATION_MAX, max(1.0, (1.0 + rho) / (1.0 - rho)))
+
+    def stds(self) -> list[float]:
+        """Standard deviations of the tracked parameters in their units, shape ``(2n + 2,)``
+        (``[k…, B…, f_c, D_m]``)."""
+        nu = self.inflation()
+        size = 2 * self.n + 2
+        return [math.sqrt(max(self.P[i][i], 0.0) * nu) * self.scale[i] for i in range(size)]
+
+    def values(self) -> list[float]:
+        """The tracked parameters in their units, shape ``(2n + 2,)`` (``[k…, B…, f_c, D_m]``)."""
+        return [x * s for x, s in zip(self.p[: 2 * self.n + 2], self.scale)]
+
+    def judge(self) -> None:
+        """Set :attr:`valid` and :attr:`alarm` (see the module doc)."""
+        n = self.n
+        nu = self.inflation()
+        threshold = self.drift_threshold
+        sigma = [math.sqrt(max(self.P[i][i], 0.0) * nu) for i in range(2 * n + 2)]
+        resolved = [3.0 * x <= threshold for x in sigma]
+        self.valid = all(resolved[:n]) and resolved[2 * n]
+        self.alarm = any(
+            resolved[i]
+            and abs(self.p[i] - self.p0[i]) > max(threshold * abs(self.p0[i]), 3.0 * sigma[i])
+            for i in range(2 * n + 2)
+        )
+
+
+def same_step(h: float, h_d: float) -> bool:
+    """Whether a step ``h`` (s) is the design's ``h_d`` to within :data:`STEP_TOLERANCE`."""
+    return abs(h - h_d) <= STEP_TOLERANCE * h_d
+
+
+def fsum_dot(a: Sequence[float], b: Sequence[float]) -> float:
+    """``Σ a_i b_i`` by :func:`math.fsum` (the same sum on every CPython)."""
+    return math.fsum(map(mul, a, b))

@@ -1,0 +1,138 @@
+"""The chain tracker (arcosim.fmu.flexchain.chain_tracker) on logs of the independent
+drive simulator (benchmarks.simulators.field_sim)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.chain_tracker import PRIOR_STD, ChainTracker
+from arcosim.fmu.flexchain.dob import Actuator, ReactionObserver
+from arcosim.fmu.flexchain.model_observer import NoiseModel
+from arcosim.fmu.fmukit.state import restore, snapshot
+from benchmarks.simulators import field_sim
+
+H = 1e-3
+G = defaults.G_DIST
+J2 = tuple(defaults.inertias(2))
+K2 = (defaults.K,) * 2
+B2 = (defaults.B,) * 2
+
+
+def moves(t: np.ndarray) -> np.ndarray:
+    """Back-and-forth moves: 1 rad in 1 s (a cycloid), 1 s dwell, back (rad)."""
+    phase = np.mod(np.asarray(t, float), 4.0)
+    up, down = np.clip(phase, 0.0, 1.0), np.clip(phase - 2.0, 0.0, 1.0)
+
+    def cycloid(x: np.ndarray) -> np.ndarray:
+        return x - np.sin(2 * np.pi * x) / (2 * np.pi)
+
+    return cycloid(up) - cycloid(down)
+
+
+def drive(**kw) -> field_sim.Drive:
+    base = dict(J_m=defaults.J_M, k_t=defaults.K_T, J=J2, k=K2, B=B2)
+    base.update(kw)
+    return field_sim.Drive(**base)
+
+
+def log_of(plant: field_sim.Drive, duration: float, reference=moves, position_gain=5.0):
+    loop = field_sim.SpeedLoop(0.1, 0.5, reference, limit=10.0, position_gain=position_gain)
+    return field_sim.simulate(plant, H, duration, speed_loop=loop, seed=1)
+
+
+def tracker(plant: field_sim.Drive, theta0: float = 0.0) -> ChainTracker:
+    half = math.pi / plant.counts if plant.counts else 0.0
+    noise = NoiseModel(2 * half / math.sqrt(3.0), defaults.TORQUE_NOISE_STD, defaults.TAU_NOISE_STD)
+    return ChainTracker(J2, K2, B2, plant.f_c, plant.D_m, G, noise, theta0, half, 60.0, 0.05)
+
+
+def replay(tr: ChainTracker, plant: field_sim.Drive, log, start: int = 1, stop=None):
+    """Feed the log's samples to the tracker through the DOB's torque."""
+    dob = ReactionObserver(Actuator(plant.J_m, plant.k_t), G, 0.0, 0.0)
+    for i in range(start, stop or len(log.time)):
+        dob.step(H, float(log.i_a[i]), float(log.omega_m[i]), float(log.theta_m[i]))
+        tr.step(H, dob.drive, float(log.theta_m[i]))
+
+
+def test_at_rest_it_learns_nothing():
+    tr = tracker(drive(f_c=defaults.F_C, counts=2000))
+    prior = [row[:] for row in tr.P]
+    for _ in range(2000):
+        tr.step(H, 0.0, 0.0)
+    assert tr.p == tr.p0
+    assert tr.P == prior
+    assert not tr.valid and not tr.alarm
+    assert tr.values()[:2] == list(K2)
+
+
+@pytest.mark.slow
+def test_gradient_is_the_innovations_derivative():
+    """ψ_j, from the sensitivity equations, against a central difference of the
+    innovation over 1.5 s of a move (learning off): the difference's own error is of
+    order δ² and the neglected ∂K/∂p is zero with the gain held, so 1 % is ample."""
+    plant = drive(counts=0)
+    log = log_of(plant, 1.5)
+
+    def innovations(j: int, delta: float):
+        tr = tracker(plant)
+        tr.p[j] += delta
+        found: list[tuple[float, float]] = []
+        tr.learn = lambda h, e, psi: found.append((e, psi[j]))
+        replay(tr, plant, log)
+        return np.array(found)
+
+    delta = 1e-3  # below REDESIGN_STEP: both runs share one design and gain
+    for j in (0, 1, 2, 4):
+        plus, minus, base = innovations(j, delta), innovations(j, -delta), innovations(j, 0.0)
+        numeric = -(plus[:, 0] - minus[:, 0]) / (2 * delta)
+        psi = base[:, 1]
+        assert np.linalg.norm(numeric - psi) <= 0.01 * np.linalg.norm(psi), j
+
+
+@pytest.mark.slow
+def test_memory_is_constant_and_state_round_trips():
+    plant = drive(f_c=defaults.F_C, counts=2000, current_noise=0.005)
+    log = log_of(plant, 3.0)
+    tr = tracker(plant)
+    replay(tr, plant, log, 1, 1000)
+    size = len(json.dumps(snapshot(tr)))
+    copy = restore(json.loads(json.dumps(snapshot(tr))))
+    replay(tr, plant, log, 1000, 3000)
+    replay(copy, plant, log, 1000, 3000)
+    assert len(json.dumps(snapshot(tr))) == pytest.approx(size, rel=0.01)  # digits only
+    assert snapshot(copy) == snapshot(tr)
+
+
+@pytest.mark.slow
+def test_tracks_a_two_mass_chain_in_moves():
+    """A healthy two-mass chain in 40 s of position-loop moves with the realistic
+    sensors: every k within 3 % (the issue's target), resolved, and σ_k within a few %
+    (the prior's 10 % shrinks with the moves' information)."""
+    plant = drive(D_m=defaults.D_M, f_c=defaults.F_C, counts=2000, current_noise=0.005)
+    log = log_of(plant, 40.0)
+    tr = tracker(plant)
+    replay(tr, plant, log)
+    k, std = tr.values()[:2], tr.stds()[:2]
+    assert all(abs(x / y - 1.0) < 0.03 for x, y in zip(k, K2)), k
+    assert all(s < 0.03 * y for s, y in zip(std, K2)), std
+    assert tr.valid
+
+
+@pytest.mark.slow
+def test_constant_speed_cannot_resolve_friction():
+    """At constant speed the Coulomb friction is one more constant torque, like τ_0:
+    not resolved, so not valid, and no alarm."""
+    plant = drive(D_m=defaults.D_M, f_c=defaults.F_C, counts=2000, current_noise=0.005)
+    ramp = lambda t: np.minimum(np.asarray(t, float), 1.0) * 5.0  # noqa: E731 (rad/s)
+    log = log_of(plant, 20.0, reference=ramp, position_gain=0.0)
+    tr = tracker(plant)
+    replay(tr, plant, log)
+    assert not tr.valid
+    assert 3.0 * tr.stds()[4] > 0.05 * tr.scale[4]
+    assert not tr.alarm
+    assert tr.P[4][4] <= PRIOR_STD**2 * (1 + 1e-12)
