@@ -8,7 +8,7 @@ parameters tracked over time, their standard deviations, the drift alarm and val
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,6 +86,20 @@ def tracking_outputs(n: int) -> tuple[list[str], list[str], list[str]]:
     stds = [*(f"k_track_std[{i}]" for i in idx), *(f"B_track_std[{i}]" for i in idx)]
     stds += ["f_c_track_std", "D_m_track_std"]
     return given, tracked, stds
+
+
+def untracked_outputs(names: Sequence[str], n: int) -> list[str]:
+    """``names`` (an observer's outputs) without the tracker's, which stay 0 while
+    tracking is off: what a replay without tracking records, for ``n`` masses.
+
+    Examples
+    --------
+    >>> untracked_outputs(["d_hat", "k_track[1]", "k_track_std[1]", "drift_alarm"], 1)
+    ['d_hat']
+    """
+    _, tracked, stds = tracking_outputs(n)
+    tracker = {*tracked, *stds, "drift_alarm", "tracking_valid"}
+    return [name for name in names if name not in tracker]
 
 
 def replay_tracking(

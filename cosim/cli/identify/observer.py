@@ -19,7 +19,7 @@ from arcosim.errors import UserError
 from arcosim.fmu.flexchain.codes import Mode
 from arcosim.host.instance import FmuInstance
 from arcosim.host.replay import final_values, observer_parameters, replay_log
-from arcosim.host.tracking import TrackedChain, replay_tracking
+from arcosim.host.tracking import TrackedChain, replay_tracking, untracked_outputs
 from arcosim.logs import DriveLog, tool_keys, write_csv
 
 
@@ -62,7 +62,8 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
             raise UserError(
                 "--plot with the observer draws the tracked chain: add --set tracking=1"
             )
-        recording = replay_log(observer, log, parameters)
+        outputs = untracked_outputs(observer.output_names(), n)
+        recording = replay_log(observer, log, parameters, outputs)
         final = final_values(observer, recording)
     if args.out:
         columns = {"time": recording.time}
