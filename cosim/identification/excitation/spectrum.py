@@ -139,8 +139,8 @@ class ExcitationSpectrum:
         'periodic: 3 lines on harmonics of 1 rad/s (period 6.28 s), 1 … 5 rad/s'
         >>> lines = np.arange(11.0, 251.0) * 2 * np.pi
         >>> ExcitationSpectrum("periodic", lines, np.ones(240), (lines[0], lines[-1]),
-        ...                    2 * np.pi, periods=20).text()[:73]
-        'periodic: 240 lines on harmonics of 6.283 rad/s (period 1 s, 20 whole pe'
+        ...                    2 * np.pi, periods=20).text()[:72]
+        'periodic: 240 lines on harmonics of 6.283 rad/s (period 1 s, 20 whole p'
         """
         low, high = self.band
         span = f"{low:.3g} … {high:.4g} rad/s"
