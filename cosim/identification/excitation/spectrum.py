@@ -140,7 +140,7 @@ class ExcitationSpectrum:
         >>> lines = np.arange(11.0, 251.0) * 2 * np.pi
         >>> ExcitationSpectrum("periodic", lines, np.ones(240), (lines[0], lines[-1]),
         ...                    2 * np.pi, periods=20).text()[:72]
-        'periodic: 240 lines on harmonics of 6.283 rad/s (period 1 s, 20 whole p'
+        'periodic: 240 lines on harmonics of 6.283 rad/s (period 1 s, 20 whole pe'
         """
         low, high = self.band
         span = f"{low:.3g} … {high:.4g} rad/s"
