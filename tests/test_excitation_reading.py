@@ -45,8 +45,9 @@ def test_forty_lines_on_the_grid_read_as_forty(seed) -> None:
 def test_forty_lines_off_the_grid_invent_none(seed, offset) -> None:
     """Off the grid: every line whose neighbours lie beyond its Hann main lobe and theirs
     (over three bins, 6π/T: the lobes are two bins wide either side) found within a
-    fifth of a bin (the merged lines a few bins below, fitted as one, pull on it), no line found over a bin from a played one, and the lines under two
-    bins apart (under about 6 rad/s in 20 s) merge: 33 … 40."""
+    fifth of a bin (the merged lines a few bins below, fitted as one, pull on it); no
+    line found over a bin from a played one; the lines under two bins apart (under
+    about 6 rad/s in 20 s) merge: 33 … 40."""
     lines = LINES if offset == "geometric" else excitations.offgrid_lines(LINES, 20.0)
     found = excitation_spectrum(drive_current(lines, seed), H)
     assert found.kind == "lines" and 33 <= len(found.lines) <= 40, found.text()
