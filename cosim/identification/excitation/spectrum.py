@@ -372,15 +372,14 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
         return np.empty(0), np.empty(0), share
     coarse = position[keep] * resolution
     amplitude = amplitude[keep]
-    played = played_lines(amplitude)
-    coarse, amplitude = coarse[played], amplitude[played]
-    # lines under two periods of the record are told from a trend's remnant poorly:
-    # the harmonic test leaves them out, and a periodic excitation keeps its harmonics
-    low = coarse >= 2 * resolution
-    w0 = harmonic_fundamental(coarse[low], resolution, amplitude[low])
+    # a periodic reference's harmonics, all of them (in a position loop its current
+    # shows the loop's resonance above them: they are played all the same)
+    w0 = harmonic_fundamental(coarse, resolution, amplitude)
     if w0:
         on = on_harmonics(coarse, w0, resolution)
         return np.rint(coarse[on] / w0) * w0, amplitude[on], share
+    played = played_lines(amplitude)
+    coarse, amplitude = coarse[played], amplitude[played]
     if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
         return coarse, amplitude, share
     q_decimate = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
