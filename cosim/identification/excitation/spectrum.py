@@ -70,9 +70,10 @@ REFINE_LIMIT = 120
 #: Broadband: the usable band is where the Welch spectrum stays above this fraction of
 #: its peak (dimensionless; 0.1: −10 dB).
 BROADBAND_DROP = 0.1
-#: Least periods (a count) a line must hold in the record: under two, its Hann main lobe
-#: (two bins either side) reaches bin 0 and the trend the detrend removed.
-LEAST_LINE_PERIODS = 2.0
+#: Least periods (a count) a line must hold in the record: under one it is a trend, not
+#: a line (a line of one to three periods is kept, and the record-length check warns of
+#: it).
+LEAST_LINE_PERIODS = 1.0
 #: The lines a drive adds lie beneath the played ones by at least this ratio of
 #: amplitudes (dimensionless; 2: 6 dB). A designed multi-sine's lines, flat or shaped
 #: smoothly over the band, differ from their neighbours in amplitude far less (40
@@ -365,9 +366,7 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     resolution = 2.0 * np.pi / (n * h)
     amplitude = 2.0 * np.sqrt(power[bins]) / np.sum(np.hanning(n))
     position = _interpolated(power, bins)
-    # under two periods in the record a line's main lobe (two bins either side) reaches
-    # bin 0, where the trend the detrend removed lies: it is not told from that trend
-    keep = position >= LEAST_LINE_PERIODS
+    keep = position >= LEAST_LINE_PERIODS  # under one period in the record: a trend
     if not np.any(keep):
         return np.empty(0), np.empty(0), share
     coarse = position[keep] * resolution
