@@ -4,7 +4,9 @@ what the excitation is, the band it shows modes in, and the one to play.
 Modules:
 
 spectrum        -- what the excitation is: lines (leakage-aware), harmonics of one period,
-                   or broadband with its band (excitation_spectrum)
+                   or broadband with its band (excitation_spectrum); the lines played
+periodic        -- a record of whole periods: the period, its harmonics over the noise
+                   (the χ² detection threshold, the local noise level)
 harmonics       -- lines that are harmonics of one fundamental (a periodic reference)
 line_prominence -- which found lines are lines: the prominence again on their fitted
                    amplitudes, over the noise and the detrend's remnant

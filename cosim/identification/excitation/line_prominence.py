@@ -2,15 +2,15 @@
 amplitudes a joint fit gives (offline).
 
 :mod:`arcosim.identification.excitation.spectrum` finds a multi-sine's lines as the Hann
-periodogram's peaks that stand a prominence above its median and above the leakage of
-every stronger line, then refines them by least squares. One source of a false peak
+periodogram's peaks that stand the χ² threshold above its noise level and above the
+leakage of every stronger line, then refines them by least squares. One source of a false peak
 stays: removing the signal's linear trend also removes its lines' projection on a
 constant and a ramp, and leaves that projection, sign turned, in the signal. A ramp's
 Hann spectrum peaks one to two bins above 0, where the periodogram then finds a weak
 "line" (0.48 rad/s in a 20 s record of 40 lines 3–150 rad/s, 1 % of their amplitude),
 which fed the torque balance and the record-length check false warnings. Once the lines
 are fitted that remnant is known: :func:`prominent_lines` asks each line to pass the
-same prominence over the noise and it.
+same threshold over the noise and it.
 """
 
 from __future__ import annotations
@@ -18,22 +18,23 @@ from __future__ import annotations
 import numpy as np
 
 
-def noise_amplitude(floor: float, n: int) -> float:
+def noise_amplitude(floor: float | np.ndarray, n: int) -> float | np.ndarray:
     """The amplitude (the signal's unit) whose Hann periodogram peak, (a·Σw/2)², is the
-    periodogram's level ``floor`` (its median: the noise or broadband level), the record
-    ``n`` samples long: that level in a line's unit.
+    periodogram's level ``floor`` (its noise level), the record ``n`` samples long: that
+    level in a line's unit.
 
     Parameters
     ----------
-    floor : float
-        The Hann-windowed periodogram's median (the signal's unit squared).
+    floor : float or ndarray
+        The Hann-windowed periodogram's noise level (the signal's unit squared), any
+        shape.
     n : int
         Samples in the record (a count).
 
     Returns
     -------
-    float
-        The amplitude (the signal's unit).
+    float or ndarray
+        The amplitude (the signal's unit), the shape of ``floor``.
 
     Examples
     --------
@@ -42,11 +43,12 @@ def noise_amplitude(floor: float, n: int) -> float:
     >>> round(noise_amplitude(float(np.median(power[1:])), 20000), 4)   # unit white noise
     0.0142
     """
-    return float(2.0 * np.sqrt(floor) / np.sum(np.hanning(n)))
+    amplitude = 2.0 * np.sqrt(floor) / np.sum(np.hanning(n))
+    return float(amplitude) if np.ndim(amplitude) == 0 else amplitude
 
 
 def prominent_lines(
-    x: np.ndarray, h: float, lines: np.ndarray, noise: float, prominence: float
+    x: np.ndarray, h: float, lines: np.ndarray, noise: float | np.ndarray, prominence: float
 ) -> np.ndarray:
     """Which refined lines pass the periodogram's test again, on their fitted amplitudes:
     ``prominence`` times (in power) above the noise and the detrend's remnant.
@@ -65,11 +67,13 @@ def prominent_lines(
         Its sample step (s).
     lines : ndarray
         The refined lines (rad/s), shape ``(L,)``.
-    noise : float
-        The noise level in a line's amplitude (the signal's unit, :func:`noise_amplitude`).
+    noise : float or ndarray
+        The noise level in a line's amplitude (the signal's unit, :func:`noise_amplitude`),
+        one for all or one per line, shape ``(L,)``.
     prominence : float
         The power ratio a line must stand above the noise and the remnant
-        (dimensionless; :data:`~arcosim.identification.excitation.spectrum.LINE_PROMINENCE`).
+        (dimensionless; the χ² threshold,
+        :func:`~arcosim.identification.excitation.periodic.detection_threshold`).
 
     Returns
     -------
@@ -98,9 +102,10 @@ def prominent_lines(
     basis = np.linalg.qr(trend)[0]
     each = basis.T @ (cos * c + sin * s)  # each line's projection on the constant and ramp
     keep = np.zeros(len(lines), dtype=bool)
+    noise = np.broadcast_to(np.asarray(noise, dtype=float), (len(lines),))
     for i in range(len(lines)):
         remnant = basis @ (each.sum(axis=1) - each[:, i])
         pair = np.column_stack([cos[:, i], sin[:, i]])
         a_rem = float(np.hypot(*np.linalg.lstsq(pair, remnant, rcond=None)[0]))
-        keep[i] = np.hypot(c[i], s[i]) ** 2 >= prominence * (noise**2 + a_rem**2)
+        keep[i] = np.hypot(c[i], s[i]) ** 2 >= prominence * (noise[i] ** 2 + a_rem**2)
     return keep

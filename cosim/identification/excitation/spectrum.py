@@ -3,21 +3,31 @@
 :func:`excitation_spectrum` reads a command or a measured current (any unit, a constant
 step) and says what was played, for the log's check and the fits' decisions
 (:mod:`arcosim.identification.checks.log_decision`) and for the measured frequency response
-(:mod:`arcosim.identification.checks.frf`):
+(:mod:`arcosim.identification.checks.frf`). One test decides what is a line: a bin whose
+power stands over the noise level (the mean power of a noise bin) by the χ² threshold
+q = ln(K / 0.5) over the K bins tested, so that noise alone passes on half a bin of the
+band on average (:func:`~arcosim.identification.excitation.periodic.detection_threshold`).
 
-- **lines** (a multi-sine, on or off the record's frequency grid): the peaks of the
-  Hann-windowed periodogram that stand :data:`LINE_PROMINENCE` times above its median
-  *and* above the leakage of every stronger line (the Hann window's sidelobe envelope,
-  :func:`leakage_envelope`), so an off-grid line counts once and not as the dozen
-  sidelobes its leakage leaves; each line's frequency then refined by a least-squares
-  fit of a sine at off-grid frequencies (:func:`refine_lines`), and a line kept only if
-  its fitted amplitude passes the same prominence over the noise and the linear
-  detrend's remnant (:mod:`arcosim.identification.excitation.line_prominence`: that remnant, a
-  ramp, reads as a weak line one to two bins above 0);
-- **periodic** (a square-wave or stepped reference, position-loop steps): lines that all
-  sit on whole multiples of one fundamental whose first harmonics are present, counted
-  as the harmonics of that fundamental
+- **periodic, whole periods** (a Schroeder or random-phase multi-sine played period
+  after period, a square wave, when the record holds M ≥ 2 whole periods): the period
+  from the greatest common divisor of the strongest bins on the record's DFT grid, the
+  noise level from the bins between the harmonics, the lines the harmonics above it
+  (:mod:`arcosim.identification.excitation.periodic`); the fundamental is the greatest
+  common divisor of the lines played;
+- **lines** (a multi-sine whose lines are not harmonics of the record's period): the
+  peaks of the Hann-windowed periodogram above the threshold *and* above the leakage of
+  every stronger line (the window's sidelobe envelope, :func:`leakage_envelope`), so an
+  off-grid line counts once and not as the dozen sidelobes its leakage leaves; each
+  line's frequency then refined by a least-squares fit of a sine at off-grid frequencies
+  (:func:`refine_lines`), and a line kept only if its fitted amplitude passes the same
+  threshold over the noise and the linear detrend's remnant
+  (:mod:`arcosim.identification.excitation.line_prominence`: that remnant, a ramp, reads as
+  a weak line one to two bins above 0); lines that sit on whole multiples of one
+  fundamental whose first harmonics are present (a periodic reference over a record of
+  no whole number of periods) read as **periodic**
   (:func:`~arcosim.identification.excitation.harmonics.harmonic_fundamental`);
+- in both, the lines the drive adds beneath the played ones (friction's and the current
+  loop's harmonics, in a measured current) are not played lines (:func:`played_lines`);
 - **broadband** (PRBS, noise, steps): lines that carry less than
   :data:`LINE_SHARE` of the signal's power; the usable band is where the Welch spectrum
   stays within :data:`BROADBAND_DROP` of its peak (:func:`broadband_band`).
@@ -38,10 +48,14 @@ from arcosim.identification.excitation.harmonics import (
     on_harmonics,
 )
 from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
+from arcosim.identification.excitation.periodic import (
+    detection_threshold,
+    harmonic_lines,
+    noise_level,
+    on_grid,
+    whole_periods,
+)
 
-#: A line stands this many times above the periodogram's median (its noise or
-#: broadband level) and above the leakage envelope of the stronger lines.
-LINE_PROMINENCE = 30.0
 #: Share of the signal's power (dimensionless, 0 … 1) the lines must carry for the
 #: excitation to count as lines; below it, broadband.
 LINE_SHARE = 0.8
@@ -56,6 +70,21 @@ REFINE_LIMIT = 120
 #: Broadband: the usable band is where the Welch spectrum stays above this fraction of
 #: its peak (dimensionless; 0.1: −10 dB).
 BROADBAND_DROP = 0.1
+#: Least periods (a count) a line must hold in the record: under one it is a trend, not
+#: a line (a line of one to three periods is kept, and the record-length check warns of
+#: it).
+LEAST_LINE_PERIODS = 1.0
+#: The lines a drive adds lie beneath the played ones by at least this ratio of
+#: amplitudes (dimensionless; 2: 6 dB). A designed multi-sine's lines, flat or shaped
+#: smoothly over the band, differ from their neighbours in amplitude far less (40
+#: log-spaced lines with amplitudes ∝ ω: 10 %); a square wave's first two harmonics by
+#: 3, which :data:`DISTORTION_SHARE` keeps together.
+DISTORTION_GAP = 2.0
+#: The lines beneath such a gap are the drive's own when they carry at most this share
+#: of the lines' power (dimensionless; 0.05: 13 dB under the played lines): what a
+#: linear chain's fit leaves as distortion, not what an excitation plays (a square
+#: wave's harmonics above its fundamental carry 19 %).
+DISTORTION_SHARE = 0.05
 
 
 @dataclass(frozen=True)
@@ -80,6 +109,9 @@ class ExcitationSpectrum:
         Share of the signal's power in the lines (dimensionless, 0 … 1).
     resolution : float
         The record's frequency grid 2π/T (rad/s).
+    periods : int
+        Whole periods the record holds (a count); 0 when it is not read as whole
+        periods.
     """
 
     kind: str
@@ -89,6 +121,7 @@ class ExcitationSpectrum:
     fundamental: float = 0.0
     line_share: float = 0.0
     resolution: float = 0.0
+    periods: int = 0
 
     @property
     def lowest(self) -> float | None:
@@ -107,7 +140,11 @@ class ExcitationSpectrum:
         --------
         >>> ExcitationSpectrum("periodic", np.array([1.0, 3.0, 5.0]), np.ones(3), (1.0, 5.0),
         ...                    1.0).text()
-        'periodic: 3 harmonics of 1 rad/s (period 6.28 s), 1 … 5 rad/s'
+        'periodic: 3 lines on harmonics of 1 rad/s (period 6.28 s), 1 … 5 rad/s'
+        >>> lines = np.arange(11.0, 251.0) * 2 * np.pi
+        >>> ExcitationSpectrum("periodic", lines, np.ones(240), (lines[0], lines[-1]),
+        ...                    2 * np.pi, periods=20).text()[:72]
+        'periodic: 240 lines on harmonics of 6.283 rad/s (period 1 s, 20 whole pe'
         """
         low, high = self.band
         span = f"{low:.3g} … {high:.4g} rad/s"
@@ -115,9 +152,10 @@ class ExcitationSpectrum:
             return f"multi-sine: {len(self.lines)} lines, {span}"
         if self.kind == "periodic":
             period = 2 * np.pi / self.fundamental
+            whole = f", {self.periods} whole periods in the record" if self.periods else ""
             return (
-                f"periodic: {len(self.lines)} harmonics of {self.fundamental:.4g} rad/s "
-                f"(period {period:.3g} s), {span}"
+                f"periodic: {len(self.lines)} lines on harmonics of {self.fundamental:.4g} "
+                f"rad/s (period {period:.3g} s{whole}), {span}"
             )
         if self.kind == "broadband":
             return f"broadband: {span} (the Welch spectrum within 10 dB of its peak)"
@@ -126,6 +164,14 @@ class ExcitationSpectrum:
 
 def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     """What excitation a signal carries: lines, harmonics of one period, or broadband.
+
+    A record of whole periods (:func:`~arcosim.identification.excitation.periodic.whole_periods`)
+    is read on its harmonics (:func:`~arcosim.identification.excitation.periodic.harmonic_lines`),
+    any other by the Hann periodogram's peaks (:func:`spectral_lines`); in both, a bin
+    counts as a line when it stands over the noise level by the χ² threshold that lets
+    :data:`~arcosim.identification.excitation.periodic.FALSE_LINES` noise bins through
+    over the band, and the lines played are told from the drive's own lines beneath them
+    (:func:`played_lines`).
 
     Parameters
     ----------
@@ -143,7 +189,7 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     Examples
     --------
     A multi-sine of 40 lines off the record's grid counts as lines, not as their leakage
-    (the pairs under about 6 rad/s, under two bins apart, merge: 33):
+    (the lines under about 6 rad/s, under two bins apart, merge in the window: 34):
 
     >>> t = np.arange(20001) * 1e-3
     >>> lines = np.geomspace(3.0, 150.0, 40)
@@ -151,17 +197,34 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     >>> current = np.sin(np.outer(t, lines) + phases).sum(axis=1) * 0.075
     >>> found = excitation_spectrum(current, 1e-3)
     >>> found.kind, len(found.lines), round(found.band[1], 1)
-    ('lines', 33, 150.0)
+    ('lines', 34, 150.0)
+
+    The same lines moved onto the record's grid: each in its own bin, all 40:
+
+    >>> grid = 2 * np.pi / 20.001
+    >>> current = np.sin(np.outer(t, np.rint(lines / grid) * grid) + phases).sum(axis=1) * 0.075
+    >>> current += 0.005 * np.random.default_rng(2).standard_normal(len(t))
+    >>> len(excitation_spectrum(current, 1e-3).lines)
+    40
     """
     x = np.asarray(x, dtype=float)
     if len(x) < 16 or not np.all(np.isfinite(x)):
         return ExcitationSpectrum("none")
+    resolution = 2.0 * np.pi / (len(x) * h)
+    centred = x - x.mean()
+    periodic = _periodic(centred, h)
+    if periodic is not None:
+        return periodic
     t = np.arange(len(x)) * h
     x = x - np.polyval(np.polyfit(t, x, 1), t)
-    resolution = 2.0 * np.pi / (len(x) * h)
     if not np.any(x):
         return ExcitationSpectrum("none", resolution=resolution)
     lines, amplitudes, share = spectral_lines(x, h)
+    if len(lines) and share >= LINE_SHARE and on_grid(lines, resolution):
+        # on the grid, no window: each line in its bin, lines a bin apart apart
+        bins, amplitudes, _ = harmonic_lines(centred, 1)
+        played = played_lines(amplitudes)
+        lines, amplitudes = bins[played] * resolution, amplitudes[played]
     if len(lines) and share >= LINE_SHARE:
         fundamental = harmonic_fundamental(lines, resolution)
         kind = "periodic" if fundamental else "lines"
@@ -173,15 +236,93 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     return ExcitationSpectrum("broadband", band=band, line_share=share, resolution=resolution)
 
 
+def _periodic(x: np.ndarray, h: float) -> ExcitationSpectrum | None:
+    """The spectrum of a record of whole periods (``x`` mean removed, shape ``(N,)``,
+    step ``h`` s), its lines those played; None when it does not hold whole periods
+    or its harmonics carry under :data:`LINE_SHARE` of its power."""
+    periods = whole_periods(x)
+    if not periods:
+        return None
+    harmonics, amplitudes, share = harmonic_lines(x, periods)
+    if len(harmonics) == 0 or share < LINE_SHARE:
+        return None
+    played = played_lines(amplitudes)
+    harmonics, amplitudes = harmonics[played], amplitudes[played]
+    per_period = 2.0 * np.pi * periods / (len(x) * h)  # the first harmonic (rad/s)
+    lines = harmonics * per_period
+    fundamental = float(np.gcd.reduce(harmonics)) * per_period
+    band = (float(lines[0]), float(lines[-1]))
+    resolution = 2.0 * np.pi / (len(x) * h)
+    return ExcitationSpectrum(
+        "periodic", lines, amplitudes, band, fundamental, share, resolution, periods
+    )
+
+
+def played_lines(amplitudes: np.ndarray) -> np.ndarray:
+    """Which lines the excitation plays, among lines that all stand above the noise.
+
+    A drive adds lines of its own in step with what it is played: friction's and the
+    current loop's harmonics and intermodulation, in the current as in the motion. They
+    are lines too, above the noise, but beneath the played ones: a multi-sine plays its
+    lines at one designed level (flat, or shaped smoothly across the band), and a log
+    fit for a linear chain has what the drive adds well below it (else no linear model
+    describes it). The lines sorted by amplitude part at their widest ratio between
+    neighbours when it spans at least :data:`DISTORTION_GAP` and the lines beneath carry
+    at most :data:`DISTORTION_SHARE` of the lines' power; otherwise every line is played
+    (a square wave's harmonics, falling as 1/k, carry 19 % of its power above the
+    fundamental: all played).
+
+    Parameters
+    ----------
+    amplitudes : ndarray
+        The lines' amplitudes (any unit), shape ``(L,)``.
+
+    Returns
+    -------
+    ndarray
+        Boolean, shape ``(L,)``: the lines played.
+
+    Examples
+    --------
+    240 lines near 0.85 A over 1000 harmonics of friction under 0.15 A (the motor
+    bench's current):
+
+    >>> rng = np.random.default_rng(0)
+    >>> a = np.concatenate([rng.uniform(0.77, 0.93, 240), rng.uniform(0.001, 0.142, 1000)])
+    >>> int(played_lines(a).sum())
+    240
+    >>> int(played_lines(1.0 / np.arange(1, 40, 2)).sum())   # a square wave's
+    20
+    """
+    a = np.asarray(amplitudes, dtype=float)
+    played = np.ones(len(a), dtype=bool)
+    if len(a) < 2:
+        return played
+    order = np.argsort(-a)
+    sorted_a = np.maximum(a[order], 1e-300)
+    power = sorted_a**2
+    beneath = (power.sum() - np.cumsum(power))[:-1] / power.sum()  # below each split
+    ratio = sorted_a[:-1] / sorted_a[1:]
+    allowed = (beneath <= DISTORTION_SHARE) & (ratio >= DISTORTION_GAP)
+    if not np.any(allowed):
+        return played
+    split = int(np.argmax(np.where(allowed, ratio, 0.0)))
+    played[order[split + 1 :]] = False
+    return played
+
+
 def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, float]:
     """The lines of a detrended signal, leakage-aware.
 
-    Peaks of the Hann-windowed periodogram above :data:`LINE_PROMINENCE` times its
-    median and above the leakage of every stronger peak (:func:`leakage_envelope`);
-    then, unless they are harmonics of one fundamental, their frequencies refined
-    together by least squares (:func:`refine_lines`) on the signal decimated to the
-    lines' band, and the residual searched once more for lines the window merged
-    (lines closer than two bins, 4π/T).
+    Peaks of the Hann-windowed periodogram that stand over its noise level (its local
+    lower quartile over ln(4/3)) by the χ² threshold
+    (:func:`~arcosim.identification.excitation.periodic.detection_threshold`) and over
+    the leakage of every stronger peak (:func:`leakage_envelope`); then, unless they
+    are harmonics of one fundamental, their frequencies refined together by least
+    squares (:func:`refine_lines`) on the signal decimated to the lines' band, each
+    held to the same threshold on its fitted amplitude
+    (:func:`~arcosim.identification.excitation.line_prominence.prominent_lines`), and
+    the lines played kept (:func:`played_lines`).
 
     Parameters
     ----------
@@ -207,36 +348,45 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     (array([10.29, 40.08]), array([1. , 0.5]), 1.0)
     """
     n = len(x)
-    bins, power = _peaks(x)
+    bins, power, level, q = _peaks(x)
     if not len(bins):
         return np.empty(0), np.empty(0), 0.0
+    # the lines' power: over each peak's main lobe (two bins either side), and every
+    # bin above the threshold between the first and the last peak, so that lines a
+    # window merges count whole (a step's 1/k decay from its one peak does not)
     near = np.zeros(len(power), dtype=bool)
     for d in range(-2, 3):
         near[np.clip(bins + d, 1, len(power) - 1)] = True
+    inside = np.zeros(len(power), dtype=bool)
+    inside[bins[0] : bins[-1] + 1] = True
+    near |= inside & (power > q * level)
     share = float(power[near].sum() / max(power[1:].sum(), 1e-300))
     if share < LINE_SHARE or len(bins) > MAX_LINES:
         return np.empty(0), np.empty(0), share
     resolution = 2.0 * np.pi / (n * h)
     amplitude = 2.0 * np.sqrt(power[bins]) / np.sum(np.hanning(n))
     position = _interpolated(power, bins)
-    keep = position >= 1.0  # under one period in the record: a trend, not a line
+    keep = position >= LEAST_LINE_PERIODS  # under one period in the record: a trend
     if not np.any(keep):
         return np.empty(0), np.empty(0), share
     coarse = position[keep] * resolution
-    # lines under two periods of the record are told from a trend's remnant poorly:
-    # the harmonic test leaves them out, and a periodic excitation keeps its harmonics
-    low = coarse >= 2 * resolution
-    w0 = harmonic_fundamental(coarse[low], resolution, amplitude[keep][low])
+    amplitude = amplitude[keep]
+    # a periodic reference's harmonics, all of them (in a position loop its current
+    # shows the loop's resonance above them: they are played all the same)
+    w0 = harmonic_fundamental(coarse, resolution, amplitude)
     if w0:
         on = on_harmonics(coarse, w0, resolution)
-        return np.rint(coarse[on] / w0) * w0, amplitude[keep][on], share
+        return np.rint(coarse[on] / w0) * w0, amplitude[on], share
+    played = played_lines(amplitude)
+    coarse, amplitude = coarse[played], amplitude[played]
     if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
-        return coarse, amplitude[keep], share
-    q = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
-    y = sp_signal.resample_poly(x, 1, q) if q > 1 else x
-    lines, amplitudes, _ = refine_lines(y, q * h, coarse)
-    noise = noise_amplitude(_floor(power), n)
-    prominent = prominent_lines(y, q * h, lines, noise, LINE_PROMINENCE)
+        return coarse, amplitude, share
+    q_decimate = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
+    y = sp_signal.resample_poly(x, 1, q_decimate) if q_decimate > 1 else x
+    lines, amplitudes, _ = refine_lines(y, q_decimate * h, coarse)
+    at = np.clip(np.rint(lines / resolution).astype(int), 1, len(level) - 1)
+    noise = noise_amplitude(level[at], n)
+    prominent = prominent_lines(y, q_decimate * h, lines, noise, q)
     order = np.argsort(lines[prominent])
     return lines[prominent][order], amplitudes[prominent][order], share
 
@@ -251,31 +401,29 @@ def _peaks_power(x: np.ndarray) -> np.ndarray:
     return np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
 
 
-def _floor(power: np.ndarray) -> float:
-    """The periodogram's median (its noise or broadband level)."""
-    return max(float(np.median(power[1:])), 1e-300)
-
-
-def _peaks(x: np.ndarray, floor: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Bins of the lines in ``x`` (shape ``(N,)``): peaks of the Hann periodogram
-    :data:`LINE_PROMINENCE` times above ``floor`` (default its median) and above the
-    leakage envelope of every stronger peak; with the periodogram."""
+def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Bins of the lines in ``x`` (shape ``(N,)``): peaks of the Hann periodogram whose
+    power exceeds q times the noise level plus the leakage envelope of every stronger
+    peak, q the χ² threshold over the periodogram's bins; with the periodogram, the
+    noise level at each bin (its local lower quartile over ln(4/3),
+    :func:`~arcosim.identification.excitation.periodic.noise_level`) and q."""
     power = _peaks_power(x)
-    floor = _floor(power) if floor is None else floor
+    level = np.concatenate([[np.inf], noise_level(power[1:])])
+    q = detection_threshold(len(power) - 1)
     peak = np.zeros(len(power), dtype=bool)
     peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
-    candidates = np.flatnonzero(peak & (power > LINE_PROMINENCE * floor))
+    candidates = np.flatnonzero(peak & (power > q * level))
     accepted: list[int] = []
     leak = np.zeros(len(power))
     reach = np.arange(-LEAKAGE_REACH, LEAKAGE_REACH + 1)
     envelope = leakage_envelope(reach)
     for j in candidates[np.argsort(-power[candidates])]:
-        if power[j] <= LINE_PROMINENCE * (floor + leak[j]):
+        if power[j] <= q * (level[j] + leak[j]):
             continue
         accepted.append(int(j))
         near = (j + reach >= 0) & (j + reach < len(power))
         leak[j + reach[near]] += power[j] * envelope[near]
-    return np.sort(np.array(accepted, dtype=int)), power
+    return np.sort(np.array(accepted, dtype=int)), power, level, q
 
 
 def leakage_envelope(distance: np.ndarray) -> np.ndarray:
