@@ -74,7 +74,10 @@ def test_ssp_in_ecos_matches_the_fmpy_jacobi_run(build_fmus, tmp_path) -> None:
             scale = max(np.max(np.abs(mine)), 1e-300)
             assert np.max(np.abs(mine - theirs[:, j + 1])) <= 1e-9 * scale, f"{component}.{name}"
             compared += 1
-    assert compared == 37  # 1 source + 16 plant + 20 observer outputs (w_tip_hat, alpha_tip_hat)
+    # 1 source + 16 plant + 38 observer outputs: 20 (w_tip_hat, alpha_tip_hat among them) and
+    # the tracker's 18 for n = 3 (k, B and their σ per spring; f_c, D_m and their σ; the alarm
+    # and the validity)
+    assert compared == 55
 
 
 def test_a_missing_system_library_skips_ecos_naming_its_package(
