@@ -41,7 +41,7 @@ class TrackedChain:
     Examples
     --------
     >>> t = np.array([0.0, 1.0])
-    >>> run = arcosim.host.tracking.TrackedChain(t, ("k[1]",), ("N.m/rad",),
+    >>> run = TrackedChain(t, ("k[1]",), ("N.m/rad",),
     ...     np.array([[1.0], [0.9]]), np.array([[0.1], [0.01]]), np.array([1.0]),
     ...     np.array([0, 1]), np.array([0, 1]))
     >>> run.first_alarm()
@@ -76,6 +76,10 @@ class TrackedChain:
         return columns, units
 
 
+#: The tracker's Integer outputs: the drift alarm and the motion's validity.
+FLAGS = ("drift_alarm", "tracking_valid")
+
+
 def tracking_outputs(n: int) -> tuple[list[str], list[str], list[str]]:
     """The observer's parameter names, tracked outputs and their σ outputs, each in the
     order of :attr:`TrackedChain.names`, for ``n`` masses."""
@@ -98,7 +102,7 @@ def untracked_outputs(names: Sequence[str], n: int) -> list[str]:
     ['d_hat']
     """
     _, tracked, stds = tracking_outputs(n)
-    tracker = {*tracked, *stds, "drift_alarm", "tracking_valid"}
+    tracker = {*tracked, *stds, *FLAGS}
     return [name for name in names if name not in tracker]
 
 
@@ -132,8 +136,7 @@ def replay_tracking(
         When the observer refuses its parameters or a sample.
     """
     given, tracked, stds = tracking_outputs(n)
-    flags = ["drift_alarm", "tracking_valid"]
-    run = replay_log(observer, log, {"tracking": 1, **parameters}, [*tracked, *stds, *flags])
+    run = replay_log(observer, log, {"tracking": 1, **parameters}, [*tracked, *stds, *FLAGS])
 
     def block(names: list[str]) -> np.ndarray:
         return np.column_stack([run.signals[f"observer.{name}"] for name in names])
