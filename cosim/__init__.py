@@ -105,6 +105,7 @@ sweeps                    -- Monte Carlo and grid sweeps of co-simulations
 fleet                     -- many axes identified over time, and their parameters' drift
 outputs                   -- every file a command writes: checked first, written atomically
 errors, version           -- the errors a user can fix; the installed version
+lazy                      -- a package's public names, each loaded on first use
 cli, __main__             -- the ``arcosim`` command (imported by nothing else)
 
 Examples
@@ -116,8 +117,7 @@ Examples
 
 from __future__ import annotations
 
-import importlib
-
+from arcosim.lazy import public_api
 from arcosim.version import __version__
 
 #: Public name → the module that defines it.
@@ -169,16 +169,5 @@ _API = {
     "IdentificationError": "arcosim.identification.errors",
     "ChainFileError": "arcosim.chainfile",
 }
-__all__ = ["__version__", *_API]
-
-
-def __getattr__(name: str) -> object:
-    if name not in _API:
-        raise AttributeError(f"module 'arcosim' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_API[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+_names, __getattr__, __dir__ = public_api("arcosim", _API, globals())
+__all__ = ["__version__", *_names]

@@ -15,3 +15,9 @@ native     -- the C sources compiled at build time (``fmu_trampoline.c``)
 
 Imports nothing of :mod:`arcosim.host`, :mod:`arcosim.experiments` or the CLI.
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -11,3 +11,9 @@ margins         -- both together for one chain (``controller_margins``), with a 
 
 ``arcosim control`` prints :func:`~arcosim.control.margins.controller_margins`.
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -21,3 +21,9 @@ motion/          -- experiment 7: a move of the last mass by four controllers (b
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identification`.
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -11,3 +11,9 @@ figures  -- the drift drawn: a figure per alarmed axis, an overview of every axi
 
 Sits above :mod:`arcosim.identification` and :mod:`arcosim.sweeps` (the folder's lock).
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

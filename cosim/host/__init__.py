@@ -17,3 +17,9 @@ validate   -- the checks a strict FMI host runs on an FMU (``arcosim validate``)
 Imports of the project: :mod:`arcosim.errors`, :mod:`arcosim.logs`, :mod:`arcosim.fmu`,
 :mod:`arcosim.portability`, :mod:`arcosim.version` (``tests/test_layout.py``).
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -22,3 +22,9 @@ offline_observer     -- the observer FMU's algorithms run over a log
 threads              -- one BLAS thread inside the fits
 errors               -- IdentificationError
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

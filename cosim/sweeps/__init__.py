@@ -10,3 +10,9 @@ summary     -- the metrics' quantiles per varied parameter, and plots
 
 Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.experiments`.
 """
+
+from arcosim.lazy import public_api
+
+#: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
+_API: dict[str, str] = {}
+__all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -53,3 +53,19 @@ The controller
 * :mod:`~arcosim.fmu.flexchain.control` — the motion controller (its package lists its
   modules).
 """
+
+import importlib
+
+#: Public name → the module that defines it, relative to this package (the package's
+#: API; ``tests/test_public_api.py``). Loaded on first use, so an FMU imports only what
+#: it runs.
+_API: dict[str, str] = {}
+__all__ = list(_API)
+
+
+def __getattr__(name: str) -> object:
+    if name not in _API:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_API[name], __name__), name)
+    globals()[name] = value
+    return value
