@@ -30,6 +30,13 @@ from arcosim.identification.checks.verdict import Verdict, judge, unresolved
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.fit.encoder_fit import RIGID_LOAD
 from arcosim.identification.fit.motor_friction import without_friction
+from arcosim.identification.fit.periodic_misfit import (
+    chain_drive,
+    inadequate_reason,
+    misfit,
+    model_response,
+    periodic_response,
+)
 from arcosim.identification.fit.whole_chain import ChainChoice, identify_whole_chain, split
 from arcosim.identification.modes.chain_modes import driving_point_modes
 from arcosim.identification.records.record import LOADS, MotorRecord
@@ -285,7 +292,12 @@ def identify_drive(
     record, encoder = decision.record, decision.encoder
     try:
         choice = identify_whole_chain(
-            record, masses, encoder, choose_load=load is None, reading=decision.reading
+            record,
+            masses,
+            encoder,
+            choose_load=load is None,
+            reading=decision.reading,
+            spectrum=decision.spectrum,
         )
     except IdentificationError as error:
         if not plausibility:
@@ -294,6 +306,7 @@ def identify_drive(
     fit = choice.fit
     parameters = fit.as_dict()
     floor_findings = _against_floor(time, i_a, choice, decision, k_t, J_m, encoder_cpr, g_dist)
+    floor_findings += _against_periodic_noise(choice, decision)
     chain = split(fit.values, choice.n)
     std = {k: v for k, v in fit.std_dict().items() if k not in fit.extra.get("bounds", {})}
     verdict = judge(
@@ -355,6 +368,28 @@ def _against_floor(
         rms = tau_residual(motor, i_a, k_t, leaner, 0.0, below)
         above = weak_mode_floor_warning(dropped, rms, floor, sigma_i)
     return [above] if above else []
+
+
+def _against_periodic_noise(choice: ChainChoice, decision: LogDecision) -> list[str]:
+    """The final model's misfit at the lines of a periodic excitation against the noise
+    its periods show (:mod:`~arcosim.identification.fit.periodic_misfit`), whatever the
+    model: one sentence naming what to check when it misfits, else empty (and empty
+    for a record that is not periodic over enough whole periods)."""
+    encoder = decision.encoder
+    if encoder is None:
+        return []
+    response = periodic_response(encoder, decision.spectrum)
+    if response is None:
+        return []
+    n = choice.n
+    drive = chain_drive(choice.fit.as_dict(), n, encoder)
+    found = misfit(response, model_response(encoder, drive, response.w))
+    choice.fit.extra["periodic_misfit"] = {"lines": found.lines, "over_noise": found.ratio}
+    if found.adequate:
+        return []
+    tried = choice.fit.extra.get("selection", {}).get("periodic", {}).get("misfit_over_noise")
+    sizes = [int(m) for m in tried] if tried else [n]
+    return [inadequate_reason(n, found, sizes)]
 
 
 def _load_said(assumptions: dict[str, str], load: str | None) -> dict[str, str]:

@@ -32,12 +32,21 @@ import numpy as np
 
 from arcosim.fmu.flexchain.chain import Chain
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.fit.encoder_fit import refine
+from arcosim.identification.excitation.spectrum import ExcitationSpectrum
+from arcosim.identification.fit.encoder_fit import refine, unpack
 from arcosim.identification.fit.motor_friction import friction_cleaned, without_friction
 from arcosim.identification.fit.output_error import (
     ParameterFit,
     check_excited,
     continued_fit,
+)
+from arcosim.identification.fit.periodic_misfit import (
+    PeriodicResponse,
+    chain_drive,
+    misfit,
+    model_response,
+    periodic_response,
+    smallest_adequate,
 )
 from arcosim.identification.fit.refusal import (
     T_CONFIRM,
@@ -54,6 +63,7 @@ from arcosim.identification.fit.structure_choice import (
     choose,
     friction_form,
     load_choice,
+    restart,
     scores,
 )
 from arcosim.identification.fit.weak_modes import without_weak_modes
@@ -210,6 +220,7 @@ def identify_whole_chain(
     choose_load: bool = True,
     *,
     reading: tuple[MotorRecord, EncoderRecord | None, DetectedModes] | None = None,
+    spectrum: ExcitationSpectrum | None = None,
 ) -> ChainChoice:
     """Fit an n-mass chain (``masses`` an int) or choose n (``masses="auto"``).
 
@@ -241,6 +252,10 @@ def identify_whole_chain(
     reading : tuple of (MotorRecord, EncoderRecord or None, DetectedModes), optional
         ``first_reading(record, masses, encoder)`` with these very arguments (not
         checked), when the caller has it (``identify_drive`` passes ``check``'s).
+    spectrum : ExcitationSpectrum, optional
+        The log's excitation (``check``'s): when it is periodic over whole periods,
+        ``auto`` takes the smallest chain adequate to the response at its lines
+        (:mod:`~arcosim.identification.fit.periodic_misfit`) instead of the rule.
 
     Returns
     -------
@@ -274,7 +289,8 @@ def identify_whole_chain(
     if reading is None:
         reading = first_reading(record, masses, encoder)
     record, encoder, detected = reading
-    n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+    response = periodic_response(encoder, spectrum) if encoder is not None else None
+    n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked, response)
     if unknown:
         # re-read the modes with the fit's friction (far better than the start's)
         D_m, f_c = result.extra["D_m"], result.extra["f_c"]
@@ -284,13 +300,23 @@ def identify_whole_chain(
             record = cleaned
             encoder = with_friction(encoder, D_m, f_c)
             detected = again
-            n, result, criterion = _choose_and_fit(record, encoder, detected, auto, n_asked)
+            n, result, criterion = _choose_and_fit(
+                record, encoder, detected, auto, n_asked, response
+            )
+    periodic = criterion.pop("periodic", None)
     selection: dict = {"rule": RULE, "masses": {str(m): v for m, v in criterion.items()}}
+    if periodic is not None:
+        selection["periodic"] = periodic
     if encoder is not None:
+        before = result
         result, selection["friction"] = friction_form(record, encoder, n, result, CONFIRM_SECONDS)
+        result = kept(response, encoder, n, before, result, "the friction form chosen")
+        before, unloaded = result, encoder
         result, encoder, selection["load"] = load_choice(
             record, encoder, n, result, CONFIRM_SECONDS, choose_load
         )
+        if kept(response, encoder, n, before, result, "the load torque chosen") is before:
+            result, encoder = before, unloaded
     result.extra["selection"] = selection
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
@@ -378,7 +404,8 @@ def _choose_and_fit(
     detected: DetectedModes,
     auto: bool,
     n_asked: int | None,
-) -> tuple[int, ParameterFit, dict[int, float]]:
+    response: PeriodicResponse | None = None,
+) -> tuple[int, ParameterFit, dict]:
     """n (read, or asked and checked), the fit, and the criterion per n tried.
 
     ``auto`` starts from the modes the record shows (all of them, weak ones too) and
@@ -397,20 +424,28 @@ def _choose_and_fit(
         criterion[n] = information_criterion(result, record)
         return n, result, criterion
     if auto:
-        n, criterion = _auto_masses(encoder, detected)
+        n, criterion = _auto_masses(encoder, detected, response)
+        chosen = criterion.get("periodic", {}).pop("fit", None)
         if n == 0:
             return 0, rigid_fit(encoder, record), criterion
+        if chosen is not None:  # the whole record from the opening's chain the test chose
+            full = refine(encoder, record, restart(chosen, n), n)
+            return n, kept(response, encoder, n, chosen, full, "the whole record's fit"), criterion
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
 
 
-def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, dict]:
-    """n by the rule (:mod:`~arcosim.identification.fit.structure_choice`) on the record's
-    first :data:`CONFIRM_SECONDS`: from the modes seen, the weakest dropped one at a
-    time as long as the rule prefers the chain without it, down to the rigid drive (a
-    pole of the noise or of an excitation line adds nothing to the prediction of the
-    encoder); where the descent stops above 0, the rigid drive against the chain it
-    stopped at (two spurious modes can fit the noise better than one). Returns n and,
-    per n tried, its scores."""
+def _auto_masses(
+    encoder: EncoderRecord, detected: DetectedModes, response: PeriodicResponse | None = None
+) -> tuple[int, dict]:
+    """n by the smallest adequate chain for a periodic record (``response``:
+    :func:`_periodic_masses`), else by the rule
+    (:mod:`~arcosim.identification.fit.structure_choice`) on the record's first
+    :data:`CONFIRM_SECONDS`: from the modes seen, the weakest dropped one at a time as
+    long as the rule prefers the chain without it, down to the rigid drive (a pole of
+    the noise or of an excitation line adds nothing to the prediction of the encoder);
+    where the descent stops above 0, the rigid drive against the chain it stopped at
+    (two spurious modes can fit the noise better than one). Returns n and, per n tried,
+    its scores."""
     short = encoder_opening(encoder, CONFIRM_SECONDS)
 
     def candidate(m: int) -> Candidate | None:
@@ -423,6 +458,8 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
             return None  # no chain of m masses fits the opening
         return candidate_of(f"n={m}", trial)
 
+    if response is not None:
+        return _periodic_masses(short, detected, response)
     n = detected.n
     tried = {n: candidate(n)}
 
@@ -438,6 +475,68 @@ def _auto_masses(encoder: EncoderRecord, detected: DetectedModes) -> tuple[int, 
         n = 0
     table = scores([c for c in tried.values() if c is not None])
     return n, {m: table[f"n={m}"]["bic"] for m, c in tried.items() if c is not None}
+
+
+def _periodic_masses(
+    short: EncoderRecord, detected: DetectedModes, response: PeriodicResponse
+) -> tuple[int, dict]:
+    """n for a periodic record: every chain from the modes seen down to the rigid drive
+    fitted on the opening ``short`` (the m strongest modes), each judged by its misfit
+    at the lines against the response's noise, and the smallest adequate taken
+    (:func:`~arcosim.identification.fit.periodic_misfit.smallest_adequate`). Returns n
+    and, per n tried, its misfit over its expectation, with ``"periodic"``: the lines,
+    the level reached (1: within the noise) and each n's ratio."""
+    found, fits = {}, {}
+    for m in range(detected.n, -1, -1):
+        try:
+            trial = _fit_m(None, short, detected, m)
+        except (IdentificationError, ValueError, np.linalg.LinAlgError):
+            continue  # no chain of m masses fits the opening
+        drive = unpack(np.asarray(trial.values, dtype=float), m, short)
+        fits[m] = trial
+        found[m] = misfit(response, model_response(short, drive, response.w))
+    if not found:
+        raise IdentificationError(f"no chain of 0 … {detected.n} masses fits the record")
+    n, level = smallest_adequate(found)
+    table: dict = {m: found[m].ratio for m in found}
+    table["periodic"] = {
+        "lines": len(response.w),
+        "periods": response.periods,
+        "misfit_over_noise": {str(m): found[m].ratio for m in found},
+        "level": level,
+        "chosen": n,
+        "fit": fits[n],  # taken out by the caller: the start of the whole record's fit
+    }
+    return n, table
+
+
+def kept(
+    response: PeriodicResponse | None,
+    encoder: EncoderRecord,
+    n: int,
+    before: ParameterFit,
+    after: ParameterFit,
+    step: str,
+) -> ParameterFit:
+    """``after`` (a step of the fit: the whole record, a friction form, a load torque),
+    unless the record is periodic (``response``) and ``after`` misfits its response
+    beyond the level ``before`` reached (its misfit over the noise, at least 1): then
+    ``before``, with a warning naming ``step``. A time-domain fit of the whole record
+    weighs what no line carries (a slow load, a drift): on the motor bench it left the
+    chain the periodic test chose for one that misfits its lines 70 × more."""
+    if response is None or after is before:
+        return after
+    a, b = (
+        misfit(response, model_response(encoder, chain_drive(f.as_dict(), n, encoder), response.w))
+        for f in (before, after)
+    )
+    if b.cost <= max(a.ratio, 1.0) * b.threshold:
+        return after
+    before.extra.setdefault("structure_warnings", []).append(
+        f"{step} left out: it misfits the response at the periodic excitation's lines "
+        f"{b.ratio:.3g} × its noise, the fit without it {a.ratio:.3g} ×"
+    )
+    return before
 
 
 def _strongest(detected: DetectedModes, n: int) -> Modes:
