@@ -145,14 +145,31 @@ def _values_or_bounds(result: dict, names: tuple[str, ...]) -> dict[str, float]:
     return out
 
 
+def clamped_modes(J: list[float], k: list[float]) -> np.ndarray:
+    """The clamped modes (rad/s, ascending) of a chain J_i (kg·m²) on springs k_i
+    (N·m/rad), k_1 to the motor held still: √eig(J⁻¹K)."""
+    n = len(J)
+    K = np.zeros((n, n))
+    for i in range(n):
+        K[i, i] += k[i]
+        if i + 1 < n:
+            K[i, i] += k[i + 1]
+            K[i, i + 1] = K[i + 1, i] = -k[i + 1]
+    return np.sqrt(np.sort(np.linalg.eigvals(K / np.array(J)[:, None]).real))
+
+
 def _whole_chain(result: dict, values: dict[str, float]) -> dict[str, float]:
-    """Whole chain: n, J[1], k[1], B[1] and its strongest clamped mode (rad/s; the one
-    whose residue stands most standard errors above zero)."""
-    out = {"masses": float(result["masses"])}
+    """Whole chain: n, J[1], k[1], B[1] and the fitted chain's clamped mode nearest the
+    reference's (rad/s)."""
+    n = int(result["masses"])
+    out = {"masses": float(n)}
     out.update(_values_or_bounds(result, ("J[1]", "k[1]", "B[1]")))
-    modes, t = result.get("modes_rad_s") or [], result.get("residue_t_values") or []
-    if modes:
-        out["clamped_mode"] = float(modes[int(np.argmax(t[: len(modes)]))] if t else modes[0])
+    if n and all(f"J[{i}]" in result and f"k[{i}]" in result for i in range(1, n + 1)):
+        modes = clamped_modes(
+            [result[f"J[{i}]"] for i in range(1, n + 1)],
+            [result[f"k[{i}]"] for i in range(1, n + 1)],
+        )
+        out["clamped_mode"] = float(modes[np.argmin(np.abs(modes - values["clamped_mode"]))])
     return out
 
 
@@ -286,6 +303,8 @@ def run_record(record: Record, data: Path, work: Path, fmus: Path | None) -> dic
     result["check"] = {"status": status, "refusal": refusal(err), **check}
     result["published"], result["reference"], result["runs"] = record.published, reference, []
     values = settings_of(settings)
+    if reference:
+        values["clamped_mode"] = reference["clamped_mode"]
     for run in record.runs:
         fmu_args = ["--fmus", str(fmus)] if fmus and run.args == MODE0 else []
         status, out, err = arcosim(["identify", str(log), *sets, *run.args, *fmu_args, "--json"])
