@@ -15,6 +15,9 @@ encoder_fit     -- the prediction-error fit from the current to the encoder (ref
 motor_friction  -- the motor's friction when only k_t and J_m are given: its start
 rigid_drive     -- the rigid drive, n = 0: the load inertia J_total − J_m (rigid_fit)
 structure_choice-- the stated rule that picks n, the friction form, the load model
+periodic_misfit -- a model against a periodic record's own noise: the response at the
+                   played lines averaged over the periods, its spread, the misfit's χ²
+                   test, the smallest adequate structure (periodic_response, misfit)
 whole_chain     -- every J_i, k_i, B_i and n from the motor alone (identify_whole_chain,
                    ChainChoice)
 refusal         -- a whole-chain result's assumptions, and why a record cannot support a
