@@ -63,7 +63,6 @@ from arcosim.identification.fit.structure_choice import (
     choose,
     friction_form,
     load_choice,
-    restart,
     scores,
 )
 from arcosim.identification.fit.weak_modes import without_weak_modes
@@ -425,12 +424,8 @@ def _choose_and_fit(
         return n, result, criterion
     if auto:
         n, criterion = _auto_masses(encoder, detected, response)
-        chosen = criterion.get("periodic", {}).pop("fit", None)
         if n == 0:
             return 0, rigid_fit(encoder, record), criterion
-        if chosen is not None:  # the whole record from the opening's chain the test chose
-            full = refine(encoder, record, restart(chosen, n), n)
-            return n, kept(response, encoder, n, chosen, full, "the whole record's fit"), criterion
     return n, _prediction_error(record, encoder, _strongest(detected, n)), criterion
 
 
@@ -486,14 +481,13 @@ def _periodic_masses(
     (:func:`~arcosim.identification.fit.periodic_misfit.smallest_adequate`). Returns n
     and, per n tried, its misfit over its expectation, with ``"periodic"``: the lines,
     the level reached (1: within the noise) and each n's ratio."""
-    found, fits = {}, {}
+    found = {}
     for m in range(detected.n, -1, -1):
         try:
             trial = _fit_m(None, short, detected, m)
         except (IdentificationError, ValueError, np.linalg.LinAlgError):
             continue  # no chain of m masses fits the opening
         drive = unpack(np.asarray(trial.values, dtype=float), m, short)
-        fits[m] = trial
         found[m] = misfit(response, model_response(short, drive, response.w))
     if not found:
         raise IdentificationError(f"no chain of 0 … {detected.n} masses fits the record")
@@ -505,7 +499,6 @@ def _periodic_masses(
         "misfit_over_noise": {str(m): found[m].ratio for m in found},
         "level": level,
         "chosen": n,
-        "fit": fits[n],  # taken out by the caller: the start of the whole record's fit
     }
     return n, table
 
@@ -518,12 +511,13 @@ def kept(
     after: ParameterFit,
     step: str,
 ) -> ParameterFit:
-    """``after`` (a step of the fit: the whole record, a friction form, a load torque),
-    unless the record is periodic (``response``) and ``after`` misfits its response
-    beyond the level ``before`` reached (its misfit over the noise, at least 1): then
-    ``before``, with a warning naming ``step``. A time-domain fit of the whole record
-    weighs what no line carries (a slow load, a drift): on the motor bench it left the
-    chain the periodic test chose for one that misfits its lines 70 × more."""
+    """``after`` (a step of the fit after the chain's choice: the friction form, the
+    load torque), unless the record is periodic (``response``) and ``after`` misfits its
+    response beyond the level ``before`` reached (its misfit over the noise, at least
+    1): then ``before``, with a warning naming ``step``. The steps' rules weigh the time
+    domain, where what no line carries counts (a slow load, a drift): on the motor bench
+    the slow load the rule took moved the chain to one that misfits the lines 67 × more
+    (J_1 −99.6 %)."""
     if response is None or after is before:
         return after
     a, b = (
