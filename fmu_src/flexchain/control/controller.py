@@ -58,7 +58,27 @@ from .hold_dither import HoldDither
 from .hold_edge import hold_edge
 from .motor_observer import MotorObserver
 
-__all__ = ["MotionController", "MotorObserver", "design_controller", "shaped_step"]
+__all__ = ["PARTS", "MotionController", "MotorObserver", "design_controller", "shaped_step"]
+
+#: The controller's parts that ``MotionController(design, without=…)`` switches off, each
+#: added to meet the control benchmark's criteria (docs/control.md, "What each part buys"):
+#: the hold's dither, the hold near an edge, the hold's estimator gain, the DOB told the
+#: heading from the encoder's edges and from the reference, the chain model's torque over
+#: a stuck step, the estimator bank (its one member on the chain kept), the move's refit,
+#: the crossed edge's velocity (the plain difference instead) and the motor observer's
+#: friction. Every part is on by default; switching one off is for measuring what it buys.
+PARTS = (
+    "hold_dither",
+    "hold_edge",
+    "hold_gain",
+    "edge_heading",
+    "sliding_heading",
+    "sticking_settle",
+    "bank",
+    "move_refit",
+    "crossed_edge",
+    "motor_observer",
+)
 
 #: The share of i_max the reference model may use; the rest is the feedback's (dimensionless).
 REFERENCE_SHARE = 0.8
@@ -143,6 +163,9 @@ class MotionController:
     ----------
     design : ControllerDesign
         From :func:`~arcosim.fmu.flexchain.control.design.design_controller`.
+    without : frozenset of str
+        Parts of :data:`PARTS` switched off (default none: the controller as shipped); for
+        measuring what each part buys.
 
     Attributes
     ----------
@@ -167,8 +190,12 @@ class MotionController:
 
     _transient = ("_designs",)
 
-    def __init__(self, design: ControllerDesign) -> None:
+    def __init__(self, design: ControllerDesign, without: frozenset[str] = frozenset()) -> None:
+        unknown = sorted(set(without) - set(PARTS))
+        if unknown:
+            raise ValueError(f"unknown controller parts {unknown}; the parts are {PARTS}")
         self.design = design
+        self.parts = frozenset(PARTS) - frozenset(without)
         self._designs = {design.h: design}
         self.reset()
 
@@ -190,7 +217,9 @@ class MotionController:
         self.observer = Observer(settings, theta_m0, 0.0)
         # the estimator on the chain and on its scaled models (estimator_bank); the
         # observer keeps its DOB and offset, the bank owns the estimators
-        self.bank = EstimatorBank(self.observer.estimator)
+        scales = defaults.BANK_SCALES if "bank" in self.parts else (1.0,)
+        self.bank = EstimatorBank(self.observer.estimator, scales)
+        self.bank.hold_gain = "hold_gain" in self.parts
         self.observer.estimator = None
         self.offset = settings.angle_offset()
         self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
@@ -210,7 +239,7 @@ class MotionController:
         self.friction = 0.0  # the friction the feedforward assumed over the next step (N·m)
         self.dither: HoldDither | None = None  # while the hold's dither runs
         # the shift of the hold's target that keeps the motor near an edge (hold_edge)
-        self.edge = hold_edge(d.encoder_cpr)
+        self.edge = hold_edge(d.encoder_cpr) if "hold_edge" in self.parts else None
         self._needed = self._any_edge = 0.0  # where the hold needs the motor; an edge (rad)
         self._moved = 0.0  # when the target path last moved (s)
         self._first_move = True
@@ -247,8 +276,10 @@ class MotionController:
         # edge is no motion; encoder_edge), the DOB's too, where reset chose it
         motion = theta_m
         if self.crossed is not None:
-            omega_m = self.crossed.step(h, theta_m)
-            motion = self.crossed.edge - self.offset
+            edge_velocity = self.crossed.step(h, theta_m)
+            if "crossed_edge" in self.parts:
+                omega_m = edge_velocity
+                motion = self.crossed.edge - self.offset
         heading = self._heading()
         dob.step(h, i_a, omega_m, motion, heading)
         th_m = theta_m + self.offset - t0
@@ -256,7 +287,7 @@ class MotionController:
         dither = self.dither
         if dither is None:
             self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
-            d_m = self.motor.s[0]
+            d_m = self.motor.s[0] if "motor_observer" in self.parts else 0.0
         else:  # at rest: the motor's angle and velocity below a count, from the reading
             # less the dither's path (hold_dither's doc); the DOB keeps the crossed edge's
             th_m = dither.measure(h, i_a, th_m)
@@ -264,13 +295,17 @@ class MotionController:
             self.motor.step(h, dither.steady, dither.reading, theta_1, omega_1, 0.0)
             d_m = 0.0
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
-        if dob.sticking:
+        if dob.sticking and "sticking_settle" in self.parts:
             settle_sticking(dob, est, h, drive)
         choosing = self.t - self._moved < defaults.BANK_CHOICE_AFTER * self.design.move_time
         bank = self.bank
         bank.step(h, dob.tau_reac_hat, drive, choosing, heading)
         record = bank.record
-        if record is not None and record.elapsed >= self._refine_after - 0.5 * h:
+        if (
+            record is not None
+            and record.elapsed >= self._refine_after - 0.5 * h
+            and "move_refit" in self.parts
+        ):
             bank.refine()  # every J_i and k_i from the move so far (move_fit)
         est = bank.chosen
         # the motor's own states as measured: its observer's (model-based) estimates of
@@ -295,7 +330,7 @@ class MotionController:
                 self._first_move = False
             self._moved = self.t
         rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
-        if not (rest and design.dither_current > 0.0):
+        if not (rest and design.dither_current > 0.0 and "hold_dither" in self.parts):
             self.dither = None
             self.bank.set_quiet(False)
             return self.i_ref
@@ -319,8 +354,8 @@ class MotionController:
         model's while it moves (:meth:`_reference_heading`), weighed against the encoder's
         edges until the hold's dither starts (``CrossedEdge.heading``,
         ``defaults.SLIDING_INTERVAL``); 0 leaves it to the DOB's samples."""
-        heading = self._reference_heading()
-        if self.dither is None and self.crossed is not None:
+        heading = self._reference_heading() if "sliding_heading" in self.parts else 0.0
+        if self.dither is None and self.crossed is not None and "edge_heading" in self.parts:
             heading = self.crossed.heading(heading, defaults.SLIDING_INTERVAL)
         return heading
 
@@ -365,7 +400,8 @@ class MotionController:
         self._prev_1 = (angles[1] - t0, velocities[1])
         x = [a - t0 for a in angles] + list(velocities)
         self.theta_hat_ctrl = angles[self.design.control_mass]
-        return self._command(h, theta_ref, x, 0.0, self.motor.s[0])
+        d_m = self.motor.s[0] if "motor_observer" in self.parts else 0.0
+        return self._command(h, theta_ref, x, 0.0, d_m)
 
     _prev_1 = (0.0, 0.0)
 

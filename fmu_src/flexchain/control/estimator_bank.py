@@ -95,6 +95,9 @@ class EstimatorBank:
         Whether the chosen member was refined from this move (``fit`` is not None).
     settled : bool
         Whether a member was ever refined: the choice then rests for good.
+    hold_gain : bool
+        Whether :meth:`set_quiet` gives the members the hold's gain (default True); False
+        keeps the move's gain at rest while :attr:`quiet` still says when the chain is quiet.
 
     Examples
     --------
@@ -130,6 +133,7 @@ class EstimatorBank:
         self.starts: list[LoadTorqueObserver] = []
         self.fit: ChainFit | None = None
         self.quiet = False
+        self.hold_gain = True
         self.still = 0.0
         self.move_noise = estimator.noise
         self._other: dict[int, dict] = {}
@@ -218,6 +222,9 @@ class EstimatorBank:
         if not quiet:
             self.still = 0.0
         if quiet == self.quiet:
+            return
+        if not self.hold_gain:
+            self.quiet = quiet
             return
         noise = self.move_noise
         if quiet:
