@@ -4,15 +4,17 @@ For n masses (default 1, 3 and 5) the controller FMU (``ActionReactionController
 the loop around the C plant FMU, both with their defaults (the bench chain of n masses,
 realistic sensors), for a 1 rad move of the last mass held for the rest of the run, as
 :func:`arcosim.host.control_loop.control_loop` runs it. Only the controller's
-``fmi2DoStep`` is timed (``time.perf_counter_ns`` around the raw ctypes call), each step
-apart: the mean over the run after its first step (what a host's budget must hold on
-average), the median (a typical step), the slowest step (the refit from the move,
-``REFINE_AT`` move times after its start, falls into one ``doStep``) and the first step
-(the estimators' step models designed on first use). Each figure is the median over ``--runs``
-runs. Writes ``controller_speed.md`` and ``controller_speed.json`` into ``--out``.
+``fmi2DoStep`` is timed, each step apart, in the CPU time of the calling thread
+(``time.thread_time_ns`` around the raw ctypes call; the Python FMU runs in that thread),
+so that other processes on a shared machine do not count: the mean over the run after
+its first step (what a host's budget must hold on average), the median (a typical
+step), the slowest step (the refit from the move, ``REFINE_AT`` move times after its
+start, falls into one ``doStep``) and the first step (the estimators' step models
+designed on first use). Each figure is the median over ``--runs`` runs. Writes
+``controller_speed.md`` and ``controller_speed.json`` into ``--out``.
 
-Timings are this machine's under its load at the time; compare two versions of the
-controller in the same session, one after the other.
+Timings are this machine's; the CPU time still grows with a loaded machine's cache and
+memory traffic, so compare two versions of the controller one after the other.
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ def controller_steps(n: int, seconds: float) -> list[float]:
         µs per step, shape ``(round(seconds / H),)``.
     """
     folder = ensure_built(n)
-    clock = time.perf_counter_ns
+    clock = time.thread_time_ns  # CPU time: a step preempted by other work is not charged
     times = []
     with (
         FmuInstance(folder / f"{CONTROLLER.name}.fmu", "controller") as controller,
