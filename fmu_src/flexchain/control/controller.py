@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from operator import mul
 
 from .. import defaults
 from ..codes import Estimator, Mode
@@ -471,5 +472,5 @@ def heading(design: ControllerDesign, x: Sequence[float], i: float, h: float) ->
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:
-    """``Σ a_i b_i``."""
-    return math.fsum(p * q for p, q in zip(a, b))
+    """``Σ a_i b_i`` (``math.fsum``, correctly rounded)."""
+    return math.fsum(map(mul, a, b))

@@ -283,8 +283,11 @@ class EstimatorBank:
         """
         if self.record is not None:
             self.record.step(h, tau_reac_hat, theta_m, heading)
-        if self.settled:  # a member was refined: the choice is over (module doc)
-            choose = False
+        if self.settled:  # a member was refined: the choice is over for good (module doc),
+            # and only the chosen member's estimates are ever read again (a refit starts
+            # from its own state), so the others rest
+            self.chosen.step(h, tau_reac_hat, theta_m)
+            return
         if not choose:  # the scores and open-loop models are restarted before they count
             for member in self.members:
                 member.step(h, tau_reac_hat, theta_m)
