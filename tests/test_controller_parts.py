@@ -27,12 +27,20 @@ def shipped():
     return closed_loop(BENCH_2, WRONG, stop=STOP)
 
 
+#: What each part is compared against: the controller as shipped, except for the bank,
+#: which on this chain picks no other member before the refit replaces its choice, so it
+#: is compared without the refit on both sides.
+ALSO_OFF = {"bank": frozenset({"move_refit"})}
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("part", PARTS)
 def test_each_part_switched_off_changes_the_commands(shipped, part: str) -> None:
-    without = closed_loop(BENCH_2, WRONG, stop=STOP, without=frozenset({part}))
-    changed = np.flatnonzero(without.i_ref != shipped.i_ref)
-    assert changed.size, f"{part} off left every command as shipped"
+    also = ALSO_OFF.get(part, frozenset())
+    reference = closed_loop(BENCH_2, WRONG, stop=STOP, without=also) if also else shipped
+    without = closed_loop(BENCH_2, WRONG, stop=STOP, without=also | {part})
+    changed = np.flatnonzero(without.i_ref != reference.i_ref)
+    assert changed.size, f"{part} off left every command as it was"
 
 
 def test_an_unknown_part_is_refused_naming_the_parts() -> None:
