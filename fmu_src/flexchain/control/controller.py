@@ -16,9 +16,6 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   motor's heading, the reference's during a move and, as the motor creeps to rest, the
   one its encoder edges show
   (:meth:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge.sliding`);
-  a motor observer (:class:`MotorObserver`) gives the friction d̂_m the friction model
-  misses, from the current and the encoder, with the first spring pulling towards the
-  estimated mass 1;
 * **reference shaping**: each change of ``theta_ref`` starts a shaped step of that size
   (:func:`shaped_step`, zero velocity, acceleration and jerk at both ends, lasting
   ``move_time``) whose sum is the target path s(t); a reference model, the design model
@@ -26,14 +23,14 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
   moves the whole chain along s as one body) and gives the reference state x_r and
   the feedforward current ``i_ff`` — consistent with the model, so with an exact model
   the feedback has nothing to do;
-* **feedback**: ``i_fb = −K (x̂ − x_r − x_d(d̂)) − d̂/k_t + d̂_m/k_t``, the design's
+* **feedback**: ``i_fb = −K (x̂ − x_r − x_d(d̂)) − d̂/k_t + f_c sgn(ω̄)/k_t``, the design's
   gain (:mod:`~arcosim.fmu.flexchain.control.design`) on the estimate's deviation from
   the reference, shifted to where the chain rests under d̂ with mass L on target
   (:meth:`~arcosim.fmu.flexchain.control.design.ControllerDesign.load_offset`), the
-  current that holds d̂, and the motor friction cancelled;
+  current that holds d̂, and the motor's Coulomb friction cancelled (:func:`heading`);
 * **the limit**: ``i_ref = clamp(i_ff + i_fb, i_max)``. Anti-windup by construction:
-  the only integrators of the loop (the load torque and the friction estimates) are
-  driven by the *measured* current, the one that acted, so they integrate nothing the
+  the only integrator of the loop (the load torque estimate) is
+  driven by the *measured* current, the one that acted, so it integrates nothing the
   limit cut off; the reference model keeps its own current within
   ``REFERENCE_SHARE · i_max``.
 
@@ -57,17 +54,16 @@ from .encoder_edge import CrossedEdge
 from .estimator_bank import EstimatorBank
 from .hold_dither import HoldDither
 from .hold_edge import hold_edge
-from .motor_observer import MotorObserver
 
-__all__ = ["PARTS", "MotionController", "MotorObserver", "design_controller", "shaped_step"]
+__all__ = ["PARTS", "MotionController", "design_controller", "shaped_step"]
 
 #: The controller's parts that ``MotionController(design, without=…)`` switches off, each
 #: added to meet the control benchmark's criteria (docs/control.md, "What each part buys"):
 #: the hold's dither, the hold near an edge, the hold's estimator gain, the DOB told the
 #: heading from the encoder's edges and from the reference, the chain model's torque over
-#: a stuck step, the estimator bank (its one member on the chain kept), the move's refit,
-#: the crossed edge's velocity (the plain difference instead) and the motor observer's
-#: friction. Every part is on by default; switching one off is for measuring what it buys.
+#: a stuck step, the estimator bank (its one member on the chain kept), the move's refit
+#: and the crossed edge's velocity (the plain difference instead). Every part is on by
+#: default; switching one off is for measuring what it buys.
 PARTS = (
     "hold_dither",
     "hold_edge",
@@ -78,7 +74,6 @@ PARTS = (
     "bank",
     "move_refit",
     "crossed_edge",
-    "motor_observer",
 )
 
 #: The share of i_max the reference model may use; the rest is the feedback's (dimensionless).
@@ -223,7 +218,6 @@ class MotionController:
         self.bank.hold_gain = "hold_gain" in self.parts
         self.observer.estimator = None
         self.offset = settings.angle_offset()
-        self.motor = MotorObserver(d, defaults.MOTOR_OBSERVER_BANDWIDTH)
         # the crossed edge's velocity only with an encoder and the friction cancelled:
         # without friction the plain difference's kick at an edge is the motor's only
         # damping there and holds it on the edge (docs/control.md)
@@ -271,7 +265,6 @@ class MotionController:
         obs = self.observer
         est = self.bank.chosen
         t0 = self.theta0
-        theta_1, omega_1 = est.theta[0] - t0, est.omega[0]  # mass 1 at the previous sample
         dob = obs.dob
         # the velocity of the last crossed edge, not of the count (a dither across one
         # edge is no motion; encoder_edge), the DOB's too, where reset chose it
@@ -286,15 +279,11 @@ class MotionController:
         th_m = theta_m + self.offset - t0
         self._any_edge = theta_m - t0  # the encoder's reading is its count's lower edge
         dither = self.dither
-        if dither is None:
-            self.motor.step(h, i_a, th_m, theta_1, omega_1, self.friction)
-            d_m = self.motor.s[0] if "motor_observer" in self.parts else 0.0
-        else:  # at rest: the motor's angle and velocity below a count, from the reading
-            # less the dither's path (hold_dither's doc); the DOB keeps the crossed edge's
+        if dither is not None:  # at rest: the motor's angle and velocity below a count,
+            # from the reading less the dither's path (hold_dither's doc); the DOB keeps
+            # the crossed edge's
             th_m = dither.measure(h, i_a, th_m)
             omega_m = dither.observer.s[1]
-            self.motor.step(h, dither.steady, dither.reading, theta_1, omega_1, 0.0)
-            d_m = 0.0
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
         if dob.sticking and "sticking_settle" in self.parts:
             settle_sticking(dob, est, h, drive)
@@ -314,7 +303,7 @@ class MotionController:
         x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]
         L = self.design.control_mass
         self.theta_hat_ctrl = est.theta[L - 1]
-        self._command(h, theta_ref, x, est.tau_load, d_m)
+        self._command(h, theta_ref, x, est.tau_load)
         return self._hold(h, x)
 
     def _hold(self, h: float, x: Sequence[float]) -> float:
@@ -376,8 +365,8 @@ class MotionController:
     ) -> float:
         """:meth:`step` with the true state instead of the estimates (the upper bound).
 
-        The same gains, reference and limit; the motor friction is still cancelled, from
-        the motor observer run on the true angles; no load torque is estimated.
+        The same gains, reference and limit; the motor's Coulomb friction is still
+        cancelled; no load torque is estimated.
 
         Parameters
         ----------
@@ -389,7 +378,8 @@ class MotionController:
             Motor, then masses 1 … n: angles (rad) and velocities (rad/s) at t_k, shape
             ``(n + 1,)`` each.
         i_a : float
-            Current that acted over the step ending at t_k (A).
+            Current that acted over the step ending at t_k (A); not used (the loop's
+            signature).
 
         Returns
         -------
@@ -397,14 +387,9 @@ class MotionController:
             ``i_ref`` (A).
         """
         t0 = self.theta0
-        self.motor.step(h, i_a, angles[0] - t0, self._prev_1[0], self._prev_1[1], self.friction)
-        self._prev_1 = (angles[1] - t0, velocities[1])
         x = [a - t0 for a in angles] + list(velocities)
         self.theta_hat_ctrl = angles[self.design.control_mass]
-        d_m = self.motor.s[0] if "motor_observer" in self.parts else 0.0
-        return self._command(h, theta_ref, x, 0.0, d_m)
-
-    _prev_1 = (0.0, 0.0)
+        return self._command(h, theta_ref, x, 0.0)
 
     def _design_for(self, h: float) -> ControllerDesign:
         """The design for a step of ``h`` s (the first one's settings; cached)."""
@@ -425,9 +410,9 @@ class MotionController:
             self._designs[h] = found
         return found
 
-    def _command(self, h: float, theta_ref: float, x: list[float], d: float, d_m: float) -> float:
+    def _command(self, h: float, theta_ref: float, x: list[float], d: float) -> float:
         """The reference's step and the command from the state ``x`` (relative to the
-        start), the load torque estimate ``d`` (N·m) and the motor friction ``d_m`` (N·m)."""
+        start) and the load torque estimate ``d`` (N·m)."""
         design = self._design_for(h)
         t0 = self.theta0
         path = self.path
@@ -448,7 +433,7 @@ class MotionController:
         if self.dither is not None and self.edge is not None:  # the hold near an edge
             offset = [c + self.edge.shift if j < n1 else c for j, c in enumerate(offset)]
         error = [a - b - c for a, b, c in zip(x, xr, offset)]
-        i_linear = i_ff - _dot(K, error) + i_hold + d_m / design.k_t
+        i_linear = i_ff - _dot(K, error) + i_hold
         self.friction = design.f_c * heading(design, x, i_linear, h)
         i_fb = i_linear - i_ff + self.friction / design.k_t
         self.reference = [_dot(row, xr) + g * i_ff for row, g in zip(design.F, design.g)]
