@@ -191,7 +191,8 @@ class MotionController:
         if unknown:
             raise ValueError(f"unknown controller parts {unknown}; the parts are {PARTS}")
         self.design = design
-        self.parts = frozenset(PARTS) - frozenset(without)
+        # a tuple, not a set: the FMU state (fmukit.state) stores tuples
+        self.parts = tuple(part for part in PARTS if part not in without)
         self._designs = {design.h: design}
         self.reset()
 
