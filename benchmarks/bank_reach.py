@@ -49,8 +49,8 @@ from benchmarks.control_accuracy import CHAINS, score, seed_models
 class WithoutLoadTorque(MotionController):
     """The controller with the load-torque estimate left out of the feedback (d̂ = 0)."""
 
-    def _command(self, h: float, theta_ref: float, x: list[float], d: float, d_m: float) -> float:
-        return super()._command(h, theta_ref, x, 0.0, d_m)
+    def _command(self, h: float, theta_ref: float, x: list[float], d: float) -> float:
+        return super()._command(h, theta_ref, x, 0.0)
 
 
 def fixed(params: dict[str, float], member: int) -> MotionController:

@@ -63,6 +63,7 @@ from arcosim.experiments.motion.findings import (
 )
 from arcosim.experiments.report import markdown_table
 from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.control.controller import PARTS
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR
 from arcosim.host.overrides import INT_MAX
 from benchmarks import progress
@@ -85,10 +86,11 @@ def score_seed(
     corners: bool,
     encoder_cpr: int = ENCODER_CPR,
     distance: float = DISTANCE,
+    without: frozenset[str] = frozenset(),
 ) -> dict[str, dict]:
     """One seed on one chain: every model's sensorless and upper-bound moves, and the
     criteria; the corners only when ``corners``; an encoder of ``encoder_cpr`` counts; a
-    move of ``distance`` (rad)."""
+    move of ``distance`` (rad); the controller's parts in ``without`` switched off."""
     result = identify_chain(folder, chain, False, seed, encoder_cpr)
     params = design_parameters(result, False, encoder_cpr)
     runs = Runs(folder, chain, False, seed=seed, encoder_cpr=encoder_cpr, distance=distance)
@@ -100,8 +102,8 @@ def score_seed(
     out = {}
     for label, (fJ, fk) in seed_models(chain.n, seed, corners).items():
         wrong = scaled(params, fJ, fk)
-        moving = _score(runs.run(sensorless(wrong)))
-        upper = _score(runs.run(sensorless(wrong), full_state=True))
+        moving = _score(runs.run(sensorless(wrong, without=without)))
+        upper = _score(runs.run(sensorless(wrong, without=without), full_state=True))
         out[label] = {
             "sensorless": moving.as_dict(),
             "upper_bound": upper.as_dict(),
@@ -168,9 +170,13 @@ def run(
     progress: Callable[[str], None],
     encoder_cpr: int = ENCODER_CPR,
     distance: float = DISTANCE,
+    without: frozenset[str] = frozenset(),
+    stop_on_failure: bool = False,
 ) -> dict[str, object]:
     """Every chain over ``seeds`` with an encoder of ``encoder_cpr`` counts and a move of
-    ``distance`` (rad); the table, the per-seed results, the time (s)."""
+    ``distance`` (rad), the controller's parts in ``without`` switched off; with
+    ``stop_on_failure``, up to the first seed where a run misses a criterion; the table, the
+    per-seed results, the time (s)."""
     started = time.perf_counter()
     results: dict[str, dict] = {}
     for chain in chains:
@@ -179,13 +185,21 @@ def run(
         per_seed = {}
         for seed in seeds:
             progress(f"{chain.name}: seed {seed}")
-            per_seed[str(seed)] = score_seed(
-                chain, folder, seed, seed == seeds[0], encoder_cpr, distance
+            per_seed[str(seed)] = found = score_seed(
+                chain, folder, seed, seed == seeds[0], encoder_cpr, distance, without
             )
+            failed = not all(all(m["criteria"].values()) for m in found.values())
+            if stop_on_failure and failed:
+                break
         results[chain.name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
+        if stop_on_failure and failed:
+            break
     heading = f"Encoder: {encoder_cpr} counts per revolution. {geometry(distance, encoder_cpr)}"
+    if without:
+        heading += f" Controller without: {', '.join(sorted(without))}."
     text = heading + "\n\n" + markdown(results)
     summary = {
+        "without": sorted(without),
         "encoder_cpr": encoder_cpr,
         "distance": distance,
         "results": results,
@@ -271,7 +285,42 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="the target this many encoder counts past 1 rad, −1 … 1 (default 0: 1 rad, "
         "0.31 count past an edge at 2000 counts)",
     )
+    add_without(p)
+    p.add_argument(
+        "--stop-on-failure",
+        action="store_true",
+        help="stop after the first seed where a run misses a criterion (a screen)",
+    )
     p.set_defaults(execute=_execute)
+
+
+def add_without(p: argparse.ArgumentParser) -> None:
+    """The ``--without PART[,PART…]`` option: the controller's parts switched off."""
+    p.add_argument(
+        "--without",
+        type=parse_without,
+        default=frozenset(),
+        metavar="PART[,PART…]",
+        help="switch these parts of the controller off, to measure what each buys "
+        f"(default none; parts: {', '.join(PARTS)})",
+    )
+
+
+def parse_without(text: str) -> frozenset[str]:
+    """The parts named in ``text`` (comma-separated), each one of the controller's ``PARTS``.
+
+    Examples
+    --------
+    >>> sorted(parse_without("bank,move_refit"))
+    ['bank', 'move_refit']
+    """
+    parts = frozenset(p.strip() for p in text.split(",") if p.strip())
+    unknown = sorted(parts - set(PARTS))
+    if unknown:
+        raise UserError(
+            f"--without names unknown parts {', '.join(unknown)}: use {', '.join(PARTS)}"
+        )
+    return parts
 
 
 def _execute(args: argparse.Namespace) -> int:
@@ -290,7 +339,10 @@ def _execute(args: argparse.Namespace) -> int:
     chains = CHAINS[:1] if args.quick else CHAINS
     seeds = range(1, args.seeds + 1)
     distance = target_distance(args.target_offset, args.encoder_cpr)
-    result = run(args.out, seeds, chains, progress, args.encoder_cpr, distance)
+    result = run(
+        args.out, seeds, chains, progress, args.encoder_cpr, distance, args.without,
+        args.stop_on_failure,
+    )  # fmt: skip
     print(result["table"])
     print(f"wrote {args.out / 'control.md'} and {args.out / 'control.json'} "
           f"({result['seconds']:.0f} s)")  # fmt: skip

@@ -221,9 +221,15 @@ def _off(value: float, true: float) -> float:
     return 0.0 if value == true else math.inf
 
 
-def score_seed(folder: Path, seed: int, corners: bool, control: bool = True) -> dict[str, object]:
+def score_seed(
+    folder: Path,
+    seed: int,
+    corners: bool,
+    control: bool = True,
+    without: frozenset[str] = frozenset(),
+) -> dict[str, object]:
     """One seed: the identification's errors and (``control``) every model's moves,
-    scored."""
+    scored; the controller's parts in ``without`` switched off."""
     result = identify(folder, seed)
     found = {"identification": identification_errors(result)}
     if result.masses != CHAIN.n or not control:
@@ -242,7 +248,8 @@ def score_seed(folder: Path, seed: int, corners: bool, control: bool = True) -> 
     found["models"] = {}
     for label, (fJ, fk) in models.items():
         wrong = scaled(params, fJ, fk)
-        moving, upper = move(sensorless(wrong)), move(sensorless(wrong), full_state=True)
+        moving = move(sensorless(wrong, without=without))
+        upper = move(sensorless(wrong, without=without), full_state=True)
         found["models"][label] = {
             "sensorless": moving.as_dict(),
             "upper_bound": upper.as_dict(),
@@ -258,6 +265,7 @@ def run(
     seeds: range,
     progress: Callable[[str], None],
     control: bool = True,
+    without: frozenset[str] = frozenset(),
 ) -> dict:
     """Coupling, then every seed (``control``: the moves too, else the identification
     only); the tables and the results (written into ``out``)."""
@@ -270,7 +278,7 @@ def run(
     per_seed: dict[str, dict] = {}
     for seed in seeds:
         progress(f"seed {seed}")
-        per_seed[str(seed)] = score_seed(folder, seed, seed == seeds[0], control)
+        per_seed[str(seed)] = score_seed(folder, seed, seed == seeds[0], control, without)
         partial = {"coupling": check, "own_plant": own, "seeds": per_seed}
         (out / "thirdparty.json").write_text(json.dumps(partial, indent=1, default=str), "utf-8")
     lowest = check["modes"][0]
@@ -351,6 +359,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--identification-only", action="store_true",
                    help="skip the moves: the coupling and the identification (about 5 s "
                    "a seed)")  # fmt: skip
+    control_accuracy.add_without(p)
     p.set_defaults(execute=_execute)
 
 
@@ -363,7 +372,8 @@ def _execute(args: argparse.Namespace) -> int:
     if args.log:
         print(f"wrote {write_log(identification_log(args.fmus, 1), args.log)}")
     seeds = range(1, args.seeds + 1)
-    result = run(args.fmus, args.out, seeds, progress, not args.identification_only)
+    result = run(args.fmus, args.out, seeds, progress, not args.identification_only,
+                 args.without)  # fmt: skip
     for table in result["tables"].values():
         print(table)
     print(f"wrote {args.out / 'thirdparty.md'} and {args.out / 'thirdparty.json'} "

@@ -77,6 +77,7 @@ def closed_loop(
     i_noise_std: float = defaults.I_NOISE_STD,
     load_step: tuple[float, float] | None = None,
     seed: int = 1,
+    without: frozenset[str] = frozenset(),
     **goals,
 ) -> Run:
     """Run the controller designed from ``model`` (default: the plant) on ``plant``.
@@ -99,6 +100,8 @@ def closed_loop(
         (time s, torque N·m) on the last mass from that time on.
     seed : int
         Current noise seed.
+    without : frozenset of str
+        The controller's parts switched off (``controller.PARTS``).
     goals
         Passed to :func:`design_controller` (move_time, bandwidth, i_max, control_mass).
     """
@@ -106,7 +109,7 @@ def closed_loop(
     model = {**ACTUATOR, **(model or plant)}
     params = observer_params(**model)
     params["encoder_cpr"] = encoder_cpr
-    ctrl = MotionController(design_controller(params, h=h, **goals))
+    ctrl = MotionController(design_controller(params, h=h, **goals), without)
     physics = PlantPhysics(
         plant["J_m"], plant["k_t"], plant["D_m"], plant["f_c"], plant["J"], plant["k"], plant["B"]
     )

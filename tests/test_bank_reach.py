@@ -53,8 +53,8 @@ def test_without_load_torque_feeds_none_back():
     without = WithoutLoadTorque(shipped.design)
     x = [0.0] * (2 * shipped.design.n + 2)
     # a load torque estimate changes the shipped command, not the diagnosis's
-    assert shipped._command(H, shipped.theta0, list(x), 1e-3, 0.0) != 0.0
-    assert without._command(H, without.theta0, list(x), 1e-3, 0.0) == 0.0
+    assert shipped._command(H, shipped.theta0, list(x), 1e-3) != 0.0
+    assert without._command(H, without.theta0, list(x), 1e-3) == 0.0
 
 
 def test_counts_within_the_bound():

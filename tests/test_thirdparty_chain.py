@@ -98,7 +98,7 @@ def test_a_seed_scores_its_moves_as_the_control_benchmark_does(monkeypatch) -> N
     monkeypatch.setattr(thirdparty_chain, "scaled", lambda params, fJ, fk: params)
     monkeypatch.setattr(thirdparty_chain, "cascade_gains", lambda params: None)
     monkeypatch.setattr(thirdparty_chain, "CascadeController", lambda *a: None)
-    monkeypatch.setattr(thirdparty_chain, "sensorless", lambda params: None)
+    monkeypatch.setattr(thirdparty_chain, "sensorless", lambda params, without=frozenset(): None)
     monkeypatch.setattr(thirdparty_chain, "open_plant", lambda folder, seed: nullcontext())
     monkeypatch.setattr(thirdparty_chain, "run_loop", lambda *a: rest)
     found = thirdparty_chain.score_seed(Path("."), 1, corners=False)

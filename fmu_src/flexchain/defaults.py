@@ -95,13 +95,6 @@ LINK_BETA = 5e-5
 MOVE_TIME = 1.0  #: duration of a shaped point-to-point move (s); 0 = set by the bandwidth
 BANDWIDTH = 0.0  #: feedback bandwidth ω_c (rad/s); 0 = set by the move time
 I_MAX = 10.0  #: current limit of the controller's command (A)
-#: Bandwidth of the controller's motor observer (angle, velocity and friction of the
-#: motor, from its current and encoder; rad/s): its three poles sit there.
-MOTOR_OBSERVER_BANDWIDTH = 150.0
-#: Bandwidth of its friction estimate (rad/s): the pole of its friction state. What the
-#: friction model (f_c times the sign of the motor's heading) misses is cancelled this
-#: fast; at 150 rad/s the bench's two-mass chain held a 26 mrad limit cycle at its mode.
-MOTOR_FRICTION_BANDWIDTH = 20.0
 #: The controller's estimator: unmodelled torque on each load mass (N·m), ten times the
 #: observer's TORQUE_NOISE_STD, so the Kalman gain trusts τ̂_reac more than the model: with
 #: the observer's 1e-4 the bench's two-mass loop held a 37 mrad limit cycle when the

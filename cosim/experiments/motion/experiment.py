@@ -168,12 +168,13 @@ def model_errors(n: int, seeds: tuple[int, ...]) -> dict[str, tuple[np.ndarray, 
     return out
 
 
-def sensorless(params: Mapping[str, float], h: float = STEP):
-    """The sensorless controller designed on ``params`` (``MotionController``), reset."""
+def sensorless(params: Mapping[str, float], h: float = STEP, without: frozenset[str] = frozenset()):
+    """The sensorless controller designed on ``params`` (``MotionController``), reset;
+    the parts named in ``without`` switched off (``controller.PARTS``)."""
     from arcosim.fmu.flexchain.control.controller import MotionController, design_controller
 
     controller = MotionController(
-        design_controller(dict(params), h=h, move_time=MOVE_TIME, i_max=I_MAX)
+        design_controller(dict(params), h=h, move_time=MOVE_TIME, i_max=I_MAX), without
     )
     controller.reset()
     return controller

@@ -5,8 +5,8 @@ Modules, in the order data flows:
 
 * :mod:`~arcosim.fmu.flexchain.control.design` — the discrete motor and chain, the state
   feedback from the chain and a move time or bandwidth.
-* :mod:`~arcosim.fmu.flexchain.control.motor_observer` — the motor's angle, velocity and
-  friction.
+* :mod:`~arcosim.fmu.flexchain.control.motor_observer` — the motor's angle and velocity
+  below a count at rest, for the hold's dither.
 * :mod:`~arcosim.fmu.flexchain.control.move_record` — the samples of a move kept for its fit.
 * :mod:`~arcosim.fmu.flexchain.control.move_fit` — the chain refitted from a finished move.
 * :mod:`~arcosim.fmu.flexchain.control.estimator_bank` — the load estimators the controller

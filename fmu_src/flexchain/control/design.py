@@ -3,9 +3,8 @@ and the reference shaping's constants, from the chain and the user's goals.
 
 The design model is the motor and its chain with the current as input, held over each
 step (exact by one matrix exponential), state ``x = [θ_0 … θ_n, ω_0 … ω_n]`` (body 0 the
-motor, rad and rad/s), Coulomb friction left out (the controller's motor observer
-estimates it and the controller cancels it). The state feedback ``u = −K x`` (A) is the
-discrete linear-quadratic regulator of that model with
+motor, rad and rad/s), Coulomb friction left out (the controller cancels it). The state
+feedback ``u = −K x`` (A) is the discrete linear-quadratic regulator of that model with
 
 * the controlled mass's angle weighted so that the rigid motion alone would close at the
   bandwidth ω_c with a damping of 1/√2 (for a rigid body of inertia J_tot,

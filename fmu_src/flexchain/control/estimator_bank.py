@@ -95,6 +95,9 @@ class EstimatorBank:
         Whether the chosen member was refined from this move (``fit`` is not None).
     settled : bool
         Whether a member was ever refined: the choice then rests for good.
+    hold_gain : bool
+        Whether :meth:`set_quiet` gives the members the hold's gain (default True); False
+        keeps the move's gain at rest while :attr:`quiet` still says when the chain is quiet.
 
     Examples
     --------
@@ -130,6 +133,7 @@ class EstimatorBank:
         self.starts: list[LoadTorqueObserver] = []
         self.fit: ChainFit | None = None
         self.quiet = False
+        self.hold_gain = True
         self.still = 0.0
         self.move_noise = estimator.noise
         self._other: dict[int, dict] = {}
@@ -219,6 +223,9 @@ class EstimatorBank:
             self.still = 0.0
         if quiet == self.quiet:
             return
+        if not self.hold_gain:
+            self.quiet = quiet
+            return
         noise = self.move_noise
         if quiet:
             std = noise.torque_noise_std * defaults.HOLD_TORQUE_NOISE_SCALE
@@ -276,8 +283,11 @@ class EstimatorBank:
         """
         if self.record is not None:
             self.record.step(h, tau_reac_hat, theta_m, heading)
-        if self.settled:  # a member was refined: the choice is over (module doc)
-            choose = False
+        if self.settled:  # a member was refined: the choice is over for good (module doc),
+            # and only the chosen member's estimates are ever read again (a refit starts
+            # from its own state), so the others rest
+            self.chosen.step(h, tau_reac_hat, theta_m)
+            return
         if not choose:  # the scores and open-loop models are restarted before they count
             for member in self.members:
                 member.step(h, tau_reac_hat, theta_m)

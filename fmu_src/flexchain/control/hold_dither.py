@@ -8,7 +8,7 @@ motor, free at that frequency (far above its first spring's mode), along a known
 periodic path of peak-to-peak ``A k_t (P h)² / (16 J_m)``; the amplitude is chosen for
 ``defaults.HOLD_DITHER`` counts. The reading less that path has a quantization error
 that changes from sample to sample (subtractive dither), and an observer of the motor
-alone (:class:`~arcosim.fmu.flexchain.control.motor_observer.MotorObserver` without its spring)
+alone (:class:`~arcosim.fmu.flexchain.control.motor_observer.MotorObserver`)
 averages it into the motor's angle and velocity below a count, for the state feedback
 (both) and the estimator's input (the angle). The velocity carries the dither's periodic
 error (about 0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s); fed back with
@@ -65,7 +65,7 @@ class HoldDither:
         h = design.h
         self.period = design.dither_steps
         self.amplitude = design.dither_current
-        self.observer = MotorObserver(design, defaults.HOLD_OBSERVER_BANDWIDTH, spring=False)
+        self.observer = MotorObserver(design, defaults.HOLD_OBSERVER_BANDWIDTH)
         # the path's mean over a period, so that the path is taken about the motor's angle
         self.start(0.0, 0.0)
         samples = []
@@ -110,7 +110,7 @@ class HoldDither:
         friction = d.f_c * mean_sign(self.before + slow, self.velocity + slow)
         self.steady = i_a - self.current - friction / d.k_t
         self.reading = theta - (self.path - self.mean)
-        self.observer.step(h, self.steady, self.reading, 0.0, 0.0, 0.0)
+        self.observer.step(h, self.steady, self.reading)
         return self.observer.s[2]
 
     def command(self, h: float) -> tuple[float, float]:

@@ -1,10 +1,12 @@
-"""The controller's motor observer: the motor's angle, velocity and friction from its
-current and encoder, the first spring pulling towards the estimated mass 1.
+"""The hold's motor observer: the motor's angle and velocity below a count, from its
+current and the de-dithered encoder reading.
 
-The controller's state feedback needs the motor's velocity, and the encoder's backward
-difference carries a count per step of noise (3 rad/s at 2000 counts and 1 ms); its
-friction compensation needs what the friction model f_c · sgn misses. Both come from a
-three-state observer with its poles placed (Ackermann), standard library only.
+At rest the hold's dither (:mod:`~arcosim.fmu.flexchain.control.hold_dither`) takes its
+known path out of the encoder's reading; what is left has a quantization error that
+changes from sample to sample, and this observer of the motor alone averages it into the
+motor's angle and velocity: a three-state observer with its poles placed (Ackermann),
+the torque on the motor other than the current (the spring's, the friction) taken as a
+slow disturbance, standard library only.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import math
 from collections.abc import Sequence
 from operator import mul
 
-from .. import defaults, linalg
+from .. import linalg
 from ..linalg import Matrix
 from .design import ControllerDesign
 
@@ -47,33 +49,26 @@ def observer_gain(F: Matrix, poles: Sequence[float]) -> list[float]:
 
 
 class MotorObserver:
-    """The motor's angle, velocity and friction from its current and encoder.
+    """The motor's angle and velocity from its current and encoder, the motor alone.
 
-    State ``s = [d_m, ω_m, θ_m]`` (N·m, rad/s, rad relative to the start), the motor on
-    the first spring, whose far end follows the estimated mass 1:
-    ``J_m ω̇ = k_t i − D_m ω − k_1 (θ − θ̂_1) − B_1 (ω − ω̂_1) − d_m``, ``ḋ_m = 0``; the
-    inputs ``[i, θ̂_1, ω̂_1]`` held over the step, corrected by the measured angle with
-    all three poles of the error at ``e^{−ω_o h}``.
+    State ``s = [d_m, ω_m, θ_m]`` (N·m, rad/s, rad relative to the start):
+    ``J_m ω̇ = k_t i − D_m ω − d_m``, ``ḋ_m = 0``, d_m every other torque on the motor
+    (the first spring's, the friction); the current held over the step, corrected by the
+    measured angle with all three poles of the error at ``e^{−ω_o h}``.
 
     Parameters
     ----------
     design : ControllerDesign
-        The motor's terms and the first spring.
+        The motor's terms.
     bandwidth : float
         ω_o (rad/s).
-    spring : bool
-        True (default): the model above. False: the motor alone (``k_1 = B_1 = 0``), the
-        spring's torque taken into d_m, whose pole then sits at ω_o too: what the hold's
-        dither needs (:mod:`~arcosim.fmu.flexchain.control.hold_dither`), no load parameter in it.
     """
 
     _transient = ("_models",)  # derived from the settings; rebuilt after an FMU state restore
 
-    def __init__(self, design: ControllerDesign, bandwidth: float, spring: bool = True) -> None:
+    def __init__(self, design: ControllerDesign, bandwidth: float) -> None:
         self.design = design
         self.bandwidth = bandwidth
-        self.spring = spring
-        self.friction_bandwidth = defaults.MOTOR_FRICTION_BANDWIDTH if spring else bandwidth
         self.s = [0.0, 0.0, 0.0]
         self._models: dict[float, tuple[Matrix, Matrix, list[float]]] = {}
 
@@ -82,7 +77,7 @@ class MotorObserver:
         found = self._models.get(h)
         if found is None:
             d = self.design
-            k1, B1 = (d.k[0], d.B[0]) if self.spring else (0.0, 0.0)
+            k1 = B1 = 0.0  # the motor alone: the spring's torque is in d_m
             Jm = d.J_m
             A = [
                 [0.0, 0.0, 0.0],
@@ -96,19 +91,11 @@ class MotorObserver:
             ]
             F, Gamma = linalg.hold(A, E, h)
             p = math.exp(-self.bandwidth * h)
-            found = (F, Gamma, observer_gain(F, (p, p, math.exp(-self.friction_bandwidth * h))))
+            found = (F, Gamma, observer_gain(F, (p, p, p)))
             self._models[h] = found
         return found
 
-    def step(
-        self,
-        h: float,
-        i_a: float,
-        theta: float,
-        theta_1: float,
-        omega_1: float,
-        friction: float = 0.0,
-    ) -> None:
+    def step(self, h: float, i_a: float, theta: float) -> None:
         """Take the sample that ends a step.
 
         Parameters
@@ -119,15 +106,9 @@ class MotorObserver:
             Current that acted over the step (A).
         theta : float
             Measured motor angle at the sample, relative to the start (rad).
-        theta_1, omega_1 : float
-            Estimated angle (rad, relative to the start) and velocity (rad/s) of mass 1
-            at the previous sample.
-        friction : float
-            The friction the controller's feedforward assumed over the step (N·m): the
-            model's known part, so that d_m is what it missed.
         """
         F, Gamma, gain = self.model(h)
-        w = (i_a, theta_1, omega_1, friction)
+        w = (i_a, 0.0, 0.0, 0.0)  # the current; the model's other inputs are the spring's
         s = self.s
         pred = [math.fsum(map(mul, row, s)) + math.fsum(map(mul, g, w)) for row, g in zip(F, Gamma)]
         e = theta - pred[2]
