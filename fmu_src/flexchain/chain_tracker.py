@@ -264,6 +264,7 @@ class ChainTracker:
         self.e_f = 0.0  # the prefiltered innovation (N·m) …
         self.psi_f = [0.0] * size  # … and gradient (N·m per scale)
         self.quiet = 0.0  # s left before a stuck step's friction has left the filter
+        self.learnt = 0.0  # s since start, up to tracking_time (then the memory is full)
         self.theta = [self.theta0] * n
         self.omega = [0.0] * n
         self.valid = False
@@ -387,8 +388,11 @@ class ChainTracker:
         self.e_f = ap * self.e_f + bp * e
         self.psi_f = [ap * x + bp * y for x, y in zip(self.psi_f, psi)]
         correct = self.quiet == 0.0
+        # the memory runs in time: a step that teaches nothing (the motor may stand still)
+        # still forgets, so that a sample weighs λ^age however much of the age was spent
+        # moving
+        self.learn(h, self.e_f, self.psi_f if correct else None)
         if correct:
-            self.learn(h, self.e_f, self.psi_f)
             self.s = [x + kk * e for x, kk in zip(pred, K)]
             self.S = [[x - kk * q for x, kk in zip(Sj, K)] for Sj, q in zip(S, psi)]
         else:
@@ -399,21 +403,25 @@ class ChainTracker:
         self.omega = self.s[n : 2 * n]
         self.judge()
 
-    def learn(self, h: float, e: float, psi: list[float]) -> None:
+    def learn(self, h: float, e: float, psi: list[float] | None) -> None:
         """One recursive least-squares step with forgetting on the innovation ``e`` (N·m)
-        and its gradient ``psi`` (N·m per scale), shape ``(2n + 3,)``."""
+        and its gradient ``psi`` (N·m per scale), shape ``(2n + 3,)``; ``psi`` None: a
+        step without a sample (forgetting and the prior's renewal only)."""
         lam = 1.0 - h / self.tracking_time
-        self.lag_product = lam * self.lag_product + (1.0 - lam) * e * self.e_prev
-        self.e_prev = e
-        sd = math.sqrt(self.variance)
-        self.variance = lam * self.variance + (1.0 - lam) * e * e
-        e_n = max(-CLIP, min(CLIP, e / sd))
-        x = [q / sd for q in psi]
+        self.learnt = min(self.tracking_time, self.learnt + h)
         P = self.P
-        Px = [fsum_dot(row, x) for row in P]
-        denominator = lam + fsum_dot(x, Px)
-        gain = [q / denominator for q in Px]
         size = len(P)
+        gain, Px, e_n = [0.0] * size, [0.0] * size, 0.0
+        if psi is not None:
+            self.lag_product = lam * self.lag_product + (1.0 - lam) * e * self.e_prev
+            self.e_prev = e
+            sd = math.sqrt(self.variance)
+            self.variance = lam * self.variance + (1.0 - lam) * e * e
+            e_n = max(-CLIP, min(CLIP, e / sd))
+            x = [q / sd for q in psi]
+            Px = [fsum_dot(row, x) for row in P]
+            denominator = lam + fsum_dot(x, Px)
+            gain = [q / denominator for q in Px]
         p = self.p
         # the prior's information, forgotten as the data's, renewed at the same rate
         # (stabilized forgetting): each step pulls p towards p0 by (1 − λ) P P0⁻¹ (p0 − p)
@@ -432,6 +440,8 @@ class ChainTracker:
                 row, fi = P[i], shrink[i]
                 for j in range(size):
                     row[j] *= fi * shrink[j]
+                if fi < 1.0:
+                    row[i] = cap  # exactly: at rest P stays the prior
         self.project()
 
     def project(self) -> None:
@@ -471,7 +481,8 @@ class ChainTracker:
         sigma = [math.sqrt(max(self.P[i][i], 0.0) * nu) for i in range(2 * n + 2)]
         resolved = [3.0 * x <= threshold for x in sigma]
         self.valid = all(resolved[:n]) and resolved[2 * n]
-        self.alarm = any(
+        filled = self.learnt >= self.tracking_time
+        self.alarm = (filled and self.valid) and any(
             resolved[i]
             and abs(self.p[i] - self.p0[i]) > max(threshold * abs(self.p0[i]), 3.0 * sigma[i])
             for i in range(2 * n + 2)
