@@ -136,3 +136,33 @@ def test_constant_speed_cannot_resolve_friction():
     assert 3.0 * tr.stds()[4] > 0.05 * tr.scale[4]
     assert not tr.alarm
     assert tr.P[4][4] <= PRIOR_STD**2 * (1 + 1e-12)
+
+
+def drifted(tr: ChainTracker, resolved: tuple[int, ...]) -> ChainTracker:
+    """The tracker with k_1 off its commissioning value by twice the threshold and the
+    parameters ``resolved`` known to a tenth of the threshold (σ, in units of scale)."""
+    tr.p[0] = tr.p0[0] * (1.0 - 2.0 * tr.drift_threshold)
+    for i in resolved:
+        tr.P[i][i] = (0.1 * tr.drift_threshold) ** 2
+    return tr
+
+
+def test_alarm_waits_for_a_full_memory():
+    """A drift twice the threshold, resolved to a twentieth of it, on a tracker whose
+    motion taught every stiffness and f_c: no alarm until tracking_time has passed."""
+    tr = drifted(tracker(drive(f_c=defaults.F_C)), (0, 1, 4))
+    tr.learnt = 0.99 * tr.tracking_time
+    tr.judge()
+    assert tr.valid and not tr.alarm
+    tr.learnt = tr.tracking_time
+    tr.judge()
+    assert tr.valid and tr.alarm
+
+
+def test_no_alarm_while_friction_is_not_taught():
+    """The same drift, the memory full, but f_c still at its prior (constant speed): not
+    valid, and no alarm on the stiffness."""
+    tr = drifted(tracker(drive(f_c=defaults.F_C)), (0, 1))
+    tr.learnt = tr.tracking_time
+    tr.judge()
+    assert not tr.valid and not tr.alarm
