@@ -264,17 +264,17 @@ class ReactionTorqueObserver(FmuSlave):
             out(
                 "drift_alarm",
                 "",
-                "Tracking: 1 while a tracked parameter the motion resolves differs from its "
-                "commissioning value by more than drift_threshold of it and 3 standard "
-                "deviations",
+                "Tracking: 1 while tracking_valid, after tracking_time, and a tracked "
+                "parameter differs from its commissioning value by more than drift_threshold "
+                "of it and 3 standard deviations",
                 "Integer",
             ),
             out(
                 "tracking_valid",
                 "",
-                "Tracking: 1 when the motion so far resolves every k and f_c (3 standard "
-                "deviations within drift_threshold), 0 while it cannot tell them apart "
-                "(e.g. at rest, or f_c at constant speed)",
+                "Tracking: 1 when the motion so far has taught every k and f_c (each one's "
+                "variance at most a quarter of the prior's), 0 while it cannot tell them "
+                "apart (e.g. at rest, or f_c at constant speed)",
                 "Integer",
             ),
         ]
