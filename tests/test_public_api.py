@@ -85,7 +85,6 @@ def test_every_public_name_resolves(package: str) -> None:
     assert not missing, f"{package}.__all__ names what it does not define: {missing}"
 
 
-@pytest.mark.xfail(strict=True, reason="the CLI still imports internal modules")
 def test_cli_imports_only_the_public_api_and_itself() -> None:
     found = violations(ROOT / "cosim" / "cli", own=("arcosim.cli",))
     assert not found, "\n".join(found)
