@@ -14,6 +14,9 @@ Drive logs
 read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
+parse_scales        -- ``--scale COLUMN=FACTOR`` texts as the factors read_log takes
+read_text_file      -- a UTF-8 text file's text; any other encoding refused, naming it
+tool_keys           -- JSON data with every key as other tools keep names (``J_1``)
 read_chain          -- the Chain of a whole-chain report file
 Chain               -- a chain's values: n, J_m, every J_i, k_i, B_i, the friction, σ where known
 
@@ -24,6 +27,8 @@ DriveIdentification -- its result: the chain, standard errors, assumptions, evid
 Verdict             -- whether a fit is trusted, and the reasons when not (its .verdict)
 check_log           -- can a log support identification? (before any fit)
 identify_link       -- a flexible link's EI, ρA, damping and modes from its hub's log
+identify_uniform_chain -- the paper's uniform chain (one k, one B) by output error, J_i known
+UniformChainIdentification -- its result: the chain, the fit, the report
 design_excitation   -- the multi-sine to play on the drive for identification
 Actuator            -- the motor's terms: J_mo, k_to, Δk_t, ΔJ, D_m, f_c
 motor_record        -- a log as the reaction-torque record the fits use
@@ -31,6 +36,7 @@ encoder_record      -- a log as the current → encoder record of the refinement
 identify_whole_chain -- the whole-chain fit from those records (what identify_drive runs)
 uniform_chain       -- the paper's uniform chain: k and B by output error
 estimate_load_torque -- the torque on a load mass over a log (the observer's estimator)
+LoadEstimate        -- its result: the torque, the load angles, the summary
 ObserverSettings    -- the observer FMU's parameters as one value (estimate_load_torque's)
 
 Motion and vibration control (the FMU's algorithms, standard library; margins on numpy)
@@ -51,6 +57,7 @@ FmuInstance         -- one FMU instance on fmpy, values by name
 Recording           -- time and recorded signals of a run
 replay_log          -- feed a drive log to the observer FMU
 run_ssp             -- run an SSP system (e.g. ActionReaction.ssp)
+reproduce           -- the paper's experiments and four beyond them: tables, report.md, figures
 
 Excitation signals (A, sampled at the step times)
 -------------------------------------------------
@@ -71,6 +78,16 @@ build_all           -- build the three FMUs and their SSP into a folder
 ensure_built        -- the folder of current FMUs, built if needed (per-user cache)
 validate            -- FMI compliance and behaviour checks of an FMU file
 
+Files a command writes (checked before the work, written atomically, never over an input)
+------------------------------------------------------------------------------------------
+check_output        -- refuse an output file before the work starts unless it can be written
+check_output_folder -- the same for an output folder, created
+refuse_existing     -- refuse a folder that already holds files a command would write
+same_file           -- whether two paths name one file
+write_text          -- text written atomically (UTF-8)
+write_bytes         -- bytes written atomically
+save_figure         -- a matplotlib figure saved atomically
+
 Errors
 ------
 ArcosimError        -- base of every error arcosim raises for a user to fix
@@ -80,7 +97,7 @@ IdentificationError -- a record or setting the identification cannot work with
 ChainFileError      -- a chain file read_chain cannot read
 
 The paper's experiments and the report are the command ``arcosim reproduce``
-(:func:`arcosim.experiments.reproduce.reproduce`).
+(:func:`reproduce`, its tables :meth:`~arcosim.experiments.findings.Results.text`).
 
 Every name above is importable from ``arcosim`` directly (loaded on first use, so
 ``import arcosim`` stays fast); the subpackages are ``arcosim.identification``,
@@ -125,6 +142,9 @@ _API = {
     "read_log": "arcosim.logs",
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
+    "parse_scales": "arcosim.logs",
+    "read_text_file": "arcosim.logs",
+    "tool_keys": "arcosim.logs",
     "read_chain": "arcosim.chainfile",
     "Chain": "arcosim.fmu.flexchain.chain",
     "identify_drive": "arcosim.identification.drive_identification",
@@ -132,8 +152,11 @@ _API = {
     "Verdict": "arcosim.identification.checks.verdict",
     "check_log": "arcosim.identification.checks.log_check",
     "identify_link": "arcosim.identification.link.link_identification",
+    "identify_uniform_chain": "arcosim.identification.uniform_identification",
+    "UniformChainIdentification": "arcosim.identification.uniform_identification",
     "design_excitation": "arcosim.identification.excitation.design",
     "estimate_load_torque": "arcosim.identification.load_torque",
+    "LoadEstimate": "arcosim.identification.load_torque",
     "ObserverSettings": "arcosim.fmu.flexchain.observer",
     "Actuator": "arcosim.fmu.flexchain.dob",
     "motor_record": "arcosim.identification.records.record",
@@ -153,6 +176,7 @@ _API = {
     "Recording": "arcosim.host.master",
     "replay_log": "arcosim.host.replay",
     "run_ssp": "arcosim.host.ssp",
+    "reproduce": "arcosim.experiments.reproduce",
     "multisine": "arcosim.experiments.current_commands",
     "rigid_maneuver": "arcosim.experiments.current_commands",
     "chirp": "arcosim.experiments.current_commands",
@@ -163,6 +187,13 @@ _API = {
     "build_all": "arcosim.build.builder",
     "ensure_built": "arcosim.build.builder",
     "validate": "arcosim.host.validate",
+    "check_output": "arcosim.outputs",
+    "check_output_folder": "arcosim.outputs",
+    "refuse_existing": "arcosim.outputs",
+    "same_file": "arcosim.outputs",
+    "write_text": "arcosim.outputs",
+    "write_bytes": "arcosim.outputs",
+    "save_figure": "arcosim.outputs",
     "ArcosimError": "arcosim.errors",
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",

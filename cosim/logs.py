@@ -89,7 +89,30 @@ class DriveLog:
 
 
 def parse_scales(texts: Iterable[str]) -> dict[str, float]:
-    """``["i_a=0.001", ...]`` → ``{"i_a": 0.001}`` (factor to SI); checks each."""
+    """``["i_a=0.001", ...]`` → ``{"i_a": 0.001}`` (factor to SI); checks each.
+
+    Parameters
+    ----------
+    texts : iterable of str
+        ``--scale`` texts, ``"COLUMN=FACTOR"``, COLUMN one of the log's columns and
+        FACTOR the dimensionless multiplier to SI units.
+
+    Returns
+    -------
+    dict of str to float
+        The factors by column (dimensionless), what :func:`read_log` takes.
+
+    Raises
+    ------
+    UserError
+        A text that is not ``COLUMN=FACTOR``, an unknown column, a factor that is not a
+        finite non-zero number.
+
+    Examples
+    --------
+    >>> arcosim.parse_scales(["i_a=0.001", "theta_m=0.00314"])
+    {'i_a': 0.001, 'theta_m': 0.00314}
+    """
     scales = {}
     for text in texts:
         column, sep, factor = text.partition("=")
@@ -257,11 +280,32 @@ def _row_values(path: Path, line: int, row: list[str], index: dict[str, int]) ->
 def read_text_file(path: Path, what: str = "file") -> str:
     """The text of a UTF-8 file (a byte-order mark is dropped); refuse anything else.
 
+    Parameters
+    ----------
+    path : Path
+        The file to read.
+    what : str
+        What the file is, for messages (``"log"``, ``"spec"``).
+
+    Returns
+    -------
+    str
+        The file's text.
+
     Raises
     ------
     UserError
         When the file is missing, a folder, unreadable, or not UTF-8 (naming the
         encoding when a byte-order mark says which, else the first bad byte).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "log.csv"
+    >>> _ = path.write_bytes(b"\\xef\\xbb\\xbftime,i_a\\n")
+    >>> arcosim.read_text_file(path, "log")
+    'time,i_a\\n'
     """
     if path.is_dir():
         raise UserError(f"{path}: is a folder, not a {what}")
@@ -381,7 +425,28 @@ def tool_name(name: str) -> str:
 
 def tool_keys(value: object) -> object:
     """``value`` (JSON data) with every dict key made tool-safe (:func:`tool_name`), at any
-    depth; refuse two keys that become one."""
+    depth; refuse two keys that become one.
+
+    Parameters
+    ----------
+    value : object
+        JSON data: dicts, lists and scalars, nested.
+
+    Returns
+    -------
+    object
+        The same data, every dict key as :func:`tool_name` writes it.
+
+    Raises
+    ------
+    UserError
+        When two keys of one dict give one name.
+
+    Examples
+    --------
+    >>> arcosim.tool_keys({"J[1]": 1e-4, "std": {"k[1]": 0.2}})
+    {'J_1': 0.0001, 'std': {'k_1': 0.2}}
+    """
     if isinstance(value, dict):
         renamed = {tool_name(str(k)): tool_keys(v) for k, v in value.items()}
         if len(renamed) != len(value):

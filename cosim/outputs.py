@@ -62,6 +62,18 @@ def check_output(
     UserError
         When ``path`` is an input, a folder, not a regular file, exists without
         ``force``, or its folder cannot take a new file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> arcosim.check_output(folder / "out.csv").name
+    'out.csv'
+    >>> arcosim.check_output(folder)
+    Traceback (most recent call last):
+    ...
+    arcosim.errors.UserError: --out ...: is a folder; name a file in it
     """
     path = Path(path).expanduser()
     for source in inputs:
@@ -88,7 +100,33 @@ def check_output(
 
 
 def check_output_folder(folder: str | Path, option: str = "--out") -> Path:
-    """Refuse ``folder`` as an output folder unless files can be created in it."""
+    """Refuse ``folder`` as an output folder unless files can be created in it; create it.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The folder the command will write its files into (created with its parents).
+    option : str
+        The option that named ``folder``, for messages (``"--out"``).
+
+    Returns
+    -------
+    Path
+        ``folder``, with ``~`` expanded, now existing.
+
+    Raises
+    ------
+    UserError
+        When ``folder`` is a file, cannot be created, or cannot take a new file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> folder = arcosim.check_output_folder(Path(tempfile.mkdtemp()) / "reports")
+    >>> folder.name, folder.is_dir()
+    ('reports', True)
+    """
     folder = Path(folder).expanduser()
     if folder.exists() and not folder.is_dir():
         raise UserError(f"{option} {folder}: is a file, not a folder")
@@ -101,7 +139,26 @@ def check_output_folder(folder: str | Path, option: str = "--out") -> Path:
 
 
 def same_file(a: Path, b: Path) -> bool:
-    """True if ``a`` and ``b`` name one file (same device and inode, or same real path)."""
+    """True if ``a`` and ``b`` name one file (same device and inode, or same real path).
+
+    Parameters
+    ----------
+    a, b : Path
+        Two paths; either may not exist (then their real paths are compared).
+
+    Returns
+    -------
+    bool
+        Whether writing to one would change the other.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> arcosim.same_file(Path("a/../b.csv"), Path("b.csv"))
+    True
+    >>> arcosim.same_file(Path("a"), Path("b"))
+    False
+    """
     try:
         return os.path.samefile(a, b)
     except OSError:
@@ -176,28 +233,148 @@ def atomic_output(
 def write_bytes(
     path: str | Path, data: bytes, *, force: bool = False, option: str = "--out"
 ) -> Path:
-    """Write ``data`` to ``path`` atomically (see :func:`atomic_output`); return ``path``."""
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_output`); return ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    data : bytes
+        What to write.
+    force : bool
+        Whether an existing ``path`` may be replaced.
+    option : str
+        The option that named ``path``, for messages (``"--out"``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    UserError
+        When the file cannot be written or exists without ``force`` (left as it was).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = arcosim.write_bytes(Path(tempfile.mkdtemp()) / "x.bin", b"\\x00\\x01")
+    >>> path.read_bytes()
+    b'\\x00\\x01'
+    """
     with atomic_output(path, "wb", force=force, option=option) as f:
         f.write(data)
     return Path(path)
 
 
 def write_text(path: str | Path, text: str, *, force: bool = False, option: str = "--out") -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically; return ``path``."""
+    """Write ``text`` (UTF-8) to ``path`` atomically; return ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    text : str
+        What to write, encoded as UTF-8.
+    force : bool
+        Whether an existing ``path`` may be replaced.
+    option : str
+        The option that named ``path``, for messages (``"--out"``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    UserError
+        When the file cannot be written or exists without ``force`` (left as it was).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = arcosim.write_text(Path(tempfile.mkdtemp()) / "note.md", "J = 1e-4 kg·m²\\n")
+    >>> path.read_text(encoding="utf-8")
+    'J = 1e-4 kg·m²\\n'
+    """
     return write_bytes(path, text.encode("utf-8"), force=force, option=option)
 
 
 def save_figure(
     figure: object, path: str | Path, *, dpi: int, force: bool = False, option: str = "--out"
 ) -> Path:
-    """Save a matplotlib figure to ``path`` atomically (format from the suffix)."""
+    """Save a matplotlib figure to ``path`` atomically (format from the suffix).
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to save.
+    path : str or Path
+        The output file; its suffix names the format (PNG without one).
+    dpi : int
+        Resolution (dots per inch).
+    force : bool
+        Whether an existing ``path`` may be replaced.
+    option : str
+        The option that named ``path``, for messages (``"--out"``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    UserError
+        When the file cannot be written or exists without ``force`` (left as it was).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from matplotlib.figure import Figure
+    >>> path = arcosim.save_figure(Figure(), Path(tempfile.mkdtemp()) / "f.png", dpi=50)
+    >>> path.read_bytes()[1:4]
+    b'PNG'
+    """
     buffer = io.BytesIO()
     figure.savefig(buffer, format=Path(path).suffix.lstrip(".") or "png", dpi=dpi)
     return write_bytes(path, buffer.getvalue(), force=force, option=option)
 
 
 def refuse_existing(folder: Path, names: Iterable[str], option: str = "--out") -> None:
-    """Refuse to run when files a command would write into ``folder`` exist already."""
+    """Refuse to run when files a command would write into ``folder`` exist already.
+
+    Parameters
+    ----------
+    folder : Path
+        The command's output folder.
+    names : iterable of str
+        The files the command would write there.
+    option : str
+        The option that named ``folder``, for messages (``"--out"``).
+
+    Raises
+    ------
+    UserError
+        Naming the first of those files that exists, and how many more do.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> arcosim.refuse_existing(folder, ["report.md"])  # nothing there: no error
+    >>> _ = (folder / "report.md").write_text("")
+    >>> arcosim.refuse_existing(folder, ["report.md"])
+    Traceback (most recent call last):
+    ...
+    arcosim.errors.UserError: --out ...: report.md exist(s) already; add --force ...
+    """
     existing = [name for name in names if (folder / name).exists()]
     if existing:
         more = f" and {len(existing) - 1} more" if len(existing) > 1 else ""

@@ -17,12 +17,12 @@ import pytest
 import arcosim
 from arcosim.chainfile import ChainFileError, read_chain
 from arcosim.cli.identify.options import chain_assignments
-from arcosim.cli.parameters import known_parameters
 from arcosim.fmu.arcontroller.fmu import ActionReactionController
 from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
 from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.control.design import design_controller
 from arcosim.fmu.flexchain.observer import ObserverSettings
+from arcosim.host import observer_values
 
 K_T = 0.0406  #: the bench motor's torque constant (N·m/A)
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,7 +105,7 @@ def test_a_chain_reaches_the_observer_the_controller_and_set_unchanged(tmp_path:
             declared = fmu.interface(n)
             assert all(declared[name].causality == "parameter" for name in parameters)
         # --set text, parsed as the CLI parses it, over the observer's defaults
-        values = known_parameters(n, chain_assignments(chain, []))
+        values = observer_values(n, chain_assignments(chain, []))
         assert Chain.from_parameters(values, n=n) == bare
         # the controller FMU's parameters give the very same design
         fmu_params = {**parameters, "k_to": K_T}

@@ -19,5 +19,14 @@ Imports nothing of :mod:`arcosim.host`, :mod:`arcosim.experiments` or the CLI.
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "MIN_MASSES": "arcosim.build.recipes",
+    "MAX_MASSES": "arcosim.build.recipes",
+    "MIN_ELEMENTS": "arcosim.build.recipes",
+    "MAX_ELEMENTS": "arcosim.build.recipes",
+    "check_masses": "arcosim.build.recipes",
+    "check_elements": "arcosim.build.recipes",
+    "OBSERVER": "arcosim.build.recipes",
+    "fmu_variables": "arcosim.build.builder",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -45,6 +45,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
+from arcosim import ArcosimError, __version__
 from arcosim.cli import (
     bench,
     build,
@@ -60,8 +61,6 @@ from arcosim.cli import (
     validate,
 )
 from arcosim.cli.identify import command as identify
-from arcosim.errors import ArcosimError
-from arcosim.version import __version__
 
 #: Exit status of a refused input, and of an internal error (sysexits' EX_SOFTWARE).
 EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 2, 70, 130

@@ -13,8 +13,8 @@ import importlib
 import sys
 from pathlib import Path
 
+from arcosim import UserError
 from arcosim.cli.options import add_command
-from arcosim.errors import UserError
 
 #: Benchmark name → module of the ``benchmarks`` package.
 BENCHMARKS = {

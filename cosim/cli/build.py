@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arcosim.build.builder import build_all
-from arcosim.build.recipes import (
+from arcosim import build_all
+from arcosim.build import (
     MAX_ELEMENTS,
     MAX_MASSES,
     MIN_ELEMENTS,
@@ -23,7 +23,7 @@ from arcosim.build.recipes import (
     check_masses,
 )
 from arcosim.cli.options import add_command
-from arcosim.fmu.flexchain.defaults import LINK_ELEMENTS
+from arcosim.fmu.flexchain import LINK_ELEMENTS
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

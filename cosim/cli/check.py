@@ -17,11 +17,11 @@ from __future__ import annotations
 import argparse
 import json
 
+from arcosim import check_log, parse_scales, read_log
 from arcosim.cli.identify.options import EXIT_UNTRUSTED, masses_option
 from arcosim.cli.options import add_command, log_options
-from arcosim.cli.parameters import defaults_note, known_parameters, set_names
-from arcosim.identification.checks.log_check import check_log
-from arcosim.logs import parse_scales, read_log
+from arcosim.cli.parameters import defaults_note, set_names
+from arcosim.host import observer_values
 
 #: The drive's figures a check needs, as observer parameter names.
 NEEDED = ("k_to", "J_mo", "encoder_cpr")
@@ -71,7 +71,7 @@ arcosim check log.csv --scale i_a=0.001 --set k_to=0.0406 --json""",
 
 def _execute(args: argparse.Namespace) -> int:
     log = read_log(args.log, parse_scales(args.scale))
-    values = known_parameters(3, args.set)
+    values = observer_values(3, args.set)
     given = set_names(args.set)
     c = log.columns
     report = check_log(

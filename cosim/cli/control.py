@@ -17,18 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Mapping, Sequence
 
+from arcosim import Chain, UserError, controller_margins
 from arcosim.cli.identify.options import chain_assignments, chain_option, masses_option
 from arcosim.cli.options import add_command, number
 from arcosim.cli.parameters import defaults_note, drive_parameters, set_names
-from arcosim.control.margins import controller_margins
-from arcosim.control.model_errors import ERROR, RANDOM_MODELS
-from arcosim.errors import UserError
-from arcosim.fmu.arcontroller.fmu import ActionReactionController
-from arcosim.fmu.flexchain.chain import Chain
-from arcosim.fmu.flexchain.defaults import STEP
-from arcosim.host.overrides import check_name, parse_assignment, typed_value
+from arcosim.control import ERROR, RANDOM_MODELS
+from arcosim.fmu.flexchain import STEP
+from arcosim.host import controller_problems, controller_values
 
 #: The goals among the controller's parameters (the rest describe the drive).
 GOALS = ("control_mass", "move_time", "bandwidth", "i_max", "hold_dither")
@@ -105,8 +101,8 @@ def _execute(args: argparse.Namespace) -> int:
     chain = chain_option(args.chain) if args.chain else None
     n = _masses(args, chain)
     assignments = [*chain_assignments(chain, args.set), *args.set]
-    values = controller_parameters(n, assignments)
-    problems = parameter_problems(n, values)
+    values = controller_values(n, assignments)
+    problems = controller_problems(n, values)
     if problems:
         raise UserError("; ".join(problems))
     goals = {name: values[name] for name in GOALS}
@@ -152,36 +148,3 @@ def _masses(args: argparse.Namespace, chain: Chain | None) -> int:
     if given is not None and given != n:
         raise UserError(f"--masses {given} but --chain {args.chain} holds {n}: give one of them")
     return n
-
-
-def controller_parameters(n: int, assignments: Sequence[str]) -> dict[str, float]:
-    """The controller FMU's Real and Integer parameters for ``n`` masses: its defaults with
-    ``--set`` applied (each in its unit).
-
-    Raises
-    ------
-    UserError
-        When an assignment names no parameter of the controller or its value does not fit.
-    """
-    variables = ActionReactionController.interface(n)
-    values = {
-        name: float(v.start)
-        for name, v in variables.items()
-        if v.causality == "parameter" and v.type in ("Real", "Integer")
-    }
-    for text in assignments:
-        name, value = parse_assignment(text)
-        check_name(name, variables, "the controller")
-        if name not in values:
-            raise UserError(f"--set {text!r}: {name} is not a parameter of the controller")
-        values[name] = float(typed_value(name, value, variables[name].type))
-    return values
-
-
-def parameter_problems(n: int, values: Mapping[str, float]) -> list[str]:
-    """What the controller FMU would refuse at initialization, one sentence each: its own
-    check (:meth:`ActionReactionController.check_parameters`) on these values."""
-    checked = type(
-        "Checked", (ActionReactionController,), {"n_masses": n, "value": lambda _, k: values[k]}
-    )
-    return checked.check_parameters(checked.__new__(checked))

@@ -9,8 +9,8 @@ import argparse
 from importlib import resources
 from pathlib import Path
 
+from arcosim import check_output_folder, refuse_existing, write_bytes
 from arcosim.cli.options import add_command, force_option
-from arcosim.outputs import check_output_folder, refuse_existing, write_bytes
 
 #: The files written, by their path under ``--out`` (the script reads ``data/…``
 #: beside itself).

@@ -16,11 +16,10 @@ import argparse
 import json
 from pathlib import Path
 
+from arcosim import check_output, design_excitation, write_csv
 from arcosim.cli.options import add_command, force_option, number, step_option, whole_number
-from arcosim.host.overrides import INT_MAX
-from arcosim.identification.excitation.design import DURATION, LINES, design_excitation
-from arcosim.logs import write_csv
-from arcosim.outputs import check_output
+from arcosim.host import INT_MAX
+from arcosim.identification import DURATION, LINES
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

@@ -15,11 +15,9 @@ import datetime
 import sys
 from pathlib import Path
 
+from arcosim import UserError, fleet_drift, fleet_figures, identify_fleet
 from arcosim.cli.options import add_command, number, whole_number
-from arcosim.errors import UserError
-from arcosim.fleet.drift import THRESHOLD, fleet_drift
-from arcosim.fleet.figures import fleet_figures
-from arcosim.fleet.identify import identify_fleet
+from arcosim.fleet import THRESHOLD
 
 #: Exit status of ``drift`` when any axis has an alarm.
 ALARM = 1

@@ -16,10 +16,9 @@ import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
-from arcosim.build.builder import ensure_built
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.defaults import STEP
-from arcosim.host.master import MAX_STEPS, MAX_TIME, MIN_STEP
+from arcosim import UserError, ensure_built
+from arcosim.fmu.flexchain import STEP
+from arcosim.host import MAX_STEPS, MAX_TIME, MIN_STEP
 
 
 def add_command(

@@ -1,51 +1,15 @@
-"""What ``arcosim identify`` and ``arcosim check`` know of a drive: the observer's
-parameters, ``--set NAME=VALUE`` over the observer FMU's own defaults, and the note
-naming those left at the paper bench's value.
+"""What ``arcosim identify`` and ``arcosim check`` know of a drive: the actuator among
+the observer's parameters (:func:`arcosim.host.observer_values`: ``--set NAME=VALUE``
+over the observer FMU's own defaults), and the note naming those left at the paper
+bench's value.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.host.overrides import parse_assignment
-from arcosim.host.replay import parameter_sets
-
-
-def known_parameters(n: int, assignments: Sequence[str]) -> dict[str, float]:
-    """The observer's parameters for ``n`` masses: its defaults with ``--set`` applied.
-
-    The defaults come from the observer FMU's own declaration, so the offline methods
-    need no built FMU.
-
-    Parameters
-    ----------
-    n : int
-        Number of load masses (a count).
-    assignments : sequence of str
-        ``--set`` texts, ``"NAME=VALUE"`` (the value in the parameter's unit).
-
-    Returns
-    -------
-    dict of str to float
-        Every Real and Integer parameter of the observer by name, in its unit.
-
-    Raises
-    ------
-    UserError
-        When an assignment names no parameter of the observer or its value does not fit.
-    """
-    from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
-
-    variables = ReactionTorqueObserver.interface(n)
-    values: dict[str, float] = {
-        name: float(v.start)
-        for name, v in variables.items()
-        if v.causality == "parameter" and v.type in ("Real", "Integer")
-    }
-    values.update({k: float(v) for k, v in parameter_sets(variables, assignments).items()})
-    return values
+from arcosim import Actuator, UserError
+from arcosim.host import parse_assignment
 
 
 def actuator_of(values: Mapping[str, float]) -> Actuator:
@@ -54,7 +18,7 @@ def actuator_of(values: Mapping[str, float]) -> Actuator:
     Parameters
     ----------
     values : mapping of str to float
-        The observer's parameters (:func:`known_parameters`): ``J_mo`` (kg·m²), ``k_to``
+        The observer's parameters (:func:`arcosim.host.observer_values`): ``J_mo`` (kg·m²), ``k_to``
         (N·m/A), ``dkt``, ``dJm``, ``D_m`` (N·m·s/rad), ``f_c`` (N·m), ``g_dist`` (rad/s).
 
     Returns

@@ -15,25 +15,8 @@ import argparse
 import time
 from pathlib import Path
 
+from arcosim import reproduce
 from arcosim.cli.options import add_command, add_fmus_option, tool_names_option
-from arcosim.experiments.findings import (
-    LINK_HEADER,
-    LOAD_HEADER,
-    TABLE_II_HEADER,
-    TABLE_II_NOTE,
-    WHOLE_CHAIN_HEADER,
-    actuator_rows,
-    link_rows,
-    load_angle_rows,
-    load_rows,
-    state_rows,
-    table_ii_rows,
-    whole_chain_rows,
-    whole_state_rows,
-)
-from arcosim.experiments.motion import findings as motion
-from arcosim.experiments.report import text_table
-from arcosim.experiments.reproduce import reproduce
 
 
 def add_parser(
@@ -92,27 +75,7 @@ def _execute(args: argparse.Namespace) -> int:
         all_csv=args.all_csv,
         tool_names=args.tool_names,
     )
-    print("\n1. Actuator self-identification (load detached)")
-    print(text_table(["term", "identified", "true", "error"], actuator_rows(results)))
-    print("\n2. Table II: five rigid maneuvers (ours) next to the paper's")
-    print(text_table(TABLE_II_HEADER, table_ii_rows(results)))
-    print(TABLE_II_NOTE)
-    print("\n3. State estimation (recursion), score rms(θ̂_i − θ_i) / rms(θ_i − θ_m)")
-    print(text_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(results)))
-    print(f"\n4. Whole chain from the motor alone (n = {results.masses} read from the record)")
-    print(text_table(WHOLE_CHAIN_HEADER, whole_chain_rows(results)))
-    print(text_table(["mass", "model-based score, identified chain"], whole_state_rows(results)))
-    print("\n5. Load torque on mass 3 from the motor alone, % of the step")
-    print(text_table(LOAD_HEADER, load_rows(results)))
-    print(text_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(results)))
-    print("\n6. Flexible link from the hub alone (FlexLinkPlant.fmu)")
-    print(text_table(LINK_HEADER, link_rows(results)))
-    print(f"\n{motion.NUMBER}. A 1 rad move of the last mass by four controllers")
-    print(text_table(motion.MOVE_HEADER, motion.move_rows(results.motion)))
-    print("the same with a load-torque step on the last mass during the hold")
-    print(text_table(motion.LOAD_HEADER, motion.load_rows(results.motion)))
-    print("the sensorless controller with model errors, against its four criteria")
-    print(text_table(motion.ERROR_HEADER, motion.error_rows(results.motion)))
+    print(results.text())
     print(
         f"\nwrote {args.out / 'report.md'} and {len(results.files) - 1} more files "
         f"in {time.perf_counter() - start:.0f} s"

@@ -31,8 +31,17 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import fmu_variables
-from arcosim.build.recipes import MAX_MASSES, MIN_MASSES
+from arcosim import (
+    SCENARIOS,
+    Recording,
+    Scenario,
+    UserError,
+    check_output,
+    run_scenario,
+    tool_keys,
+    write_csv,
+)
+from arcosim.build import MAX_MASSES, MIN_MASSES, fmu_variables
 from arcosim.cli.options import (
     MAX_TIME,
     add_command,
@@ -45,23 +54,14 @@ from arcosim.cli.options import (
     step_option,
     whole_number,
 )
-from arcosim.errors import UserError
-from arcosim.experiments.control_scenarios import (
+from arcosim.experiments import (
     CONTROL_SCENARIOS,
+    IDEAL_SENSORS,
     move_summary,
+    recording_columns,
     run_control_scenario,
 )
-from arcosim.experiments.scenarios import (
-    IDEAL_SENSORS,
-    SCENARIOS,
-    Scenario,
-    recording_columns,
-    run_scenario,
-)
-from arcosim.host.master import ORDERINGS, Recording
-from arcosim.host.overrides import split_overrides
-from arcosim.logs import tool_keys, write_csv
-from arcosim.outputs import check_output
+from arcosim.host import ORDERINGS, split_overrides
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

@@ -7,10 +7,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arcosim import check_output, run_ssp, write_csv
 from arcosim.cli.options import MAX_TIME, add_command, force_option, number, step_option
-from arcosim.host.ssp import run_ssp
-from arcosim.logs import write_csv
-from arcosim.outputs import check_output
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

@@ -16,12 +16,9 @@ import sys
 import time
 from pathlib import Path
 
+from arcosim import UserError, same_file
 from arcosim.cli.options import add_command, add_fmus_option, whole_number
-from arcosim.errors import UserError
-from arcosim.outputs import same_file
-from arcosim.sweeps.runner import RESULTS, SUMMARY, sweep
-from arcosim.sweeps.spec import load_spec
-from arcosim.sweeps.summary import read_results
+from arcosim.sweeps import RESULTS, SUMMARY, load_spec, read_results, sweep
 
 #: Exit statuses of a sweep that ran: some runs failed, every run failed.
 SOME_FAILED, ALL_FAILED = 1, 3

@@ -11,10 +11,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arcosim.build.builder import ensure_built
+from arcosim import UserError, ensure_built, validate
 from arcosim.cli.options import add_command
-from arcosim.errors import UserError
-from arcosim.host.validate import not_an_fmu, validate
+from arcosim.host import not_an_fmu
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

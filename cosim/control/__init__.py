@@ -15,5 +15,8 @@ margins         -- both together for one chain (``controller_margins``), with a 
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "ERROR": "arcosim.control.model_errors",
+    "RANDOM_MODELS": "arcosim.control.model_errors",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

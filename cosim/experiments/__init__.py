@@ -25,5 +25,13 @@ Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.identific
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "IDEAL_SENSORS": "arcosim.experiments.scenarios",
+    "recording_columns": "arcosim.experiments.scenarios",
+    "CONTROL_SCENARIOS": "arcosim.experiments.control_scenarios",
+    "run_control_scenario": "arcosim.experiments.control_scenarios",
+    "move_summary": "arcosim.experiments.control_scenarios",
+    "Results": "arcosim.experiments.findings",
+    "draw_tracking": "arcosim.experiments.tracking_figure",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -14,9 +14,10 @@ import numpy as np
 from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
 from arcosim.experiments.flexible_link import EXPERIMENT_RIG, SETTLE
 from arcosim.experiments.metrics import percent_error
+from arcosim.experiments.motion import findings as motion_findings
 from arcosim.experiments.motion.findings import MotionResults, motion_markdown
 from arcosim.experiments.paper import B_TRUE_PAPER, K_TRUE_PAPER, table_ii_si
-from arcosim.experiments.report import markdown_table
+from arcosim.experiments.report import markdown_table, text_table
 from arcosim.experiments.scenarios import LOAD_PROFILE
 from arcosim.fmu.flexchain import defaults
 from arcosim.version import __version__
@@ -84,6 +85,36 @@ class Results:
     link: dict[str, object] = field(default_factory=dict)
     motion: MotionResults = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
+
+    def text(self) -> str:
+        """The tables ``arcosim reproduce`` prints: one section per experiment, each
+        headed by its number and title, as plain text (no trailing newline)."""
+        motion = motion_findings
+        return "\n".join(
+            [
+                "\n1. Actuator self-identification (load detached)",
+                text_table(["term", "identified", "true", "error"], actuator_rows(self)),
+                "\n2. Table II: five rigid maneuvers (ours) next to the paper's",
+                text_table(TABLE_II_HEADER, table_ii_rows(self)),
+                TABLE_II_NOTE,
+                "\n3. State estimation (recursion), score rms(θ̂_i − θ_i) / rms(θ_i − θ_m)",
+                text_table(["mass", "recursion score", "naive θ_i = θ_m"], state_rows(self)),
+                f"\n4. Whole chain from the motor alone (n = {self.masses} read from the record)",
+                text_table(WHOLE_CHAIN_HEADER, whole_chain_rows(self)),
+                text_table(["mass", "model-based score, identified chain"], whole_state_rows(self)),
+                "\n5. Load torque on mass 3 from the motor alone, % of the step",
+                text_table(LOAD_HEADER, load_rows(self)),
+                text_table(["observer", "mass 1", "mass 2", "mass 3"], load_angle_rows(self)),
+                "\n6. Flexible link from the hub alone (FlexLinkPlant.fmu)",
+                text_table(LINK_HEADER, link_rows(self)),
+                f"\n{motion.NUMBER}. A 1 rad move of the last mass by four controllers",
+                text_table(motion.MOVE_HEADER, motion.move_rows(self.motion)),
+                "the same with a load-torque step on the last mass during the hold",
+                text_table(motion.LOAD_HEADER, motion.load_rows(self.motion)),
+                "the sensorless controller with model errors, against its four criteria",
+                text_table(motion.ERROR_HEADER, motion.error_rows(self.motion)),
+            ]
+        )
 
 
 def actuator_rows(results: Results) -> list[list[str]]:

@@ -138,6 +138,21 @@ def reproduce(
         When ``out`` is not a folder that can be written, or one of :data:`OUTPUTS`
         exists in it and not ``force`` (checked before any run); every file is written
         atomically.
+
+    Examples
+    --------
+    ``arcosim.reproduce(Path("reports"))`` runs them all (a minute or two) and
+    ``print(results.text())`` shows their tables. A folder that holds an earlier report
+    is refused before anything runs:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> out = Path(tempfile.mkdtemp())
+    >>> _ = (out / "report.md").write_text("")
+    >>> arcosim.reproduce(out)
+    Traceback (most recent call last):
+    ...
+    arcosim.errors.UserError: --out ...: report.md exist(s) already; add --force ...
     """
     from tqdm import tqdm
 

@@ -4,6 +4,7 @@ on fmpy.
 Modules, in the order data flows:
 
 overrides  -- ``plant.k[2]=0.2`` texts typed and checked against an FMU's variables
+parameters -- the observer's and the controller's parameters with ``--set`` applied, no FMU built
 instance   -- one FMU instance through fmpy's FMI 2.0 calls (``FmuInstance``), ctypes ports
 stepping   -- what every fixed-step loop over FMUs needs (the step grid, the recording)
 master     -- the fixed-step master of plant and observer (``cosimulate``, ``Recording``)
@@ -21,5 +22,22 @@ Imports of the project: :mod:`arcosim.errors`, :mod:`arcosim.logs`, :mod:`arcosi
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "INT_MAX": "arcosim.host.overrides",
+    "parse_assignment": "arcosim.host.overrides",
+    "split_overrides": "arcosim.host.overrides",
+    "observer_values": "arcosim.host.parameters",
+    "controller_values": "arcosim.host.parameters",
+    "controller_problems": "arcosim.host.parameters",
+    "MIN_STEP": "arcosim.host.master",
+    "MAX_STEPS": "arcosim.host.master",
+    "MAX_TIME": "arcosim.host.master",
+    "ORDERINGS": "arcosim.host.master",
+    "observer_parameters": "arcosim.host.replay",
+    "final_values": "arcosim.host.replay",
+    "TrackedChain": "arcosim.host.tracking",
+    "replay_tracking": "arcosim.host.tracking",
+    "untracked_outputs": "arcosim.host.tracking",
+    "not_an_fmu": "arcosim.host.validate",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -75,6 +75,38 @@ class TrackedChain:
         units["drift_alarm"] = units["tracking_valid"] = "1"
         return columns, units
 
+    def to_json(self) -> dict[str, object]:
+        """The replay's end as JSON data: ``tracked`` (per name its last ``value``,
+        ``std`` and ``commissioning`` value, each in its unit), the last ``drift_alarm``
+        and ``tracking_valid`` (0 or 1), and ``first_alarm_time`` (s, None if never)."""
+        final = {
+            name: {"value": float(v), "std": float(s), "commissioning": float(c)}
+            for name, v, s, c in zip(self.names, self.values[-1], self.stds[-1], self.commissioning)
+        }
+        return {
+            "tracked": final,
+            "drift_alarm": int(self.alarm[-1]),
+            "tracking_valid": int(self.valid[-1]),
+            "first_alarm_time": self.first_alarm(),
+        }
+
+    def text(self) -> str:
+        """The replay's end as text: each tracked value ± σ (the commissioning value),
+        the alarm with the time it was first raised, the validity."""
+        summary = self.to_json()
+        lines = [f"{len(self.time)} samples; the tracked chain at the end (value ± σ, given):"]
+        for name, row in summary["tracked"].items():
+            lines.append(
+                f"  {name:8s} {row['value']:.6g} ± {row['std']:.2g}  ({row['commissioning']:.6g})"
+            )
+        alarm = summary["first_alarm_time"]
+        lines.append(
+            f"  drift_alarm {summary['drift_alarm']}, first raised at "
+            + (f"{alarm:g} s" if alarm is not None else "no time")
+        )
+        lines.append(f"  tracking_valid {summary['tracking_valid']}")
+        return "\n".join(lines)
+
 
 #: The tracker's Integer outputs: the drift alarm and the motion's validity.
 FLAGS = ("drift_alarm", "tracking_valid")

@@ -18,6 +18,7 @@ Modules
 -------
 drive_identification -- the whole job from a log
 load_torque          -- the torque on a load mass over a log
+uniform_identification -- the paper's uniform chain by output error, with its report
 offline_observer     -- the observer FMU's algorithms run over a log
 threads              -- one BLAS thread inside the fits
 errors               -- IdentificationError
@@ -26,5 +27,18 @@ errors               -- IdentificationError
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "LINES": "arcosim.identification.excitation.design",
+    "DURATION": "arcosim.identification.excitation.design",
+    "search_band": "arcosim.identification.excitation.band",
+    "MAX_AUTO_MASSES": "arcosim.identification.fit.whole_chain",
+    "MeasuredResponse": "arcosim.identification.checks.frf",
+    "measured_response": "arcosim.identification.checks.frf",
+    "model_response": "arcosim.identification.checks.frf",
+    "residual_spectrum": "arcosim.identification.checks.frf",
+    "current_noise": "arcosim.identification.checks.noise_floor",
+    "identify_uniform_chain": "arcosim.identification.uniform_identification",
+    "UniformChainIdentification": "arcosim.identification.uniform_identification",
+    "LoadEstimate": "arcosim.identification.load_torque",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -10,7 +10,7 @@ bench accuracy`` score it (:mod:`arcosim.experiments.load_scores`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,6 +35,22 @@ class LoadEstimate:
         Estimated load angles (rad) and velocities (rad/s), shape ``(N, n)``.
     innovation : ndarray
         τ̂_reac minus the model's prediction (N·m), shape ``(N,)``.
+    load_mass : int
+        The mass the torque acts on, 1 … n (an index; 0: not said).
+    load_torque_bandwidth : float
+        The estimator's bandwidth for the load torque (rad/s; 0: not said).
+    assumptions : dict of str to str
+        What the estimate rests on, by topic (e.g. ``"defaults"``: the parameters left
+        at the paper bench's value).
+
+    Examples
+    --------
+    >>> t = np.arange(3) * 1e-3
+    >>> z = np.zeros(3)
+    >>> estimate = arcosim.LoadEstimate(t, t, z, z[:, None], z[:, None], z, load_mass=1)
+    >>> report = estimate.to_json()
+    >>> report["masses"], report["final"], report["mean_last_second"]
+    (1, 0.002, 0.001)
     """
 
     time: np.ndarray
@@ -43,6 +59,9 @@ class LoadEstimate:
     theta: np.ndarray
     omega: np.ndarray
     innovation: np.ndarray
+    load_mass: int = 0
+    load_torque_bandwidth: float = 0.0
+    assumptions: dict[str, str] = field(default_factory=dict)
 
     def columns(self) -> dict[str, np.ndarray]:
         """CSV columns named as the observer FMU's outputs (``time`` first)."""
@@ -52,6 +71,47 @@ class LoadEstimate:
         columns.update({f"omega_hat[{i + 1}]": self.omega[:, i] for i in range(n)})
         columns["innovation"] = self.innovation
         return columns
+
+    def with_assumption(self, key: str, text: str) -> LoadEstimate:
+        """The same estimate with one more assumption (``key``: a topic, ``text``: a
+        sentence)."""
+        return replace(self, assumptions={**self.assumptions, key: text})
+
+    def to_json(self) -> dict[str, object]:
+        """The summary as JSON data: ``method``, ``masses``, ``load_mass``,
+        ``load_torque_bandwidth`` (rad/s), ``samples``, the ``final`` torque and its
+        ``mean_last_second`` and ``std_last_second`` (N·m), ``rms_innovation`` (N·m) and,
+        when any, ``assumptions``."""
+        last = self.time >= self.time[-1] - 1.0
+        report: dict[str, object] = {
+            "method": "load-torque",
+            "masses": self.theta.shape[1],
+            "load_mass": self.load_mass,
+            "load_torque_bandwidth": self.load_torque_bandwidth,
+            "samples": len(self.time),
+            "final": float(self.tau_load[-1]),
+            "mean_last_second": float(np.mean(self.tau_load[last])),
+            "std_last_second": float(np.std(self.tau_load[last])),
+            "rms_innovation": float(np.sqrt(np.mean(self.innovation**2))),
+        }
+        if self.assumptions:
+            report["assumptions"] = dict(self.assumptions)
+        return report
+
+    def text(self) -> str:
+        """The summary as text: the final torque, the last second's mean and spread, the
+        innovation, the assumptions."""
+        report = self.to_json()
+        lines = [
+            f"{report['samples']} samples, load torque on mass {report['load_mass']} of "
+            f"{report['masses']} (bandwidth {report['load_torque_bandwidth']:g} rad/s):",
+            f"  final              {report['final']:.6g} N·m",
+            f"  last second        {report['mean_last_second']:.6g} ± "
+            f"{report['std_last_second']:.2g} N·m (mean ± std)",
+            f"  rms innovation     {report['rms_innovation']:.3g} N·m",
+        ]
+        lines += [f"  assumption, {key}: {text}" for key, text in self.assumptions.items()]
+        return "\n".join(lines)
 
 
 def estimate_load_torque(
@@ -84,7 +144,8 @@ def estimate_load_torque(
     -------
     LoadEstimate
         The estimated torque on the load mass (N·m, the plant's ``tau_ext`` sign),
-        τ̂_reac (N·m), the load angles (rad) and velocities (rad/s), the innovation.
+        τ̂_reac (N·m), the load angles (rad) and velocities (rad/s), the innovation;
+        its summary (:meth:`LoadEstimate.to_json`, :meth:`LoadEstimate.text`).
 
     Raises
     ------
@@ -124,4 +185,13 @@ def estimate_load_torque(
             innovation[k] = est.innovation
 
     replay(settings, {"time": t, "i_a": i_a, "omega_m": omega_m, "theta_m": theta_m}, keep)
-    return LoadEstimate(t.copy(), tau_load, tau_reac, theta, omega, innovation)
+    return LoadEstimate(
+        t.copy(),
+        tau_load,
+        tau_reac,
+        theta,
+        omega,
+        innovation,
+        settings.load_mass,
+        settings.load_torque_bandwidth,
+    )

@@ -14,5 +14,11 @@ Sits above :mod:`arcosim.host`, :mod:`arcosim.build` and :mod:`arcosim.experimen
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "load_spec": "arcosim.sweeps.spec",
+    "sweep": "arcosim.sweeps.runner",
+    "RESULTS": "arcosim.sweeps.runner",
+    "SUMMARY": "arcosim.sweeps.runner",
+    "read_results": "arcosim.sweeps.summary",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

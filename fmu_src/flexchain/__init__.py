@@ -59,7 +59,12 @@ import importlib
 #: Public name → the module that defines it, relative to this package (the package's
 #: API; ``tests/test_public_api.py``). Loaded on first use, so an FMU imports only what
 #: it runs.
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "STEP": ".defaults",
+    "LINK_ELEMENTS": ".defaults",
+    "Mode": ".codes",
+    "Estimator": ".codes",
+}
 __all__ = list(_API)
 
 

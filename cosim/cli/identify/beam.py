@@ -19,11 +19,10 @@ import math
 import sys
 from collections.abc import Sequence
 
-from arcosim import identify_link
+from arcosim import DriveLog, UserError, identify_link, tool_keys, write_csv
 from arcosim.cli.identify.options import write_report
-from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
-from arcosim.errors import UserError
-from arcosim.logs import DriveLog, tool_keys, write_csv
+from arcosim.cli.parameters import actuator_of, defaults_note, set_names
+from arcosim.host import observer_values
 
 #: The link's ``--set`` names and their units; ``L`` is needed for EI and ρA; ``rhoA``
 #: (mass per length, > 0) is held in the fit, not fitted.
@@ -106,7 +105,7 @@ def run_beam(args: argparse.Namespace, log: DriveLog) -> int:
             "--method beam: --set m_tip, J_tip, r_hub or rhoA need the link's --set L=… (m)"
         )
     rhoA = shape.pop("rhoA", None)
-    values = known_parameters(1, assignments)
+    values = observer_values(1, assignments)
     given = set_names(assignments)
     cpr = int(values["encoder_cpr"])
     if cpr <= 0:

@@ -87,6 +87,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arcosim import UserError, parse_scales, read_log
 from arcosim.cli.identify.beam import run_beam
 from arcosim.cli.identify.load_torque import run_load_torque
 from arcosim.cli.identify.observer import run_observer
@@ -102,8 +103,6 @@ from arcosim.cli.identify.plot import check_plot
 from arcosim.cli.identify.whole_chain import run_whole_chain
 from arcosim.cli.options import add_command, add_fmus_option, force_option, log_options, number
 from arcosim.cli.parameters import set_names
-from arcosim.errors import UserError
-from arcosim.logs import parse_scales, read_log
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

@@ -1,29 +1,25 @@
 """``arcosim identify --method load-torque``: the external torque on one load mass over
 time, from the motor alone (the observer's estimator 1 with ``load_mass``, run offline),
-the chain from ``--set`` (``--chain``, a whole-chain report, adds its values there).
+the chain from ``--set`` (``--chain``, a whole-chain report, adds its values there):
+:func:`arcosim.estimate_load_torque` and its summary.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-import numpy as np
-
-from arcosim.cli.parameters import (
-    actuator_of,
-    defaults_note,
-    drive_parameters,
-    known_parameters,
-    set_names,
+from arcosim import (
+    Chain,
+    DriveLog,
+    ObserverSettings,
+    UserError,
+    estimate_load_torque,
+    write_csv,
 )
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.chain import Chain
-from arcosim.fmu.flexchain.codes import Estimator, Mode
-from arcosim.fmu.flexchain.observer import ObserverSettings
-from arcosim.identification import load_torque
-from arcosim.logs import DriveLog, write_csv
+from arcosim.cli.parameters import actuator_of, defaults_note, drive_parameters, set_names
+from arcosim.fmu.flexchain import Estimator, Mode
+from arcosim.host import observer_values
 
 
 def run_load_torque(args: argparse.Namespace, log: DriveLog, n: int) -> int:
@@ -48,14 +44,12 @@ def run_load_torque(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     UserError
         No ``load_mass`` in 1 … n, a chain or tuning no estimator can be designed for.
     """
-    values = known_parameters(n, args.set)
+    values = observer_values(n, args.set)
     defaults = defaults_note(values, drive_parameters(n), set_names(args.set))
     settings = _settings(values, n)
     c = log.columns
     try:
-        result = load_torque.estimate_load_torque(
-            settings, log.time, c["i_a"], c["omega_m"], c["theta_m"]
-        )
+        result = estimate_load_torque(settings, log.time, c["i_a"], c["omega_m"], c["theta_m"])
     except (ValueError, ZeroDivisionError, OverflowError) as error:  # the Kalman design
         raise UserError(
             f"--method load-torque: no estimator for these settings ({error}); check "
@@ -63,24 +57,14 @@ def run_load_torque(args: argparse.Namespace, log: DriveLog, n: int) -> int:
         ) from None
     if args.out:
         write_csv(args.out, result.columns(), tool_names=args.tool_names, force=args.force)
-    last = log.time >= log.time[-1] - 1.0
-    report = {
-        "method": "load-torque",
-        "masses": n,
-        "load_mass": settings.load_mass,
-        "load_torque_bandwidth": settings.load_torque_bandwidth,
-        "samples": len(log),
-        "final": float(result.tau_load[-1]),
-        "mean_last_second": float(np.mean(result.tau_load[last])),
-        "std_last_second": float(np.std(result.tau_load[last])),
-        "rms_innovation": float(np.sqrt(np.mean(result.innovation**2))),
-    }
     if defaults:
-        report["assumptions"] = {"defaults": defaults}
+        result = result.with_assumption("defaults", defaults)
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(result.to_json(), indent=2))
     else:
-        _print_report(report, args.out)
+        print(result.text())
+        if args.out:
+            print(f"wrote {args.out}")
     return 0
 
 
@@ -112,21 +96,3 @@ def _settings(values: dict[str, float], n: int) -> ObserverSettings:
     if not settings.load_torque_bandwidth > 0:
         raise UserError("load_torque_bandwidth must be > 0 (rad/s)")
     return settings
-
-
-def _print_report(report: dict, out: Path | None) -> None:
-    """The summary as text, and the file written."""
-    print(
-        f"{report['samples']} samples, load torque on mass {report['load_mass']} of "
-        f"{report['masses']} (bandwidth {report['load_torque_bandwidth']:g} rad/s):"
-    )
-    print(f"  final              {report['final']:.6g} N·m")
-    print(
-        f"  last second        {report['mean_last_second']:.6g} ± "
-        f"{report['std_last_second']:.2g} N·m (mean ± std)"
-    )
-    print(f"  rms innovation     {report['rms_innovation']:.3g} N·m")
-    if "assumptions" in report:
-        print(f"  assumption, defaults: {report['assumptions']['defaults']}")
-    if out:
-        print(f"wrote {out}")

@@ -11,16 +11,20 @@ import json
 import sys
 from pathlib import Path
 
-from arcosim.build.recipes import OBSERVER
+from arcosim import DriveLog, FmuInstance, UserError, replay_log, tool_keys, write_csv
+from arcosim.build import OBSERVER
 from arcosim.cli.identify.options import check_out
 from arcosim.cli.options import fmu_folder, fmu_inputs
-from arcosim.cli.parameters import defaults_note, drive_parameters, known_parameters, set_names
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.codes import Mode
-from arcosim.host.instance import FmuInstance
-from arcosim.host.replay import final_values, observer_parameters, replay_log
-from arcosim.host.tracking import TrackedChain, replay_tracking, untracked_outputs
-from arcosim.logs import DriveLog, tool_keys, write_csv
+from arcosim.cli.parameters import defaults_note, drive_parameters, set_names
+from arcosim.fmu.flexchain import Mode
+from arcosim.host import (
+    TrackedChain,
+    final_values,
+    observer_parameters,
+    observer_values,
+    replay_tracking,
+    untracked_outputs,
+)
 
 
 def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
@@ -49,7 +53,7 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
     folder = fmu_folder(args, n)
     check_out(args, fmu_inputs(folder))
     defaults = defaults_note(
-        known_parameters(n, args.set),
+        observer_values(n, args.set),
         drive_parameters(n, chain=args.mode in (None, Mode.STATE_ESTIMATION)),
         set_names(args.set),
     )
@@ -83,39 +87,17 @@ def run_observer(args: argparse.Namespace, log: DriveLog, n: int) -> int:
 
 def _report_tracking(args: argparse.Namespace, tracked: TrackedChain, defaults: str) -> int:
     """Write, draw and print a tracked replay; exit status 0."""
-    from arcosim.experiments.tracking_figure import draw_tracking
+    from arcosim.experiments import draw_tracking
 
     if args.out:
         columns, units = tracked.columns()
         write_csv(args.out, columns, units=units, tool_names=args.tool_names, force=args.force)
     if args.plot is not None:
         draw_tracking(tracked, args.plot, force=args.force)
-    final = {
-        name: {"value": float(v), "std": float(s), "commissioning": float(c)}
-        for name, v, s, c in zip(
-            tracked.names, tracked.values[-1], tracked.stds[-1], tracked.commissioning
-        )
-    }
-    summary = {
-        "tracked": final,
-        "drift_alarm": int(tracked.alarm[-1]),
-        "tracking_valid": int(tracked.valid[-1]),
-        "first_alarm_time": tracked.first_alarm(),
-    }
     if args.json:
-        print(json.dumps(summary, indent=2))
+        print(json.dumps(tracked.to_json(), indent=2))
     else:
-        print(f"{len(tracked.time)} samples; the tracked chain at the end (value ± σ, given):")
-        for name, row in final.items():
-            print(
-                f"  {name:8s} {row['value']:.6g} ± {row['std']:.2g}  ({row['commissioning']:.6g})"
-            )
-        alarm = summary["first_alarm_time"]
-        print(
-            f"  drift_alarm {summary['drift_alarm']}, first raised at "
-            + (f"{alarm:g} s" if alarm is not None else "no time")
-        )
-        print(f"  tracking_valid {summary['tracking_valid']}")
+        print(tracked.text())
         for path in (args.out, args.plot):
             if path:
                 print(f"wrote {path}")

@@ -12,13 +12,17 @@ import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from arcosim.build.recipes import check_masses
-from arcosim.chainfile import ChainFileError, read_chain
+from arcosim import (
+    Chain,
+    ChainFileError,
+    UserError,
+    check_output,
+    read_chain,
+    tool_keys,
+    write_text,
+)
+from arcosim.build import check_masses
 from arcosim.cli.parameters import set_names
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.chain import Chain
-from arcosim.logs import tool_keys
-from arcosim.outputs import check_output, write_text
 
 #: Methods whose result is a report (``--out`` writes it as JSON), not a time series.
 OFFLINE = ("output-error", "whole-chain")

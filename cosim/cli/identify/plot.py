@@ -19,18 +19,22 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.errors import UserError
-from arcosim.identification.checks.frf import (
+from arcosim import (
+    DriveIdentification,
+    DriveLog,
+    UserError,
+    check_output,
+    read_text_file,
+    save_figure,
+    write_csv,
+)
+from arcosim.identification import (
     MeasuredResponse,
+    current_noise,
     measured_response,
     model_response,
     residual_spectrum,
 )
-from arcosim.identification.checks.noise_floor import current_noise
-from arcosim.identification.drive_identification import DriveIdentification
-from arcosim.identification.fit.whole_chain import split
-from arcosim.logs import DriveLog, read_text_file, write_csv
-from arcosim.outputs import check_output, save_figure
 
 #: The CSV's columns and their units.
 UNITS = {
@@ -107,7 +111,9 @@ def write_plot(
     c = log.columns
     reference = reference_column(log.path, args.reference, len(log)) if args.reference else None
     measured = measured_response(log.time, c["i_a"], c["theta_m"], k_t, reference, band)
-    J, k, B = split(np.array([result.parameters[n] for n in _names(result.masses)]), result.masses)
+    n = result.masses
+    stacked = np.array([result.parameters[name] for name in _names(n)])
+    J, k, B = list(stacked[:n]), list(stacked[n : 2 * n]), list(stacked[2 * n : 3 * n])
     D_m = float(result.friction.get("D_m", 0.0))
     model = (J_m, J, k, B, D_m)
     modelled = model_response(measured.omega, *model)

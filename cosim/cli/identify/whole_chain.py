@@ -9,13 +9,12 @@ import argparse
 import json
 import sys
 
+from arcosim import DriveIdentification, DriveLog, identify_drive, tool_keys
 from arcosim.cli.identify.options import EXIT_UNTRUSTED, write_report
 from arcosim.cli.identify.plot import write_plot
-from arcosim.cli.parameters import actuator_of, defaults_note, known_parameters, set_names
-from arcosim.identification.drive_identification import DriveIdentification, identify_drive
-from arcosim.identification.excitation.band import search_band
-from arcosim.identification.fit.whole_chain import MAX_AUTO_MASSES
-from arcosim.logs import DriveLog, tool_keys
+from arcosim.cli.parameters import actuator_of, defaults_note, set_names
+from arcosim.host import observer_values
+from arcosim.identification import MAX_AUTO_MASSES, search_band
 
 
 def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) -> int:
@@ -44,7 +43,7 @@ def run_whole_chain(args: argparse.Namespace, log: DriveLog, masses: int | str) 
         A bad ``--set``, a record the fit cannot work with, a fit that ends on
         non-finite numbers.
     """
-    values = known_parameters(masses if isinstance(masses, int) else 3, args.set)
+    values = observer_values(masses if isinstance(masses, int) else 3, args.set)
     given = set_names(args.set)
     friction = {"D_m": values["D_m"], "f_c": values["f_c"]} if {"D_m", "f_c"} <= given else {}
     actuator = actuator_of(values)
