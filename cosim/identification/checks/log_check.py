@@ -18,7 +18,7 @@ import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST
 from arcosim.identification.checks.log_decision import WEAK_T, LogDecision, decide_log
-from arcosim.identification.checks.plausibility import plausibility_warnings
+from arcosim.identification.checks.plausibility import plausibility_warnings, resolved_lowest
 from arcosim.identification.excitation.design import LINE_T
 from arcosim.identification.excitation.spectrum import excitation_spectrum
 from arcosim.identification.fit.encoder_fit import STUCK_VELOCITY_COUNTS
@@ -263,13 +263,15 @@ def log_plausibility(
 ) -> list[str]:
     """The log's plausibility warnings
     (:func:`~arcosim.identification.checks.plausibility.plausibility_warnings`) with the lowest
-    frequency the current excites
+    frequency the current excites that the record resolves
+    (:func:`~arcosim.identification.checks.plausibility.resolved_lowest`)
     (:func:`~arcosim.identification.excitation.spectrum.excitation_spectrum`): what ``check`` and
     ``identify`` both warn of (:func:`~arcosim.identification.checks.log_decision.decide_log`
     runs the same). Arguments as :func:`check_log`'s; returns one line per finding."""
     time = np.asarray(time, dtype=float)
     i_a = np.asarray(i_a, dtype=float)
-    lowest = excitation_spectrum(i_a, float(np.mean(np.diff(time)))).lowest
+    spectrum = excitation_spectrum(i_a, float(np.mean(np.diff(time))))
+    lowest = resolved_lowest(spectrum, float(time[-1] - time[0]))
     args = (np.asarray(omega_m, dtype=float), np.asarray(theta_m, dtype=float))
     return plausibility_warnings(time, i_a, *args, k_t, J_m, lowest)
 

@@ -10,7 +10,8 @@ exactly when ``identify`` goes on to fit, and every warning ``check`` gives,
 - the sample step: increasing, at least 16 samples, constant (a problem otherwise: the
   fits need a constant step);
 - the log's plausibility (:mod:`arcosim.identification.checks.plausibility`: its units, the
-  torque balance, the record's length against the lowest frequency excited and, once
+  torque balance, the record's length against the lowest frequency excited that the
+  record resolves and, once
   the modes are read, against the lowest mode seen), warnings;
 - the motion: an encoder range under :data:`LEAST_RANGE_COUNTS` counts, a motor
   standing still more than :data:`STUCK_LIMIT` of the time (Coulomb friction then holds
@@ -34,7 +35,11 @@ import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST, VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.checks.plausibility import mode_record_length, plausibility_warnings
+from arcosim.identification.checks.plausibility import (
+    mode_record_length,
+    plausibility_warnings,
+    resolved_lowest,
+)
 from arcosim.identification.checks.verdict import excitation_above_band
 from arcosim.identification.errors import IdentificationError
 from arcosim.identification.excitation.band import search_band
@@ -203,9 +208,8 @@ def decide_log(
     decision.band = search_band(g_dist, h)
     decision.spectrum = excitation_spectrum(i_a, h)
     _excitation(decision, i_a)
-    decision.plausibility = plausibility_warnings(
-        time, i_a, omega_m, theta_m, k_t, J_m, decision.spectrum.lowest
-    )
+    lowest = resolved_lowest(decision.spectrum, float(time[-1] - time[0]))
+    decision.plausibility = plausibility_warnings(time, i_a, omega_m, theta_m, k_t, J_m, lowest)
     decision.above_band = excitation_above_band(decision.spectrum, g_dist)
     decision.warnings += decision.doubts
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0

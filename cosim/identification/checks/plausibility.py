@@ -13,10 +13,18 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
   gives 1000).
 - :func:`torque_balance`: the low-frequency balance k_t·i = J·α + D·ω at the lowest
   excitation line (least squares of the current and angle there); J outside
-  [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m names the current scale, k_t and the
-  time column.
+  [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m by more than :data:`BALANCE_SIGMAS`
+  of its standard errors names the current scale, k_t and the time column. The line is
+  fitted under a Hann window (a slow load's motion leaks into it as 1/k³ of the bins
+  between them, not 1/k), and its standard errors are Newey–West's: what the line's fit
+  leaves (the other lines, a slow load's motion) is coloured, and a white residual's σ
+  was ten times too small on a slow-load log.
 - :func:`record_length`: fewer than :data:`LEAST_PERIODS` periods of the lowest line the
   current shows.
+
+Both read the lowest line the record resolves (:func:`resolved_lowest`): one holding at
+least :data:`RESOLVED_PERIODS` periods, so that it is told from the record's mean and
+trend.
 - :func:`mode_record_length`: fewer than :data:`LEAST_MODE_PERIODS` periods of the
   lowest mode the record shows (judged once the modes are read,
   :func:`~arcosim.identification.checks.log_decision.decide_log`; it does not rest on finding
@@ -26,6 +34,9 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
 from __future__ import annotations
 
 import numpy as np
+
+from arcosim.identification.excitation.spectrum import ExcitationSpectrum
+from arcosim.identification.fit.newey_west import long_run_covariance, significance_lag
 
 #: Largest factor (dimensionless) between the RMS speed the angle's differences give
 #: over the logged step and the RMS logged ω_m. Both measure the same motion; the
@@ -45,9 +56,17 @@ INERTIA_HIGH = 1e3
 #: transients (a few periods of the slowest motion) leave part of the record.
 LEAST_PERIODS = 3.0
 #: The torque balance's inertia counts as implausible only when it lies this many of its
-#: standard errors outside the plausible range (the three-sigma rule: a plausible log
-#: crosses it by chance 0.3 % of the time).
+#: standard errors outside the plausible range (the three-sigma rule: under Gaussian
+#: errors a plausible log crosses one bound by chance 0.13 % of the time). The rate holds
+#: only with a σ that holds: Newey–West's over the coloured residual of the line's fit.
 BALANCE_SIGMAS = 3.0
+#: Least periods (a count) of a line the record must hold for the line to count as
+#: resolved: the record's frequency grid is 2π/T, and the Hann window's main lobe spans
+#: two bins either side of a line, so a line under two bins (two periods) from 0 shares
+#: its lobe with bin 0, the record's mean and the trend the detrend removed: the record
+#: cannot tell it from them (the remnant of 40 lines' partial periods reads as a "line"
+#: of 1.1 periods, 13 % of the lines' amplitude, on one seed in five).
+RESOLVED_PERIODS = 2.0
 #: Least number of periods (a count) of the lowest mode a record should hold: its
 #: spectrum's resolution 2π/T is then at most a tenth of the mode, and the fit's start
 #: transients (a few periods of the slowest motion) leave most of the record. The 20 s
@@ -187,7 +206,7 @@ def balance_inertia(
     """Total inertia (kg·m²) of the torque balance at the line ``lowest`` (see
     :func:`torque_balance`; arguments alike), or None when there is no line or motion;
     with ``with_error``, ``(J, σ_J)``: σ_J (kg·m²) from the two line fits' standard
-    errors (their residuals taken as white), propagated to first order."""
+    errors (:func:`_line_amplitude`'s, Newey–West's), propagated to first order."""
     theta = np.asarray(theta_m, float)
     if not lowest or lowest <= 0 or len(theta) < 16:
         return None
@@ -205,16 +224,52 @@ def balance_inertia(
 
 def _line_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> tuple[complex, float]:
     """Complex amplitude of ``x`` (shape ``(N,)``) at ``w`` (rad/s) over times ``t`` (s):
-    least squares on a sine and cosine, a cubic trend removed; with its standard error
-    (the magnitude's, the residual taken as white; ``x``'s unit)."""
+    least squares on a sine and cosine, a cubic trend removed, each sample weighted by a
+    Hann window; with its standard error (the magnitude's, ``x``'s unit).
+
+    The window: a slow load's motion (one period of 0.3 rad/s in a 20 s record, tens of
+    rad) is more than a cubic trend can follow, and under uniform weights its remnant
+    leaks into the line as 1/k of the bins k between them (the balance of a slow-load
+    log read −33 × J_m where the chain has 58); the Hann window's sidelobes fall as
+    1/k³. The error: what the fit leaves is coloured (the other lines, a slow load's
+    motion), so it is Newey–West's, with the bandwidth at which the residual's
+    autocorrelation falls inside its white-noise band
+    (:func:`~arcosim.identification.fit.newey_west.significance_lag`): the residual's
+    power near ``w``, not its mean power. It counts the neighbouring lines' power, which
+    the window mostly keeps out of the estimate, so it errs large (on 40 lines 3–150
+    rad/s the scatter is a fifth of it or less), never small."""
     span = t[-1] if t[-1] > 0 else 1.0
     s = t / span
     X = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(s), s, s**2, s**3])
-    c, *_ = np.linalg.lstsq(X, x, rcond=None)
-    residual = x - X @ c
-    variance = float(residual @ residual) / max(len(x) - X.shape[1], 1)
-    covariance = np.linalg.pinv(X.T @ X)[:2, :2] * variance
-    return complex(c[0], -c[1]), float(np.sqrt(max(np.trace(covariance) / 2.0, 0.0)))
+    root = np.sqrt(np.hanning(len(t)))[:, None]  # weighted least squares on root-scaled rows
+    c, *_ = np.linalg.lstsq(X * root, x * root[:, 0], rcond=None)
+    residual = (x - X @ c) * root[:, 0]
+    covariance = long_run_covariance(X * root, residual, significance_lag(residual, 1))
+    return complex(c[0], -c[1]), float(np.sqrt(max(np.trace(covariance[:2, :2]) / 2.0, 0.0)))
+
+
+def resolved_lowest(spectrum: ExcitationSpectrum | None, duration: float) -> float | None:
+    """The lowest frequency (rad/s) the excitation carries that a record of ``duration``
+    s resolves: of the lines played, the lowest holding at least
+    :data:`RESOLVED_PERIODS` periods (a line closer to 0 is not told from the record's
+    mean and trend); a broadband excitation's lowest frequency as it is. None without
+    excitation or without a resolved line.
+
+    Examples
+    --------
+    >>> lines = np.array([0.34, 3.2, 4.9])
+    >>> resolved_lowest(ExcitationSpectrum("lines", lines, np.ones(3), (0.34, 4.9)), 20.0)
+    3.2
+    >>> resolved_lowest(ExcitationSpectrum("broadband", band=(3.0, 90.0)), 20.0)
+    3.0
+    """
+    if spectrum is None or spectrum.lowest is None:
+        return None
+    if spectrum.kind == "broadband":
+        return spectrum.lowest
+    lines = np.sort(np.asarray(spectrum.lines, dtype=float))
+    resolved = lines[lines * duration >= RESOLVED_PERIODS * 2.0 * np.pi]
+    return float(resolved[0]) if len(resolved) else None
 
 
 def record_length(time: np.ndarray, lowest: float | None) -> str | None:
@@ -318,7 +373,8 @@ def plausibility_warnings(
     J_m : float
         Motor inertia (kg·m²).
     lowest : float or None
-        The lowest excitation line the current shows (rad/s); None: none found.
+        The lowest excitation line the current shows that the record resolves (rad/s,
+        :func:`resolved_lowest`); None: none found.
 
     Returns
     -------

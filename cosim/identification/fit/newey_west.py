@@ -81,3 +81,46 @@ def newey_west_covariance(jac: np.ndarray, residual: np.ndarray, lag: int) -> np
         S += (1.0 - lag_k / (lag + 1.0)) * (gamma + gamma.T)
     bread = np.linalg.pinv(jac.T @ jac)
     return bread @ S @ bread
+
+
+def long_run_covariance(jac: np.ndarray, residual: np.ndarray, lag: int) -> np.ndarray:
+    """:func:`newey_west_covariance` with the score's autocovariances at every lag taken
+    at once by FFT: the same sandwich ``(JᵀJ)⁻¹ S (JᵀJ)⁻¹`` (to rounding) in
+    O(P² N log N) instead of O(lag · N · P²), for few columns and a bandwidth of
+    thousands of samples (a line's fit over a long record).
+
+    Parameters
+    ----------
+    jac : ndarray
+        The regressors (residual units per parameter unit), shape ``(N, P)``.
+    residual : ndarray
+        The residuals, shape ``(N,)``.
+    lag : int
+        The Bartlett bandwidth (samples), ``0 <= lag < N``.
+
+    Returns
+    -------
+    ndarray
+        The parameters' covariance, shape ``(P, P)``, in parameter units squared.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> X = rng.standard_normal((500, 3))
+    >>> r = np.convolve(rng.standard_normal(500), np.ones(5), mode="same")
+    >>> np.allclose(long_run_covariance(X, r, 40), newey_west_covariance(X, r, 40))
+    True
+    """
+    score = jac * residual[:, None]
+    n, p = score.shape
+    spectra = np.fft.rfft(score, 2 * n, axis=0)
+    weights = 1.0 - np.arange(1, lag + 1) / (lag + 1.0)
+    S = np.empty((p, p))
+    for a in range(p):
+        for b in range(a, p):
+            # Σ_t s_a[t + k] s_b[t] for k = 0 … lag, and the same with a and b swapped
+            ab = np.fft.irfft(spectra[:, a] * np.conj(spectra[:, b]), 2 * n)
+            ba = ab[::-1][:lag]  # ab at lags −1 … −lag (circular): ba at lags 1 … lag
+            S[a, b] = S[b, a] = ab[0] + weights @ (ab[1 : lag + 1] + ba)
+    bread = np.linalg.pinv(jac.T @ jac)
+    return bread @ S @ bread
