@@ -41,8 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.experiments.report import markdown_table
-from arcosim.logs import COLUMN_UNITS, write_csv
+from arcosim import COLUMN_UNITS, write_csv
+from arcosim.experiments import markdown_table
 from benchmarks import public_loaders as loaders
 
 #: Where each file can be had: the source's page, then a GitHub copy (raw file).

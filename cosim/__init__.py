@@ -14,6 +14,7 @@ Drive logs
 read_log            -- a drive log (CSV: time, i_a, omega_m, theta_m) as a DriveLog
 DriveLog            -- time (s) and the measured columns of a log, SI units
 write_csv           -- columns of equal length as a CSV file
+COLUMN_UNITS        -- the unit (SI) of each column arcosim writes, by the column's name
 read_chain          -- the Chain of a whole-chain report file
 Chain               -- a chain's values: n, J_m, every J_i, k_i, B_i, the friction, σ where known
 
@@ -125,6 +126,7 @@ _API = {
     "read_log": "arcosim.logs",
     "DriveLog": "arcosim.logs",
     "write_csv": "arcosim.logs",
+    "COLUMN_UNITS": "arcosim.logs",
     "read_chain": "arcosim.chainfile",
     "Chain": "arcosim.fmu.flexchain.chain",
     "identify_drive": "arcosim.identification.drive_identification",

@@ -20,7 +20,7 @@ import arcosim
 
 PUBLIC = [name for name in arcosim.__all__ if name != "__version__"]
 #: Public names that are data, not callables: described in the catalogue only.
-DATA = {"SCENARIOS"}
+DATA = {"SCENARIOS", "COLUMN_UNITS"}
 #: Public names whose examples take over ~5 s (they build FMUs or fit whole records).
 SLOW_EXAMPLES = {"build_all", "check_log", "identify_drive", "identify_whole_chain"}
 #: A unit in parentheses, e.g. "(A)", "(rad/s, shape (N,))", "(kg·m²)", or a word

@@ -78,7 +78,6 @@ def test_cli_imports_only_the_public_api_and_itself() -> None:
     assert not found, "\n".join(found)
 
 
-@pytest.mark.xfail(strict=True, reason="the benchmarks still import internal modules")
 def test_benchmarks_and_examples_import_only_the_public_api() -> None:
     found = violations(ROOT / "benchmarks", own=()) + violations(ROOT / "examples", own=())
     assert not found, "\n".join(found)

@@ -19,5 +19,9 @@ Imports nothing of :mod:`arcosim.host`, :mod:`arcosim.experiments` or the CLI.
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "OBSERVER": "arcosim.build.recipes",
+    "PLANT": "arcosim.build.recipes",
+    "build_link": "arcosim.build.clink",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

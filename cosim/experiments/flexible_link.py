@@ -5,7 +5,7 @@ experiment 6 and the published rig of ``benchmarks/published_link.py``.
 C plant of ``plant_models/flexlink_c``, written apart from the identification's modal
 model) with a current command and records what a log holds (current, encoder) with the
 plant's truth beside it (its root moment ``tau_reac``, eq. 7, and the tip angle
-``alpha_tip``). :func:`identify_link` gives the fit only k_t, J_m, the friction, the
+``alpha_tip``). :func:`score_link` gives the fit only k_t, J_m, the friction, the
 encoder's counts and the link's L, m_tip, J_tip and r (what a user knows):
 :func:`arcosim.identification.link.beam_fit.fit_link` finds EI, ρA and the damping, and
 :func:`arcosim.identification.link.beam_motion.tip_motion` the tip angle and eq. 7's reaction
@@ -34,7 +34,7 @@ from arcosim.identification.records.record import encoder_record, motor_record
 LINK_FMU = "FlexLinkPlant.fmu"
 #: Communication step (s) and record length (s) of the experiment.
 STEP = defaults.STEP
-DURATION = 20.0
+LINK_DURATION = 20.0
 #: Scores skip the record's first second (the smoother's and the excitation's start).
 SETTLE = 1.0
 #: The plant outputs a run records: the log's columns, then the truth.
@@ -149,7 +149,7 @@ class LinkRun:
         return {"time": self.time, **{c: self.signals[c] for c in ("i_a", "omega_m", "theta_m")}}
 
 
-def simulate_link(fmu: Path, rig: LinkRig, duration: float = DURATION) -> LinkRun:
+def simulate_link(fmu: Path, rig: LinkRig, duration: float = LINK_DURATION) -> LinkRun:
     """Drive the link plant FMU ``fmu`` with ``rig``'s multi-sine for ``duration`` s.
 
     Parameters
@@ -244,7 +244,7 @@ class LinkFindings:
         }
 
 
-def identify_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
+def score_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
     """Fit the link of ``run`` from its hub's current and encoder alone; score it.
 
     Parameters

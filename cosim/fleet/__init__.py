@@ -15,5 +15,11 @@ Sits above :mod:`arcosim.identification` and :mod:`arcosim.sweeps` (the folder's
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "read_store": "arcosim.fleet.store",
+    "write_store": "arcosim.fleet.store",
+    "append_store": "arcosim.fleet.store",
+    "AxisDrift": "arcosim.fleet.drift",
+    "DriftReport": "arcosim.fleet.drift",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -21,5 +21,10 @@ Imports of the project: :mod:`arcosim.errors`, :mod:`arcosim.logs`, :mod:`arcosi
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "MEASURED": "arcosim.host.master",
+    "INT_MAX": "arcosim.host.overrides",
+    "TrackedChain": "arcosim.host.tracking",
+    "replay_tracking": "arcosim.host.tracking",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -26,5 +26,20 @@ errors               -- IdentificationError
 from arcosim.lazy import public_api
 
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
-_API: dict[str, str] = {}
+_API: dict[str, str] = {
+    "MotorRecord": "arcosim.identification.records.record",
+    "driving_point_modes": "arcosim.identification.modes.chain_modes",
+    "chain_from_modes": "arcosim.identification.modes.chain_modes",
+    "ParameterFit": "arcosim.identification.fit.output_error",
+    "Link": "arcosim.identification.link.beam_model",
+    "ModalModel": "arcosim.identification.link.beam_model",
+    "modal_model": "arcosim.identification.link.beam_model",
+    "Geometry": "arcosim.identification.link.beam_fit",
+    "fit_link": "arcosim.identification.link.beam_fit",
+    "modal_of": "arcosim.identification.link.beam_fit",
+    "tip_motion": "arcosim.identification.link.beam_motion",
+    "replay": "arcosim.identification.offline_observer",
+    "estimate_states": "arcosim.identification.offline_observer",
+    "single_threaded": "arcosim.identification.threads",
+}
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

@@ -37,12 +37,12 @@ from arcosim.experiments.motion.baselines import (
 from arcosim.experiments.motion.findings import (
     CONTROLLERS,
     DISTANCE,
-    DURATION,
     ERROR_SEEDS,
     FIGURE,
     I_MAX,
     LOAD_TIME,
     LOAD_TORQUE,
+    MOTION_DURATION,
     MOVE_TIME,
     SEED,
     ChainFindings,
@@ -190,7 +190,7 @@ def baselines(params: Mapping[str, float]) -> tuple[CascadeController, CascadeCo
 def motion_steps() -> int:
     """The co-simulation steps of the experiment, for a progress bar (a count)."""
     identification = round(IDENTIFICATION_DURATION / STEP)
-    moves = (4 + 4 + 2 * (len(ERROR_SEEDS) + 2)) * round(DURATION / STEP)
+    moves = (4 + 4 + 2 * (len(ERROR_SEEDS) + 2)) * round(MOTION_DURATION / STEP)
     return len(CHAINS) * (identification + moves)
 
 
@@ -219,7 +219,7 @@ class Runs:
         """A move of ``distance`` from rest; with ``load``, the load-torque step during the hold."""
         step = LoadStep(self.chain.n, LOAD_TIME, LOAD_TORQUE) if load else None
         run = run_closed_loop(
-            self.folder, self.chain.n, controller, self.distance, DURATION,
+            self.folder, self.chain.n, controller, self.distance, MOTION_DURATION,
             plant=plant_settings(self.chain, self.ideal, self.seed, self.cpr), load=step,
             full_state=full_state,
         )  # fmt: skip

@@ -30,7 +30,7 @@ FIGURE = "fig10_motion_control.png"
 #: The move of the last mass (rad), its profile's duration (s) and the run's length (s).
 DISTANCE = 1.0
 MOVE_TIME = 1.0
-DURATION = 6.0
+MOTION_DURATION = 6.0
 #: Every controller's current limit (A).
 I_MAX = 3.0
 #: The load torque on the last mass during the hold (N·m): a tenth of what 1 A gives.
@@ -352,7 +352,7 @@ def motion_markdown(results: MotionResults) -> str:
 On the bench chain and the five-mass chain (J = 0.2, 0.3, 0.25, 0.3, 0.2 g·m², every k =
 0.4 N·m/rad, B = 1.5·10⁻⁵ N·m·s/rad), each identified by `identify_drive` from a 20 s
 log of the same plant (the `identification` multi-sine; k_t and J_m known), a
-{DISTANCE:g} rad move of the last mass from rest, in {DURATION:g} s runs at 1 ms, current
+{DISTANCE:g} rad move of the last mass from rest, in {MOTION_DURATION:g} s runs at 1 ms, current
 limit {I_MAX:g} A, by four controllers: (a) a drive's cascade tuned out of the box, a
 velocity PI on the motor encoder at half the identified first mode on the total inertia
 (its zero at a quarter of that), a position P at a quarter of it, on a minimum-jerk
