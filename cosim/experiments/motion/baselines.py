@@ -364,6 +364,14 @@ class CascadeController:
     ----------
     i_ff, i_fb : float
         The last command's feedforward and feedback parts (A).
+
+    Examples
+    --------
+    >>> params = {"J_mo": 1e-4, "k_to": 0.05, "J[1]": 4e-4}
+    >>> cascade = CascadeController(cascade_gains(params, bandwidth=10.0), 1.0, 3.0)
+    >>> cascade.reset()
+    >>> [round(cascade.step(1e-3, 1.0, 0.0, 0.0, 0.0), 4) for _ in range(3)]  # A
+    [0.0, 0.0006, 0.0012]
     """
 
     def __init__(
