@@ -136,6 +136,14 @@ def run_closed_loop(
     ------
     UserError
         When the plant refuses its parameters or a step.
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> push = OpenLoop(np.full(500, 0.2))  # 0.2 A for 0.5 s
+    >>> run = run_closed_loop(ensure_built(3), 3, push, 0.0, 0.5)
+    >>> run.theta.shape, float(run.time[-1]), bool(run.last[-1] > 0.0)  # rad, s
+    ((4, 501), 0.5, True)
     """
     steps = round(duration / h)
     ref = reference if callable(reference) else (lambda _t, r=float(reference): r)

@@ -70,6 +70,14 @@ class LinkRig:
         The multi-sine's peak current (A).
     seed : int
         Seed of the multi-sine's phases and of the plant's current noise (an index).
+
+    Examples
+    --------
+    >>> rig = LinkRig("a strip", {"EI": 0.04, "rhoA": 0.03, "L": 0.3, "m_tip": 0.005})
+    >>> rig.value("EI"), rig.value("k_t") == defaults.K_T  # N·m²; the FMU's default k_t
+    (0.04, True)
+    >>> rig.geometry
+    Geometry(L=0.3, m_tip=0.005, J_tip=0.0, r_hub=0.01)
     """
 
     name: str
@@ -139,6 +147,13 @@ class LinkRun:
         :data:`RECORDED` outputs, each shape ``(N,)``: ``i_a`` (A), ``omega_m``
         (rad/s), ``theta_m`` (rad), the hub's true speed ``omega_m_true`` (rad/s),
         ``tau_reac`` (N·m), ``alpha_tip`` (rad), ``w_tip`` (m).
+
+    Examples
+    --------
+    >>> t = np.arange(3) * STEP
+    >>> run = LinkRun(t, {name: np.zeros(3) for name in RECORDED})
+    >>> sorted(run.log())  # what a log of the rig holds
+    ['i_a', 'omega_m', 'theta_m', 'time']
     """
 
     time: np.ndarray
@@ -171,6 +186,13 @@ def simulate_link(fmu: Path, rig: LinkRig, duration: float = LINK_DURATION) -> L
     ------
     RuntimeError
         When the FMU refuses a step (its messages in the text).
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> run = simulate_link(ensure_built(3) / LINK_FMU, EXPERIMENT_RIG, duration=0.5)
+    >>> run.time.shape, float(run.time[-1])  # samples, s
+    ((501,), 0.5)
     """
     steps = round(duration / STEP)
     current = multisine(np.arange(steps) * STEP, rig.amplitude, np.array(rig.lines), rig.seed)
@@ -261,6 +283,14 @@ def score_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
     -------
     LinkFindings
         The fit against the plant.
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> run = simulate_link(ensure_built(3) / LINK_FMU, EXPERIMENT_RIG)
+    >>> found = score_link(run, EXPERIMENT_RIG)
+    >>> {p: abs(found.values[p] / found.truth[p] - 1.0) < 0.05 for p in ("EI", "rhoA")}
+    {'EI': True, 'rhoA': True}
     """
     import time as clock
 
