@@ -42,7 +42,7 @@ def percent_error(estimate: float, truth: float) -> float:
     estimate : float
         The estimate (any unit).
     truth : float
-        The true value, in the same unit, ≠ 0.
+        The true value (in the unit of ``estimate``), ≠ 0.
 
     Returns
     -------

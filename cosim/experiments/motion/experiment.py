@@ -233,6 +233,19 @@ def scaled(
 def model_errors(n: int, seeds: tuple[int, ...]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Factors on J_i and k_i: uniform in [0.9, 1.1] per seed, then the two corners.
 
+    Parameters
+    ----------
+    n : int
+        Number of load masses (a count).
+    seeds : tuple of int
+        Seeds of the random factors (an index each).
+
+    Returns
+    -------
+    dict of str to tuple of ndarray
+        By label, the factors on J_1 … J_n and on k_1 … k_n (dimensionless), shape
+        ``(n,)`` each (:func:`scaled` applies them).
+
     Examples
     --------
     >>> errors = model_errors(2, (1,))
@@ -335,7 +348,7 @@ class Runs:
     >>> runs = Runs(ensure_built(3), chain, ideal=True)
     >>> motor = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": 0.0}
     >>> run = runs.run(sensorless({**motor, **chain.plant_values()}), full_state=True)
-    >>> run.time[-1], abs(run.last[-1] - DISTANCE) < 0.01  # s; within 1 % of the move
+    >>> float(run.time[-1]), bool(abs(run.last[-1] - DISTANCE) < 0.01)  # s; within 1 %
     (6.0, True)
     """
 

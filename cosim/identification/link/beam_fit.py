@@ -163,11 +163,9 @@ def fit_link(
 
     Examples
     --------
-    With ``encoder`` and ``motor`` from a log, L = 0.4 m, a 20 g tip, a 12 g link:
-
-    >>> fit_link(encoder, motor, Geometry(0.4, 0.02), rhoA=0.012 / 0.4)  # doctest: +SKIP
-
-    A mass per length that is not > 0 is refused before the record is read:
+    A fit of a simulated link from its hub's record is the example of
+    :func:`arcosim.experiments.score_link`. A mass per length that is not > 0 is
+    refused before the record is read:
 
     >>> fit_link(None, None, Geometry(0.4), rhoA=0.0)
     Traceback (most recent call last):
