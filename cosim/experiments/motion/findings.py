@@ -98,7 +98,7 @@ def score_move(run: LoopRun, target: float, distance: float, encoder_cpr: int) -
     Parameters
     ----------
     run : LoopRun
-        The closed-loop run (:func:`arcosim.experiments.run_closed_loop`).
+        The closed-loop run (:func:`~arcosim.experiments.closed_loop.run_closed_loop`).
     target : float
         Where the last mass should come to rest (rad).
     distance : float

@@ -164,8 +164,8 @@ def fit_link(
     Examples
     --------
     A fit of a simulated link from its hub's record is the example of
-    :func:`arcosim.experiments.score_link`. A mass per length that is not > 0 is
-    refused before the record is read:
+    :func:`arcosim.experiments.flexible_link.score_link`. A mass per length that is not
+    > 0 is refused before the record is read:
 
     >>> fit_link(None, None, Geometry(0.4), rhoA=0.0)
     Traceback (most recent call last):
