@@ -52,7 +52,7 @@ import argparse
 import sys
 from collections.abc import Callable, Sequence
 
-from arcosim.errors import ArcosimError
+from arcosim import ArcosimError
 
 
 def progress(text: str) -> None:

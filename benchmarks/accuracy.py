@@ -45,17 +45,15 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.errors import UserError
-from arcosim.experiments import current_commands
-from arcosim.experiments.metrics import flexible_score, percent_error
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import BROADBAND_LINES, Scenario
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.codes import Estimator, Mode
-from arcosim.identification.fit.output_error import ParameterFit
-from arcosim.identification.fit.uniform_fit import uniform_chain
-from arcosim.identification.offline_observer import estimate_states, replay
-from arcosim.identification.records.record import MotorRecord, motor_record
+from arcosim import Scenario, UserError, motor_record, multisine, rigid_maneuver, uniform_chain
+from arcosim.experiments import (
+    BROADBAND_LINES,
+    flexible_score,
+    markdown_table,
+    percent_error,
+)
+from arcosim.fmu.flexchain import Estimator, Mode, defaults
+from arcosim.identification import MotorRecord, ParameterFit, estimate_states, replay
 from benchmarks import (
     beam_accuracy,
     chain_accuracy,
@@ -104,7 +102,7 @@ def broadband(
     scenario = Scenario(
         "broadband",
         "multi-sine 3–150 rad/s",
-        lambda t: current_commands.multisine(t, amplitude, LINES, 1),
+        lambda t: multisine(t, amplitude, LINES, 1),
         duration,
         {},
         {"mode": 2},
@@ -118,7 +116,7 @@ def rigid(case: Case, seed: int) -> dict[str, np.ndarray]:
     scenario = Scenario(
         "rigid",
         "rigid maneuver",
-        lambda t: current_commands.rigid_maneuver(t, frequency=w),
+        lambda t: rigid_maneuver(t, frequency=w),
         8 * 2 * math.pi / w,
         {},
         {"mode": 1},

@@ -31,18 +31,17 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.experiments.motion.experiment import (
+from arcosim import MotionController, ensure_built
+from arcosim.experiments import (
+    UPPER_BOUND_FACTOR,
     Runs,
     design_parameters,
     identify_chain,
+    markdown_table,
     scaled,
     sensorless,
 )
-from arcosim.experiments.motion.findings import UPPER_BOUND_FACTOR
-from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain.control.controller import MotionController
-from arcosim.fmu.flexchain.control.estimator_bank import EstimatorBank
+from arcosim.fmu.flexchain import EstimatorBank
 from benchmarks.control_accuracy import CHAINS, score, seed_models
 
 

@@ -31,13 +31,18 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.identification.link.beam_fit import Geometry, fit_link, modal_of
-from arcosim.identification.link.beam_model import Link, ModalModel, modal_model
-from arcosim.identification.link.beam_motion import tip_motion
-from arcosim.identification.records.record import encoder_record, motor_record
-from arcosim.identification.threads import single_threaded
+from arcosim import Actuator, encoder_record, motor_record
+from arcosim.experiments import markdown_table
+from arcosim.identification import (
+    Geometry,
+    Link,
+    ModalModel,
+    fit_link,
+    modal_model,
+    modal_of,
+    single_threaded,
+    tip_motion,
+)
 from benchmarks.simulators import field_sim
 
 #: The motor (kg·m², N·m/A, N·m·s/rad, N·m) and the sensors: field_sim's rows'.

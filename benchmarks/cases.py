@@ -6,12 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arcosim.experiments.scenarios import Scenario, run_scenario
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.chain import spring_matrix
-from arcosim.fmu.flexchain.defaults import ENCODER_CPR, G_DIST
-from arcosim.fmu.flexchain.dob import Actuator
-from arcosim.fmu.flexchain.observer import ObserverSettings
+from arcosim import Actuator, ObserverSettings, Scenario, run_scenario
+from arcosim.fmu.flexchain import ENCODER_CPR, G_DIST, defaults, spring_matrix
 
 ACTUATOR = Actuator(defaults.J_M, defaults.K_T, 0.0, 0.0, defaults.D_M, defaults.F_C)
 

@@ -15,11 +15,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from arcosim.experiments.metrics import percent_error
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import SCENARIOS
-from arcosim.identification.fit.whole_chain import identify_whole_chain, split
-from arcosim.identification.records.record import encoder_record, motor_record
+from arcosim import SCENARIOS, encoder_record, identify_whole_chain, motor_record
+from arcosim.experiments import markdown_table, percent_error
 from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
 
 #: The chains: the bench and two with unequal springs (n = 2 and n = 5).
@@ -51,7 +48,8 @@ def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None
         chosen.append(choice.n)
         if choice.n != case.n:
             continue
-        J, k, B = split(choice.fit.values, case.n)
+        p, n = choice.fit.values, case.n  # the fit's vector stacks J, k and B
+        J, k, B = (list(p[i * n : (i + 1) * n]) for i in range(3))
         B_std = choice.fit.std[2 * case.n :]
         J_errors.append([percent_error(a, b) for a, b in zip(J, case.J)])
         k_errors.append([percent_error(a, b) for a, b in zip(k, case.k)])

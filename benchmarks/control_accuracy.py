@@ -40,32 +40,29 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.errors import UserError
-from arcosim.experiments.closed_loop import LoopRun
-from arcosim.experiments.motion.baselines import CascadeController, cascade_gains, chain_modes
-from arcosim.experiments.motion.experiment import (
-    MotionChain,
-    Runs,
-    design_parameters,
-    identify_chain,
-    model_errors,
-    scaled,
-    sensorless,
-)
-from arcosim.experiments.motion.findings import (
+from arcosim import UserError, ensure_built
+from arcosim.experiments import (
     DISTANCE,
     I_MAX,
     MOVE_TIME,
+    CascadeController,
+    LoopRun,
+    MotionChain,
     MoveScore,
+    Runs,
+    cascade_gains,
+    chain_modes,
+    design_parameters,
     done_when,
+    identify_chain,
+    markdown_table,
+    model_errors,
+    scaled,
     score_move,
+    sensorless,
 )
-from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.control.controller import PARTS
-from arcosim.fmu.flexchain.defaults import ENCODER_CPR
-from arcosim.host.overrides import INT_MAX
+from arcosim.fmu.flexchain import ENCODER_CPR, PARTS, defaults
+from arcosim.host import INT_MAX
 from benchmarks import progress
 
 #: The chains: lowest modes 19.7, 17.1 and 13.4 rad/s (motor free), damped at 0.05–0.2 %.

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from arcosim.control.margins import controller_margins
+from arcosim import controller_margins
 from arcosim.fmu.flexchain import defaults
 
 H = 1e-3

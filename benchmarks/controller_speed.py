@@ -26,12 +26,10 @@ import time
 from ctypes import c_double
 from pathlib import Path
 
-from arcosim.build.builder import ensure_built
-from arcosim.build.recipes import CONTROLLER, PLANT
-from arcosim.errors import UserError
-from arcosim.experiments.report import markdown_table
-from arcosim.host.instance import FmuInstance
-from arcosim.host.master import MEASURED
+from arcosim import FmuInstance, UserError, ensure_built
+from arcosim.build import CONTROLLER, PLANT
+from arcosim.experiments import markdown_table
+from arcosim.host import MEASURED
 
 #: The control period (s): the project's 1 ms step.
 H = 1e-3

@@ -32,8 +32,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from arcosim.experiments.report import markdown_table
-from arcosim.identification.checks.log_check import check_log
+from arcosim import check_log
+from arcosim.experiments import markdown_table
 from benchmarks import excitations, field_accuracy
 from benchmarks.simulators import field_sim
 

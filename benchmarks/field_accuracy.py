@@ -28,12 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain.defaults import G_DIST
-from arcosim.identification.drive_identification import identify_drive
-from arcosim.identification.errors import IdentificationError
-from arcosim.identification.fit.whole_chain import split
-from arcosim.identification.modes.chain_modes import chain_from_modes, driving_point_modes
+from arcosim import IdentificationError, identify_drive
+from arcosim.experiments import markdown_table
+from arcosim.fmu.flexchain import G_DIST
+from arcosim.identification import chain_from_modes, driving_point_modes
 from benchmarks.simulators import field_sim
 
 #: The motor of most rows: the paper bench's EC motor class (kg·m², N·m/A, N·m·s/rad, N·m).
@@ -311,7 +309,7 @@ def score_log(row: Row, log: field_sim.Log, seed: int) -> dict:
     if n == 0:
         return _rigid_scores(out, result, row)
     fit = choice.fit
-    J, k, B = split(fit.values, n)
+    J, k, B = (list(fit.values[i * n : (i + 1) * n]) for i in range(3))  # stacked J, k, B
     std = fit.std
     truth = {"J": d.J, "k": d.k, "B": d.B}
     for key, values, offset in (("J", J, 0), ("k", k, n), ("B", B, 2 * n)):

@@ -34,10 +34,9 @@ import time
 from pathlib import Path
 
 import arcosim
-from arcosim.errors import UserError
-from arcosim.experiments.report import markdown_table
-from arcosim.fleet.drift import AxisDrift, DriftReport
-from arcosim.fleet.store import read_store
+from arcosim import UserError
+from arcosim.experiments import markdown_table
+from arcosim.fleet import AxisDrift, DriftReport, read_store
 from benchmarks.fleet_store import per_row
 from benchmarks.simulators.fleet_sample import MONITORING, write_monitoring_fleet
 

@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from arcosim.fleet.store import append_store, write_store
+from arcosim.fleet import append_store, write_store
 
 #: Rows already in the store when a row is added: a fleet's first months, and the
 #: 10,000 logs of the docs' estimate.

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
+from arcosim import FmuInstance
 from arcosim.fmu.flexchain import defaults
-from arcosim.host.instance import FmuInstance
 
 #: The link of the defaults, without friction, noise or encoder: the physics alone.
 IDEAL = {"f_c": 0.0, "i_noise_std": 0.0, "encoder_cpr": 0, "D_m": 0.0}
@@ -149,7 +149,7 @@ def eq7_gaps(fmus: dict[int, Path], r: float = 0.02) -> dict[int, float]:
 
 def main() -> int:
     """Print the relative frequency errors of links of 2, 4 and 8 elements."""
-    from arcosim.build.clink import build_link
+    from arcosim.build import build_link
 
     tip = {"m_tip": defaults.LINK_M_TIP, "J_tip": 0.0}
     hub = {"r": defaults.LINK_R_HUB, "J_m": defaults.J_M}

@@ -24,11 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arcosim.experiments.load_scores import LoadScore, score_profile
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import LoadProfile
-from arcosim.fmu.flexchain.codes import Estimator, Mode
-from arcosim.identification.load_torque import estimate_load_torque
+from arcosim import estimate_load_torque
+from arcosim.experiments import LoadProfile, LoadScore, markdown_table, score_profile
+from arcosim.fmu.flexchain import Estimator, Mode
 from benchmarks.cases import CASES, Case, run_case, settings_for
 
 

@@ -16,9 +16,8 @@ import sys
 import time
 from pathlib import Path
 
-from arcosim.build.builder import ensure_built
-from arcosim.build.recipes import OBSERVER
-from arcosim.host.instance import FmuInstance
+from arcosim import FmuInstance, ensure_built
+from arcosim.build import OBSERVER
 
 
 def rss_mib() -> float:

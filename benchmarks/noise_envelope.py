@@ -19,8 +19,7 @@ import math
 import sys
 import time
 
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.model_observer import NOISE_RANGE, NOISE_RATIO, NoiseModel, step_model
+from arcosim.fmu.flexchain import NOISE_RANGE, NOISE_RATIO, NoiseModel, defaults, step_model
 
 
 def envelope_pairs(low: float, high: float, ratio: float) -> list[tuple[float, float]]:

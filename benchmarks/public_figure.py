@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.logs import write_csv
+from arcosim import write_csv
 from benchmarks import public_loaders as loaders
 
 

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.io import loadmat
 from scipy.optimize import least_squares
 
-from arcosim.errors import UserError
+from arcosim import UserError
 
 #: EMPS: the motor encoder's 12500 lines in quadrature on the load side, one count in m.
 EMPS_COUNT = 5e-8

@@ -41,9 +41,9 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.experiments.report import markdown_table
-from arcosim.fmu.flexchain.defaults import G_DIST
-from arcosim.logs import COLUMN_UNITS, write_csv
+from arcosim import COLUMN_UNITS, write_csv
+from arcosim.experiments import markdown_table
+from arcosim.fmu.flexchain import G_DIST
 from benchmarks import public_loaders as loaders
 
 #: Where each file can be had: the source's page, then a GitHub copy (raw file).

@@ -43,15 +43,15 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.experiments.flexible_link import (
+from arcosim import ensure_built
+from arcosim.experiments import (
     LINK_FMU,
     LinkRig,
     clamped_frequencies,
-    identify_link,
+    markdown_table,
+    score_link,
     simulate_link,
 )
-from arcosim.experiments.report import markdown_table
 from benchmarks.simulators.modal_link import simulate_modal_link
 
 INCH = 0.0254
@@ -127,7 +127,7 @@ def score(fmu: Path, seeds: Sequence[int], simulator: str = "plant") -> list[dic
     for seed in seeds:
         rig = replace(RIG, seed=seed)
         run = simulate_link(fmu, rig) if simulator == "plant" else simulate_modal_link(rig)
-        found = identify_link(run, rig)
+        found = score_link(run, rig)
         rows.append({"seed": seed, "simulator": simulator, **found.as_dict()})
     return rows
 

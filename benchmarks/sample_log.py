@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.identification.excitation.design import design_excitation
+from arcosim import design_excitation
 from benchmarks.simulators import field_sim
 
 ROOT = Path(__file__).resolve().parents[1]

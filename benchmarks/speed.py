@@ -36,14 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.build.recipes import OBSERVER, PLANT
-from arcosim.errors import UserError
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import SCENARIOS
-from arcosim.fmu.flexchain.codes import Mode
-from arcosim.host.instance import FmuInstance
-from arcosim.host.master import MEASURED, cosimulate
+from arcosim import SCENARIOS, FmuInstance, UserError, cosimulate, ensure_built
+from arcosim.build import OBSERVER, PLANT
+from arcosim.experiments import markdown_table
+from arcosim.fmu.flexchain import Mode
+from arcosim.host import MEASURED
 from benchmarks import field_accuracy
 
 H = 1e-3
@@ -178,7 +175,7 @@ def _bench_sensors(duration: float) -> tuple[list[float], list[float], list[floa
 
 def plain_python_step(duration: float) -> float:
     """µs per step of the observer's algorithms (flexchain) with no FMI in between."""
-    from arcosim.fmu.flexchain.observer import Observer
+    from arcosim.fmu.flexchain import Observer
     from benchmarks.cases import CASES, settings_for
 
     i_a, w, th = _bench_sensors(duration)

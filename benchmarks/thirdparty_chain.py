@@ -41,24 +41,29 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.errors import UserError
-from arcosim.experiments.closed_loop import LoopRun, OpenLoop, run_closed_loop
-from arcosim.experiments.motion.baselines import CascadeController, cascade_gains, chain_modes
-from arcosim.experiments.motion.experiment import (
+from arcosim import DriveIdentification, UserError, ensure_built, identify_drive, write_csv
+from arcosim.experiments import (
+    DISTANCE,
+    I_MAX,
+    IDENTIFICATION_DURATION,
+    MOTION_DURATION,
+    MOVE_TIME,
+    CascadeController,
+    LoopRun,
     MotionChain,
+    OpenLoop,
+    cascade_gains,
+    chain_modes,
     design_parameters,
+    done_when,
+    identification_current,
+    markdown_table,
     model_errors,
+    run_closed_loop,
     scaled,
     sensorless,
 )
-from arcosim.experiments.motion.findings import DISTANCE, DURATION, I_MAX, MOVE_TIME, done_when
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import IDENTIFICATION_DURATION, identification_current
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.defaults import ENCODER_CPR, I_NOISE_STD, STEP
-from arcosim.identification.drive_identification import DriveIdentification, identify_drive
-from arcosim.logs import write_csv
+from arcosim.fmu.flexchain import ENCODER_CPR, I_NOISE_STD, STEP, defaults
 from benchmarks import control_accuracy, progress
 from benchmarks.simulators.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
 
@@ -238,7 +243,7 @@ def score_seed(
 
     def move(controller: object, full_state: bool = False):
         with open_plant(folder, seed) as plant:
-            run = run_loop(plant, controller, DISTANCE, DURATION, full_state)
+            run = run_loop(plant, controller, DISTANCE, MOTION_DURATION, full_state)
         return control_accuracy.score(run)
 
     cascade = move(CascadeController(cascade_gains(params), MOVE_TIME, I_MAX))

@@ -21,10 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.builder import ensure_built
-from arcosim.experiments.closed_loop import OpenLoop, run_closed_loop
-from arcosim.fmu.flexchain import defaults
-from arcosim.fmu.flexchain.defaults import STEP
+from arcosim import ensure_built
+from arcosim.experiments import OpenLoop, run_closed_loop
+from arcosim.fmu.flexchain import STEP, defaults
 from benchmarks import thirdparty_chain as chain
 from benchmarks.simulators.thirdparty_plant import FMU_FILE, where
 

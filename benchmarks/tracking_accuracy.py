@@ -37,11 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.build.recipes import OBSERVER
+from arcosim import DriveLog, FmuInstance
+from arcosim.build import OBSERVER
 from arcosim.fmu.flexchain import defaults
-from arcosim.host.instance import FmuInstance
-from arcosim.host.tracking import TrackedChain, replay_tracking
-from arcosim.logs import DriveLog
+from arcosim.host import TrackedChain, replay_tracking
 from benchmarks import progress
 from benchmarks.simulators import field_sim
 
@@ -253,7 +252,7 @@ OPERATIONS = ("position", "speed", "conveyor")
 
 
 def _execute(args: argparse.Namespace) -> int:
-    from arcosim.build.builder import ensure_built
+    from arcosim import ensure_built
 
     def folder(n: int) -> Path:
         return ensure_built(n)

@@ -38,9 +38,8 @@ from pathlib import Path
 import numpy as np
 
 import arcosim
-from arcosim.errors import ArcosimError, UserError
-from arcosim.experiments.report import markdown_table
-from arcosim.experiments.scenarios import IDENTIFICATION_LINES
+from arcosim import ArcosimError, UserError
+from arcosim.experiments import IDENTIFICATION_LINES, markdown_table
 from arcosim.fmu.flexchain import defaults
 from benchmarks.simulators import field_sim
 

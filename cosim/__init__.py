@@ -17,6 +17,7 @@ write_csv           -- columns of equal length as a CSV file
 parse_scales        -- ``--scale COLUMN=FACTOR`` texts as the factors read_log takes
 read_text_file      -- a UTF-8 text file's text; any other encoding refused, naming it
 tool_keys           -- JSON data with every key as other tools keep names (``J_1``)
+COLUMN_UNITS        -- the unit (SI) of each column arcosim writes, by the column's name
 read_chain          -- the Chain of a whole-chain report file
 Chain               -- a chain's values: n, J_m, every J_i, k_i, B_i, the friction, σ where known
 
@@ -145,6 +146,7 @@ _API = {
     "parse_scales": "arcosim.logs",
     "read_text_file": "arcosim.logs",
     "tool_keys": "arcosim.logs",
+    "COLUMN_UNITS": "arcosim.logs",
     "read_chain": "arcosim.chainfile",
     "Chain": "arcosim.fmu.flexchain.chain",
     "identify_drive": "arcosim.identification.drive_identification",

@@ -1,35 +1,68 @@
-"""Every name of the public API (``arcosim.__all__``) is documented the numpydoc way.
+"""Every name of the public API is documented the numpydoc way: the ``__all__`` of
+``arcosim`` and of its public subpackages (``tests/test_public_api.py``).
 
 Functions and classes: a summary; every parameter of the signature under
 *Parameters* (classes: *Parameters* or *Attributes*), each float or array with a unit
 in parentheses, each array with its shape; *Returns* when something is returned;
-*Examples* that run (no ``+SKIP``) and print what they say. Errors: a summary.
+*Examples* that run (no ``+SKIP``) and print what they say, in the namespace of the
+module that defines the name. Errors: a summary. Data (tables, constants, the defaults
+module): ``arcosim``'s in its catalogue, a subpackage's in its module.
 """
 
 from __future__ import annotations
 
 import doctest
+import importlib
 import inspect
 import re
+import sys
 
 import numpy as np
 import pytest
 from numpydoc.docscrape import ClassDoc, FunctionDoc
 
 import arcosim
+from tests.test_public_api import PUBLIC_PACKAGES
 
-PUBLIC = [name for name in arcosim.__all__ if name != "__version__"]
-#: Public names that are data, not callables: described in the catalogue only.
-DATA = {"SCENARIOS"}
-#: Public names whose examples take over ~5 s (they build FMUs or fit whole records).
-SLOW_EXAMPLES = {"build_all", "check_log", "identify_drive", "identify_whole_chain"}
+#: Every public name as ``package.name``.
+PUBLIC = [
+    f"{package}.{name}"
+    for package in PUBLIC_PACKAGES
+    for name in importlib.import_module(package).__all__
+    if name != "__version__"
+]
+#: Public names whose examples take over ~5 s (they build or run FMUs, or fit records).
+SLOW_EXAMPLES = {
+    "arcosim.build_all",
+    "arcosim.check_log",
+    "arcosim.identify_drive",
+    "arcosim.identify_whole_chain",
+    "arcosim.build.build_link",
+    "arcosim.experiments.simulate_link",
+    "arcosim.experiments.score_link",
+    "arcosim.experiments.run_closed_loop",
+    "arcosim.experiments.identify_chain",
+    "arcosim.experiments.design_parameters",
+    "arcosim.experiments.Runs",
+    "arcosim.host.replay_tracking",
+}
 #: A unit in parentheses, e.g. "(A)", "(rad/s, shape (N,))", "(kg·m²)", or a word
 #: that says there is none.
 UNIT = re.compile(r"\([^)]*[A-Za-zΩµ°%²][^)]*\)|dimensionless|count|number of|index")
 
 
-def documented(name: str):
-    obj = getattr(arcosim, name)
+def public(qualified: str) -> object:
+    """The object a public ``package.name`` names."""
+    package, name = qualified.rsplit(".", 1)
+    return getattr(importlib.import_module(package), name)
+
+
+#: The public names that are functions and classes; the rest are data.
+CALLABLE = [q for q in PUBLIC if inspect.isclass(public(q)) or inspect.isfunction(public(q))]
+
+
+def documented(qualified: str):
+    obj = public(qualified)
     return obj, (ClassDoc(obj) if inspect.isclass(obj) else FunctionDoc(obj))
 
 
@@ -51,7 +84,13 @@ def test_the_catalogue_names_every_public_name() -> None:
         ), name
 
 
-@pytest.mark.parametrize("name", [n for n in PUBLIC if n not in DATA])
+def test_the_data_are_few_and_named_in_capitals() -> None:
+    """What is not a function or a class is a table or a constant (or the defaults)."""
+    data = [q.rsplit(".", 1)[1] for q in PUBLIC if q not in CALLABLE]
+    assert all(name.isupper() or name == "defaults" for name in data), data
+
+
+@pytest.mark.parametrize("name", CALLABLE)
 def test_public_name_has_a_numpydoc_docstring(name: str) -> None:
     obj, doc = documented(name)
     assert doc["Summary"], f"{name}: no summary line"
@@ -81,19 +120,14 @@ def test_public_name_has_a_numpydoc_docstring(name: str) -> None:
 
 @pytest.mark.parametrize(
     "name",
-    [
-        pytest.param(n, marks=pytest.mark.slow) if n in SLOW_EXAMPLES else n
-        for n in PUBLIC
-        if n not in DATA
-    ],
+    [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_EXAMPLES else n for n in CALLABLE],
 )
 def test_public_examples_run(name: str, build_fmus, tmp_path, monkeypatch) -> None:
     build_fmus(3)  # the examples that co-simulate find current FMUs in the session cache
     monkeypatch.chdir(tmp_path)
     obj, _ = documented(name)
-    test = doctest.DocTestParser().get_doctest(
-        inspect.getdoc(obj) or "", {"arcosim": arcosim, "np": np}, name, None, 0
-    )
+    namespace = {**vars(sys.modules[obj.__module__]), "arcosim": arcosim, "np": np}
+    test = doctest.DocTestParser().get_doctest(inspect.getdoc(obj) or "", namespace, name, None, 0)
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     runner.run(test)
     assert runner.failures == 0, f"{name}: {runner.failures} example(s) failed (see output)"

@@ -14,7 +14,7 @@ from arcosim.experiments.flexible_link import (
     LINK_FMU,
     LinkRig,
     clamped_frequencies,
-    identify_link,
+    score_link,
     simulate_link,
 )
 
@@ -37,7 +37,7 @@ def test_clamped_modes_solve_the_tip_mass_equation(mu: float) -> None:
 def test_the_link_from_its_hub_is_within_the_targets(build_fmus) -> None:
     run = simulate_link(build_fmus(3) / LINK_FMU, EXPERIMENT_RIG)
     assert set(run.log()) == {"time", "i_a", "omega_m", "theta_m"}
-    found = identify_link(run, EXPERIMENT_RIG)
+    found = score_link(run, EXPERIMENT_RIG)
     errors = found.errors()
     assert abs(errors["mode[1]"]) < 1.0 and abs(errors["mode[2]"]) < 1.0, errors
     assert abs(errors["EI"]) < 5.0 and abs(errors["rhoA"]) < 5.0, errors

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from arcosim.experiments.flexible_link import identify_link, simulate_link
+from arcosim.experiments.flexible_link import score_link, simulate_link
 from benchmarks.link_frequencies import beam_frequencies
 from benchmarks.published_link import RIG
 from benchmarks.simulators.modal_link import link_modes, simulate_modal_link
@@ -54,7 +54,7 @@ def test_the_published_link_from_the_modal_simulator() -> None:
     EI and ρA within 5 %, rms(α̂ − α) ≤ 0.1 rms(α) (measured, seed 1: 0.04 %, 0.01 %,
     0.014 %, 0.010)."""
     rig = replace(RIG, seed=1)
-    found = identify_link(simulate_modal_link(rig), rig)
+    found = score_link(simulate_modal_link(rig), rig)
     errors = found.errors()
     assert abs(errors["EI"]) < 5 and abs(errors["rhoA"]) < 5, errors
     assert abs(errors["mode[1]"]) < 1 and abs(errors["mode[2]"]) < 1, errors

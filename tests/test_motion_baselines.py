@@ -272,9 +272,9 @@ def test_runs_give_the_plant_the_encoder_asked_for(fmus) -> None:
     """``Runs(..., encoder_cpr=N)`` puts an encoder of N counts on the plant (every reading
     a whole count of 2π/N), not the bench's 2000 (a 0.1 A push: the motor turns)."""
     from arcosim.experiments.motion.experiment import CHAINS, Runs
-    from arcosim.experiments.motion.findings import DURATION
+    from arcosim.experiments.motion.findings import MOTION_DURATION
 
-    push = OpenLoop(np.full(round(DURATION / defaults.STEP), 0.1))
+    push = OpenLoop(np.full(round(MOTION_DURATION / defaults.STEP), 0.1))
     run = Runs(fmus, CHAINS[0], False, encoder_cpr=20000).run(push)
     counts = run.theta_m / (2 * math.pi / 20000)  # whole fine counts, as a 2000 would be too
     assert np.allclose(counts, np.round(counts), atol=1e-6) and np.ptp(counts) > 100

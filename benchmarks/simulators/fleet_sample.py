@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import arcosim
-from arcosim.experiments.scenarios import IDENTIFICATION_LINES
+from arcosim.experiments import IDENTIFICATION_LINES
 from arcosim.fmu.flexchain import defaults
 from benchmarks.simulators import field_sim
 

@@ -32,8 +32,9 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from arcosim.experiments.current_commands import multisine
-from arcosim.experiments.flexible_link import DURATION, STEP, LinkRig, LinkRun
+from arcosim import multisine
+from arcosim.experiments import LINK_DURATION, LinkRig, LinkRun
+from arcosim.fmu.flexchain import STEP
 
 #: Flexible modes kept (besides the rigid one): the sixth of the Quanser link is at
 #: 2.3·10³ rad/s, under the 1 kHz record's Nyquist frequency; the fit reads 2–4.
@@ -147,7 +148,7 @@ def link_modes(EI: float, rhoA: float, L: float, J_m: float, count: int = MODES)
     )
 
 
-def simulate_modal_link(rig: LinkRig, duration: float = DURATION) -> LinkRun:
+def simulate_modal_link(rig: LinkRig, duration: float = LINK_DURATION) -> LinkRun:
     """Drive ``rig``'s link, simulated by its continuous modes, with its multi-sine.
 
     Parameters
@@ -156,7 +157,7 @@ def simulate_modal_link(rig: LinkRig, duration: float = DURATION) -> LinkRun:
         The link, the motor and the sensors (``r_hub``, ``m_tip``, ``J_tip`` and ``f_c``
         must be 0) and the excitation.
     duration : float
-        Length of the run (s), in :data:`~arcosim.experiments.flexible_link.STEP` steps.
+        Length of the run (s), in :data:`~arcosim.fmu.flexchain.defaults.STEP` steps.
 
     Returns
     -------

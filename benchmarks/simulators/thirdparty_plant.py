@@ -38,8 +38,8 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.errors import UserError
-from arcosim.fmu.flexchain.noise import gaussian, quantize
+from arcosim import UserError
+from arcosim.fmu.flexchain import gaussian, quantize
 
 #: The FMU's file name, in the folder the user names.
 FMU_FILE = "edrive_mass.fmu"

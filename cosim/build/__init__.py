@@ -28,5 +28,8 @@ _API: dict[str, str] = {
     "check_elements": "arcosim.build.recipes",
     "OBSERVER": "arcosim.build.recipes",
     "fmu_variables": "arcosim.build.builder",
+    "PLANT": "arcosim.build.recipes",
+    "CONTROLLER": "arcosim.build.recipes",
+    "build_link": "arcosim.build.clink",
 }
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

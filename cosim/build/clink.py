@@ -211,6 +211,11 @@ def build_link(elements: int, destination: Path) -> Path:
         When ``elements`` is out of range.
     BuildError
         When the compiler fails.
+
+    Examples
+    --------
+    >>> build_link(2, Path("FlexLinkPlant-2.fmu")).name  # two elements
+    'FlexLinkPlant-2.fmu'
     """
     check_elements(elements)
     description = model_description_xml(elements)

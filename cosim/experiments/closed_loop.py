@@ -68,6 +68,12 @@ class LoopRun:
     inspected : dict of str to ndarray
         The controller's ``i_ff``, ``i_fb``, ``theta_hat_ctrl`` after each step, those
         it has (A, A, rad), shape ``(N,)`` each.
+
+    Examples
+    --------
+    >>> run = LoopRun(np.array([0.0, 1e-3]), np.zeros((2, 2)), *np.zeros((3, 2)), np.zeros(1))
+    >>> run.theta.shape, run.last.shape  # the motor and one mass; the last mass's angle
+    ((2, 2), (2,))
     """
 
     time: np.ndarray
@@ -130,6 +136,14 @@ def run_closed_loop(
     ------
     UserError
         When the plant refuses its parameters or a step.
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> push = OpenLoop(np.full(500, 0.2))  # 0.2 A for 0.5 s
+    >>> run = run_closed_loop(ensure_built(3), 3, push, 0.0, 0.5)
+    >>> run.theta.shape, float(run.time[-1]), bool(run.last[-1] > 0.0)  # rad, s
+    ((4, 501), 0.5, True)
     """
     steps = round(duration / h)
     ref = reference if callable(reference) else (lambda _t, r=float(reference): r)
@@ -197,6 +211,12 @@ class OpenLoop:
     ----------
     current : sequence of float
         The command for each step (A), shape ``(N,)``.
+
+    Examples
+    --------
+    >>> command = OpenLoop([0.5, -0.5])
+    >>> command.step(1e-3, 0.0, 0.0, 0.0, 0.0), command.step(1e-3, 0.0, 0.0, 0.0, 0.0)
+    (0.5, -0.5)
     """
 
     def __init__(self, current: Sequence[float]) -> None:

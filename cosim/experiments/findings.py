@@ -11,8 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
-from arcosim.experiments.flexible_link import EXPERIMENT_RIG, SETTLE
+from arcosim.experiments.flexible_link import EXPERIMENT_RIG, LINK_DURATION, SETTLE
 from arcosim.experiments.metrics import percent_error
 from arcosim.experiments.motion import findings as motion_findings
 from arcosim.experiments.motion.findings import MotionResults, motion_markdown

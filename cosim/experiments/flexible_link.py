@@ -5,7 +5,7 @@ experiment 6 and the published rig of ``benchmarks/published_link.py``.
 C plant of ``plant_models/flexlink_c``, written apart from the identification's modal
 model) with a current command and records what a log holds (current, encoder) with the
 plant's truth beside it (its root moment ``tau_reac``, eq. 7, and the tip angle
-``alpha_tip``). :func:`identify_link` gives the fit only k_t, J_m, the friction, the
+``alpha_tip``). :func:`score_link` gives the fit only k_t, J_m, the friction, the
 encoder's counts and the link's L, m_tip, J_tip and r (what a user knows):
 :func:`arcosim.identification.link.beam_fit.fit_link` finds EI, ρA and the damping, and
 :func:`arcosim.identification.link.beam_motion.tip_motion` the tip angle and eq. 7's reaction
@@ -34,7 +34,7 @@ from arcosim.identification.records.record import encoder_record, motor_record
 LINK_FMU = "FlexLinkPlant.fmu"
 #: Communication step (s) and record length (s) of the experiment.
 STEP = defaults.STEP
-DURATION = 20.0
+LINK_DURATION = 20.0
 #: Scores skip the record's first second (the smoother's and the excitation's start).
 SETTLE = 1.0
 #: The plant outputs a run records: the log's columns, then the truth.
@@ -70,6 +70,14 @@ class LinkRig:
         The multi-sine's peak current (A).
     seed : int
         Seed of the multi-sine's phases and of the plant's current noise (an index).
+
+    Examples
+    --------
+    >>> rig = LinkRig("a strip", {"EI": 0.04, "rhoA": 0.03, "L": 0.3, "m_tip": 0.005})
+    >>> rig.value("EI"), rig.value("k_t") == defaults.K_T  # N·m²; the FMU's default k_t
+    (0.04, True)
+    >>> rig.geometry
+    Geometry(L=0.3, m_tip=0.005, J_tip=0.0, r_hub=0.01)
     """
 
     name: str
@@ -139,6 +147,13 @@ class LinkRun:
         :data:`RECORDED` outputs, each shape ``(N,)``: ``i_a`` (A), ``omega_m``
         (rad/s), ``theta_m`` (rad), the hub's true speed ``omega_m_true`` (rad/s),
         ``tau_reac`` (N·m), ``alpha_tip`` (rad), ``w_tip`` (m).
+
+    Examples
+    --------
+    >>> t = np.arange(3) * STEP
+    >>> run = LinkRun(t, {name: np.zeros(3) for name in RECORDED})
+    >>> sorted(run.log())  # what a log of the rig holds
+    ['i_a', 'omega_m', 'theta_m', 'time']
     """
 
     time: np.ndarray
@@ -149,7 +164,7 @@ class LinkRun:
         return {"time": self.time, **{c: self.signals[c] for c in ("i_a", "omega_m", "theta_m")}}
 
 
-def simulate_link(fmu: Path, rig: LinkRig, duration: float = DURATION) -> LinkRun:
+def simulate_link(fmu: Path, rig: LinkRig, duration: float = LINK_DURATION) -> LinkRun:
     """Drive the link plant FMU ``fmu`` with ``rig``'s multi-sine for ``duration`` s.
 
     Parameters
@@ -171,6 +186,13 @@ def simulate_link(fmu: Path, rig: LinkRig, duration: float = DURATION) -> LinkRu
     ------
     RuntimeError
         When the FMU refuses a step (its messages in the text).
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> run = simulate_link(ensure_built(3) / LINK_FMU, EXPERIMENT_RIG, duration=0.5)
+    >>> run.time.shape, float(run.time[-1])  # samples, s
+    ((501,), 0.5)
     """
     steps = round(duration / STEP)
     current = multisine(np.arange(steps) * STEP, rig.amplitude, np.array(rig.lines), rig.seed)
@@ -244,7 +266,7 @@ class LinkFindings:
         }
 
 
-def identify_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
+def score_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
     """Fit the link of ``run`` from its hub's current and encoder alone; score it.
 
     Parameters
@@ -261,6 +283,14 @@ def identify_link(run: LinkRun, rig: LinkRig, count: int = 2) -> LinkFindings:
     -------
     LinkFindings
         The fit against the plant.
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> run = simulate_link(ensure_built(3) / LINK_FMU, EXPERIMENT_RIG)
+    >>> found = score_link(run, EXPERIMENT_RIG)
+    >>> {p: abs(found.values[p] / found.truth[p] - 1.0) < 0.05 for p in ("EI", "rhoA")}
+    {'EI': True, 'rhoA': True}
     """
     import time as clock
 

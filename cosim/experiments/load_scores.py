@@ -47,6 +47,15 @@ class LoadScore:
         The estimate's lag behind the truth (s; phase difference / frequency).
     sine_rms_percent : float
         Rms error during the sine (% of the size).
+
+    Examples
+    --------
+    >>> from arcosim.experiments import LoadProfile, score_profile
+    >>> profile = LoadProfile(mass=1)
+    >>> t = np.arange(0.0, profile.duration, 1e-3)
+    >>> score = score_profile(t, profile.torque(t), profile)  # the truth as its estimate
+    >>> score.settling_s, score.settled_mean_percent
+    (0.0, 0.0)
     """
 
     size: float
@@ -141,6 +150,15 @@ def score_profile(time: np.ndarray, estimate: np.ndarray, profile: LoadProfile) 
     -------
     LoadScore
         The scores (:func:`score`).
+
+    Examples
+    --------
+    >>> from arcosim.experiments import LoadProfile
+    >>> profile = LoadProfile(mass=1)
+    >>> t = np.arange(0.0, profile.duration, 1e-3)
+    >>> late = np.interp(t - 0.05, t, profile.torque(t))  # the truth, 50 ms late
+    >>> round(score_profile(t, late, profile).sine_lag_s, 2)  # s
+    0.05
     """
     truth = step_truth(time, profile.torque(time))
     return score(

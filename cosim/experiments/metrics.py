@@ -37,6 +37,18 @@ def flexible_score(estimate: np.ndarray, truth: np.ndarray, motor: np.ndarray) -
 def percent_error(estimate: float, truth: float) -> float:
     """Relative error of ``estimate`` in percent of ``truth`` (both in one unit).
 
+    Parameters
+    ----------
+    estimate : float
+        The estimate (any unit).
+    truth : float
+        The true value (in the unit of ``estimate``), ≠ 0.
+
+    Returns
+    -------
+    float
+        ``100 (estimate / truth − 1)`` (%).
+
     Examples
     --------
     >>> round(percent_error(1.01, 1.0), 6)

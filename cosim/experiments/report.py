@@ -377,6 +377,18 @@ def measured_response(
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
     """A GitHub markdown table.
 
+    Parameters
+    ----------
+    header : sequence of str
+        The column titles.
+    rows : sequence of sequences
+        The cells, one sequence per row, each as long as ``header``; shown with ``str``.
+
+    Returns
+    -------
+    str
+        The table, one line per row after the header and its rule, no trailing newline.
+
     Examples
     --------
     >>> print(markdown_table(["a", "b"], [[1, 2]]))

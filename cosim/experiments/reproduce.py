@@ -43,13 +43,13 @@ from arcosim.experiments.findings import (
     Results,
     report_markdown,
 )
-from arcosim.experiments.flexible_link import DURATION as LINK_DURATION
 from arcosim.experiments.flexible_link import (
     EXPERIMENT_RIG,
+    LINK_DURATION,
     LINK_FMU,
     LINK_UNITS,
     LinkRun,
-    identify_link,
+    score_link,
     simulate_link,
 )
 from arcosim.experiments.load_scores import score_profile
@@ -384,7 +384,7 @@ def _flexible_link(bench: _Bench) -> tuple[LinkRun, dict[str, np.ndarray]]:
     run = simulate_link(bench.folder / LINK_FMU, EXPERIMENT_RIG)
     bench.progress(len(run.time) - 1)
     bench.status("flexible-link fit")
-    findings = identify_link(run, EXPERIMENT_RIG)
+    findings = score_link(run, EXPERIMENT_RIG)
     bench.results.link = findings.as_dict()
     columns = run.log()  # the log; with all_csv the plant's truth and the estimates too
     if bench.all_csv:

@@ -17,5 +17,10 @@ from arcosim.lazy import public_api
 #: Public name → the module that defines it (the package's API; ``tests/test_public_api.py``).
 _API: dict[str, str] = {
     "THRESHOLD": "arcosim.fleet.drift",
+    "read_store": "arcosim.fleet.store",
+    "write_store": "arcosim.fleet.store",
+    "append_store": "arcosim.fleet.store",
+    "AxisDrift": "arcosim.fleet.drift",
+    "DriftReport": "arcosim.fleet.drift",
 }
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

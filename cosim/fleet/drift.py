@@ -57,6 +57,12 @@ class AxisDrift:
         (``std``, NaN where a fit gives none).
     untrusted : list of dict
         The untrusted fits: ``date``, ``log``, ``reasons``.
+
+    Examples
+    --------
+    >>> drift = AxisDrift("a1", None, None, [], [], [], [])  # an axis with no trusted fit
+    >>> drift.axis, drift.alarms
+    ('a1', [])
     """
 
     axis: str

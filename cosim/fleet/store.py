@@ -75,13 +75,34 @@ def store_path(out: Path) -> Path:
 
 
 def read_store(out: Path) -> list[dict[str, object]]:
-    """Every row of the store in ``out``; numbers as float (empty cells as NaN), ``n``
-    as int (None when the fit failed); no store yet gives no rows.
+    """Every row of the store in ``out``.
+
+    Parameters
+    ----------
+    out : Path
+        The output folder that holds the store (:data:`STORE`).
+
+    Returns
+    -------
+    list of dict
+        One dict a row, by column: numbers as float in their column's unit (empty
+        cells as NaN), ``n`` as int (None when the fit failed), text as str; no
+        store yet gives no rows.
 
     Raises
     ------
     UserError
         A file that is not a fleet store (other columns, not UTF-8 text).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> row = {"axis": "a1", "date": "2026-01-05", "status": "ok", "n": 1, "k[1]": 0.3}
+    >>> _ = write_store(Path("read-out"), [row])
+    >>> [(r["axis"], r["n"], r["k[1]"]) for r in read_store(Path("read-out"))]  # N·m/rad
+    [('a1', 1, 0.3)]
+    >>> read_store(Path("no-store-yet"))
+    []
     """
     path = store_path(out)
     if not path.exists():
@@ -164,6 +185,17 @@ def write_store(out: Path, rows: Iterable[Mapping[str, object]]) -> Path:
     -------
     Path
         The store's file.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> fit = {"axis": "a1", "status": "ok", "n": 1}
+    >>> rows = [{**fit, "date": "2026-01-05", "k[1]": 0.3, "k[1]_std": 1e-3},
+    ...         {**fit, "date": "2026-02-05", "k[1]": 0.27, "k[1]_std": 1e-3}]
+    >>> write_store(Path("write-out"), rows).name
+    'fleet.csv'
+    >>> [r["k[1]"] for r in read_store(Path("write-out"))]  # N·m/rad
+    [0.3, 0.27]
     """
     rows = list(rows)
     columns = list(FIXED) + sorted({k for row in rows for k in row if k not in FIXED})

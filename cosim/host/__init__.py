@@ -39,5 +39,6 @@ _API: dict[str, str] = {
     "replay_tracking": "arcosim.host.tracking",
     "untracked_outputs": "arcosim.host.tracking",
     "not_an_fmu": "arcosim.host.validate",
+    "MEASURED": "arcosim.host.master",
 }
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

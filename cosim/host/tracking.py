@@ -166,6 +166,17 @@ def replay_tracking(
     ------
     UserError
         When the observer refuses its parameters or a sample.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from arcosim import ensure_built
+    >>> t = np.arange(201) * 1e-3
+    >>> still = {"time": t, "i_a": 0 * t, "omega_m": 0 * t, "theta_m": 0 * t}  # 0.2 s at rest
+    >>> with FmuInstance(ensure_built(3) / "ReactionTorqueObserver.fmu", "obs") as observer:
+    ...     tracked = replay_tracking(observer, DriveLog(Path("still.csv"), still), {}, 3)
+    >>> tracked.names[:3], tracked.values.shape, tracked.first_alarm()
+    (('k[1]', 'k[2]', 'k[3]'), (201, 8), None)
     """
     given, tracked, stds = tracking_outputs(n)
     run = replay_log(observer, log, {"tracking": 1, **parameters}, [*tracked, *stds, *FLAGS])

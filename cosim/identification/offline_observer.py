@@ -35,6 +35,17 @@ def replay(
     -------
     Observer
         The observer after the last sample.
+
+    Examples
+    --------
+    >>> import arcosim
+    >>> settings = arcosim.ObserverSettings(mode=2, actuator=arcosim.Actuator(2.09e-5, 0.0406),
+    ...                                     g_dist=100.0, g_lpf=100.0, J=(1e-3,), k=(0.5,),
+    ...                                     B=(1e-4,), estimator=1)
+    >>> still = np.zeros(100)  # 0.1 s at rest
+    >>> log = {"time": np.arange(100) * 1e-3, "i_a": still, "omega_m": still, "theta_m": still}
+    >>> replay(settings, log).estimator.theta  # the load angles (rad)
+    [0.0]
     """
     steps = np.diff(np.asarray(log["time"], dtype=float)).tolist()
     i_a, w, th = (np.asarray(log[c], dtype=float).tolist() for c in ("i_a", "omega_m", "theta_m"))
@@ -49,7 +60,32 @@ def replay(
 
 
 def estimate_states(settings: ObserverSettings, log: Mapping[str, np.ndarray]) -> np.ndarray:
-    """The load angles the observer estimates over a log (rad), shape ``(N, n)``."""
+    """The load angles the observer estimates over a log.
+
+    Parameters
+    ----------
+    settings : ObserverSettings
+        What the observer FMU's parameters would say (mode 2).
+    log : mapping of str to ndarray
+        ``time`` (s), ``i_a`` (A), ``omega_m`` (rad/s), ``theta_m`` (rad), each of
+        shape ``(N,)``.
+
+    Returns
+    -------
+    ndarray
+        The estimated angle of each load mass after each sample (rad), shape ``(N, n)``.
+
+    Examples
+    --------
+    >>> import arcosim
+    >>> settings = arcosim.ObserverSettings(mode=2, actuator=arcosim.Actuator(2.09e-5, 0.0406),
+    ...                                     g_dist=100.0, g_lpf=100.0, J=(1e-3,), k=(0.5,),
+    ...                                     B=(1e-4,), estimator=1)
+    >>> still = np.zeros(100)
+    >>> log = {"time": np.arange(100) * 1e-3, "i_a": still, "omega_m": still, "theta_m": still}
+    >>> estimate_states(settings, log).shape
+    (100, 1)
+    """
     out = np.empty((len(log["time"]), len(settings.J)))
 
     def keep(k: int, observer: Observer) -> None:

@@ -19,7 +19,27 @@ F = TypeVar("F", bound=Callable)
 
 
 def single_threaded(function: F) -> F:
-    """Run ``function`` with BLAS limited to one thread."""
+    """Run ``function`` with BLAS limited to one thread.
+
+    Parameters
+    ----------
+    function : callable
+        The function to limit; the caller's thread setting is restored after each call.
+
+    Returns
+    -------
+    callable
+        ``function`` wrapped, with its name and docstring.
+
+    Examples
+    --------
+    >>> from threadpoolctl import threadpool_info
+    >>> @single_threaded
+    ... def blas_threads():
+    ...     return {pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas"}
+    >>> blas_threads() <= {1}, blas_threads.__name__
+    (True, 'blas_threads')
+    """
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):

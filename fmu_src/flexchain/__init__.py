@@ -58,12 +58,26 @@ import importlib
 
 #: Public name → the module that defines it, relative to this package (the package's
 #: API; ``tests/test_public_api.py``). Loaded on first use, so an FMU imports only what
-#: it runs.
+#: it runs. A name whose module is ``.name`` itself is that module (``defaults``).
 _API: dict[str, str] = {
+    "defaults": ".defaults",
     "STEP": ".defaults",
-    "LINK_ELEMENTS": ".defaults",
+    "G_DIST": ".defaults",
+    "ENCODER_CPR": ".defaults",
+    "I_NOISE_STD": ".defaults",
     "Mode": ".codes",
     "Estimator": ".codes",
+    "spring_matrix": ".chain",
+    "gaussian": ".noise",
+    "quantize": ".noise",
+    "Observer": ".observer",
+    "NoiseModel": ".model_observer",
+    "step_model": ".model_observer",
+    "NOISE_RANGE": ".model_observer",
+    "NOISE_RATIO": ".model_observer",
+    "EstimatorBank": ".control.estimator_bank",
+    "PARTS": ".control.controller",
+    "LINK_ELEMENTS": ".defaults",
 }
 __all__ = list(_API)
 
@@ -71,6 +85,7 @@ __all__ = list(_API)
 def __getattr__(name: str) -> object:
     if name not in _API:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_API[name], __name__), name)
+    module = importlib.import_module(_API[name], __name__)
+    value = module if _API[name] == f".{name}" else getattr(module, name)
     globals()[name] = value
     return value

@@ -425,6 +425,11 @@ def spring_matrix(gains: Sequence[float]) -> Matrix:
     -------
     Matrix
         The Laplacian, shape ``(n + 1, n + 1)``, in the unit of ``gains``.
+
+    Examples
+    --------
+    >>> spring_matrix([2.0, 3.0])  # N·m/rad: motor, mass 1, mass 2
+    [[2.0, -2.0, 0.0], [-2.0, 5.0, -3.0], [0.0, -3.0, 3.0]]
     """
     return _laplacian(gains, [(i - 1, i) for i in range(1, len(gains) + 1)])
 

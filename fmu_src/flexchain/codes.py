@@ -32,7 +32,13 @@ class Mode(enum.IntEnum):
 
 
 class Estimator(enum.IntEnum):
-    """The state estimator of mode 2 (the observer's parameter ``estimator``)."""
+    """The state estimator of mode 2 (the observer's parameter ``estimator``).
+
+    Examples
+    --------
+    >>> Estimator(1).name, int(Estimator.RECURSION)
+    ('MODEL_BASED', 0)
+    """
 
     RECURSION = 0  #: the paper's recursion along the chain (eq. 22–26)
     MODEL_BASED = 1  #: the chain model driven by θ_m, Kalman-corrected by τ̂_reac

@@ -57,6 +57,11 @@ class NoiseModel:
         Unmodelled white torque on each load mass, standard deviation (N·m).
     tau_noise_std : float
         White noise on τ̂_reac, standard deviation (N·m).
+
+    Examples
+    --------
+    >>> NoiseModel(theta_noise_std=1e-4, torque_noise_std=1e-3, tau_noise_std=1e-3)
+    NoiseModel(theta_noise_std=0.0001, torque_noise_std=0.001, tau_noise_std=0.001)
     """
 
     theta_noise_std: float
@@ -191,6 +196,12 @@ def step_model(
     ------
     ValueError
         If the Riccati iteration fails (noise outside :data:`NOISE_RANGE`).
+
+    Examples
+    --------
+    >>> model = step_model([1e-3], [0.5], [1e-5], 500.0, NoiseModel(1e-4, 1e-3, 1e-3), 1e-3)
+    >>> len(model.F), len(model.F[0]), len(model.K)  # m = 2n + 1 = 3
+    (3, 3, 3)
     """
     F, Gamma = filtered_chain(J, k, B, g_dist, h, star)
     Q = chain_process_noise(Gamma, J, noise, h)

@@ -53,6 +53,11 @@ def gaussian(seed: int, k: int) -> float:
     -------
     float
         A sample of the standard normal distribution (dimensionless).
+
+    Examples
+    --------
+    >>> gaussian(1, 0) == gaussian(1, 0), gaussian(1, 0) == gaussian(2, 0)  # reproducible
+    (True, False)
     """
     base = _splitmix64((seed & _MASK) ^ 0x5DEECE66D)
     a = _splitmix64((base + 2 * k) & _MASK)
@@ -76,6 +81,12 @@ def quantize(theta: float, counts_per_rev: int) -> float:
     -------
     float
         The reported angle (rad).
+
+    Examples
+    --------
+    >>> count = 2 * math.pi / 2000  # one count of a 2000-count encoder (rad)
+    >>> quantize(0.5 * count, 2000), quantize(1.5 * count, 2000) == count, quantize(0.3, 0)
+    (0.0, True, 0.3)
     """
     if counts_per_rev <= 0:
         return theta

@@ -404,6 +404,16 @@ class Observer:
     ------
     ValueError
         If ``settings.load_mass`` cannot run (:func:`load_mass_problem`).
+
+    Examples
+    --------
+    >>> settings = ObserverSettings(mode=2, actuator=Actuator(J_mo=2.09e-5, k_to=0.0406),
+    ...                             g_dist=100.0, g_lpf=100.0, J=(1e-3,), k=(0.5,),
+    ...                             B=(1e-4,), estimator=1)
+    >>> observer = Observer(settings, 0.0, 0.0)
+    >>> observer.step(1e-3, 0.0, 0.0, 0.0)  # s, A, rad/s, rad: at rest
+    >>> type(observer.estimator).__name__, observer.estimator.theta  # load angles (rad)
+    ('ModelObserver', [0.0])
     """
 
     def __init__(self, settings: ObserverSettings, theta0: float, omega0: float) -> None:

@@ -37,12 +37,12 @@ from arcosim.experiments.motion.baselines import (
 from arcosim.experiments.motion.findings import (
     CONTROLLERS,
     DISTANCE,
-    DURATION,
     ERROR_SEEDS,
     FIGURE,
     I_MAX,
     LOAD_TIME,
     LOAD_TORQUE,
+    MOTION_DURATION,
     MOVE_TIME,
     SEED,
     ChainFindings,
@@ -59,8 +59,25 @@ from arcosim.outputs import save_figure
 
 @dataclass(frozen=True)
 class MotionChain:
-    """A plant: load inertias (kg·m²), spring stiffnesses (N·m/rad) and dampings (N·m·s/rad),
-    each shape ``(n,)``."""
+    """A plant's chain for the motion experiment: its name and its n masses and springs.
+
+    Parameters
+    ----------
+    name : str
+        Its label in tables.
+    J : tuple of float
+        Load inertias J_1 … J_n (kg·m²), shape ``(n,)``.
+    k : tuple of float
+        Spring stiffnesses k_1 … k_n (N·m/rad), shape ``(n,)``.
+    B : tuple of float
+        Spring dampings B_1 … B_n (N·m·s/rad), shape ``(n,)``.
+
+    Examples
+    --------
+    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
+    >>> chain.n, chain.plant_values()["k[2]"]
+    (2, 0.4)
+    """
 
     name: str
     J: tuple[float, ...]
@@ -103,6 +120,32 @@ def identify_chain(
     plant FMU of ``folder`` with an encoder of ``encoder_cpr`` counts (exact if
     ``ideal``); known: k_t and J_m (and, with ideal sensors, the friction).
 
+    Parameters
+    ----------
+    folder : Path
+        Folder of FMUs built for ``chain.n`` masses (:func:`arcosim.ensure_built`).
+    chain : MotionChain
+        The plant's chain.
+    ideal : bool
+        Exact sensors (no current noise, an exact encoder) and the friction known.
+    seed : int
+        The plant's noise seed (an index).
+    encoder_cpr : int
+        The plant's encoder counts per revolution (a count) unless ``ideal``.
+
+    Returns
+    -------
+    DriveIdentification
+        The identification of the plant's log.
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
+    >>> result = identify_chain(ensure_built(2), chain, ideal=True)
+    >>> [round(J / true - 1.0, 2) for J, true in zip(result.chain.J, chain.J)]  # rel. error
+    [0.0, 0.0]
+
     Raises
     ------
     IdentificationError
@@ -123,8 +166,31 @@ def identify_chain(
 def design_parameters(
     result: DriveIdentification, ideal: bool, encoder_cpr: int = ENCODER_CPR
 ) -> dict[str, float]:
-    """The controller's parameters (the observer FMU's names) from an identification, for
-    an encoder of ``encoder_cpr`` counts (exact if ``ideal``)."""
+    """The controller's parameters (the observer FMU's names) from an identification.
+
+    Parameters
+    ----------
+    result : DriveIdentification
+        The chain identified (:func:`identify_chain`).
+    ideal : bool
+        An exact encoder (``encoder_cpr`` 0).
+    encoder_cpr : int
+        The encoder's counts per revolution (a count) unless ``ideal``.
+
+    Returns
+    -------
+    dict of str to float
+        ``J_mo``, ``k_to``, the chain's ``J[i]``, ``k[i]``, ``B[i]``, the friction,
+        ``encoder_cpr`` and ``g_dist``, in SI units (:func:`sensorless` takes them).
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
+    >>> params = design_parameters(identify_chain(ensure_built(2), chain, True), True)
+    >>> params["encoder_cpr"], round(params["k[1]"], 2)
+    (0, 0.4)
+    """
     chain = {k: v for k, v in result.observer_parameters().items() if k != "estimator"}
     return {
         "J_mo": defaults.J_M,
@@ -138,8 +204,25 @@ def design_parameters(
 def scaled(
     params: Mapping[str, float], J_factors: np.ndarray, k_factors: np.ndarray
 ) -> dict[str, float]:
-    """``params`` with every ``J[i]`` and ``k[i]`` times its factor (dimensionless, each
-    factor array of shape ``(n,)``)."""
+    """``params`` with every ``J[i]`` and ``k[i]`` times its factor: a model error.
+
+    Parameters
+    ----------
+    params : mapping of str to float
+        The chain by the observer FMU's names (``J[i]`` in kg·m², ``k[i]`` in N·m/rad, …).
+    J_factors, k_factors : ndarray
+        The factors on J_1 … J_n and k_1 … k_n (dimensionless), shape ``(n,)`` each.
+
+    Returns
+    -------
+    dict of str to float
+        A copy of ``params``, its ``J[i]`` and ``k[i]`` scaled.
+
+    Examples
+    --------
+    >>> scaled({"J[1]": 1e-3, "k[1]": 0.2, "B[1]": 1e-5}, [2.0], [0.5])
+    {'J[1]': 0.002, 'k[1]': 0.1, 'B[1]': 1e-05}
+    """
     out = dict(params)
     for i, (fJ, fk) in enumerate(zip(J_factors, k_factors), start=1):
         out[f"J[{i}]"] = params[f"J[{i}]"] * fJ
@@ -149,6 +232,19 @@ def scaled(
 
 def model_errors(n: int, seeds: tuple[int, ...]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Factors on J_i and k_i: uniform in [0.9, 1.1] per seed, then the two corners.
+
+    Parameters
+    ----------
+    n : int
+        Number of load masses (a count).
+    seeds : tuple of int
+        Seeds of the random factors (an index each).
+
+    Returns
+    -------
+    dict of str to tuple of ndarray
+        By label, the factors on J_1 … J_n and on k_1 … k_n (dimensionless), shape
+        ``(n,)`` each (:func:`scaled` applies them).
 
     Examples
     --------
@@ -169,8 +265,37 @@ def model_errors(n: int, seeds: tuple[int, ...]) -> dict[str, tuple[np.ndarray, 
 
 
 def sensorless(params: Mapping[str, float], h: float = STEP, without: frozenset[str] = frozenset()):
-    """The sensorless controller designed on ``params`` (``MotionController``), reset;
-    the parts named in ``without`` switched off (``controller.PARTS``)."""
+    """The sensorless controller designed on ``params``, reset, the parts named in
+    ``without`` switched off.
+
+    Designed for the experiment's move (:data:`MOVE_TIME` s) and current limit
+    (:data:`I_MAX` A).
+
+    Parameters
+    ----------
+    params : mapping of str to float
+        ``J_mo``, ``k_to``, ``D_m``, ``f_c`` and the chain by the observer FMU's names
+        (SI units; :func:`design_parameters`).
+    h : float
+        The controller's step (s).
+    without : frozenset of str
+        The controller's parts to switch off (``PARTS`` of
+        :mod:`arcosim.fmu.flexchain.control.controller`; none by default).
+
+    Returns
+    -------
+    MotionController
+        Ready for its first ``step``.
+
+    Examples
+    --------
+    >>> from arcosim.fmu.flexchain import defaults
+    >>> chain = MotionChain("bench", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3)
+    >>> motor = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": 0.0}
+    >>> controller = sensorless({**motor, **chain.plant_values()})
+    >>> abs(controller.step(STEP, 1.0, 0.0, 0.0, 0.0)) <= I_MAX  # A
+    True
+    """
     from arcosim.fmu.flexchain.control.controller import MotionController, design_controller
 
     controller = MotionController(
@@ -191,15 +316,45 @@ def baselines(params: Mapping[str, float]) -> tuple[CascadeController, CascadeCo
 def motion_steps() -> int:
     """The co-simulation steps of the experiment, for a progress bar (a count)."""
     identification = round(IDENTIFICATION_DURATION / STEP)
-    moves = (4 + 4 + 2 * (len(ERROR_SEEDS) + 2)) * round(DURATION / STEP)
+    moves = (4 + 4 + 2 * (len(ERROR_SEEDS) + 2)) * round(MOTION_DURATION / STEP)
     return len(CHAINS) * (identification + moves)
 
 
 class Runs:
-    """The runs of one chain: its plant's FMUs, sensors and the load step, and what to
-    call with the steps done after each run; the plant's encoder has ``encoder_cpr``
-    counts (exact if ``ideal``), and limit cycles are counted in them either way; each
-    run moves the last mass by ``distance`` (rad) from rest."""
+    """The moves of one chain's plant, each by a controller.
+
+    Each run moves the last mass by ``distance`` from rest over :data:`MOTION_DURATION`
+    s on the plant FMU, with the load-torque step during the hold when asked.
+
+    Parameters
+    ----------
+    folder : Path
+        Folder of FMUs built for ``chain.n`` masses (:func:`arcosim.ensure_built`).
+    chain : MotionChain
+        The plant's chain.
+    ideal : bool
+        Exact sensors (no current noise, an exact encoder).
+    progress : callable
+        Called with the steps done after each run (a count).
+    seed : int
+        The plant's noise seed (an index).
+    encoder_cpr : int
+        The plant's encoder counts per revolution (a count) unless ``ideal``; limit
+        cycles are counted in them either way.
+    distance : float
+        The move of the last mass (rad).
+
+    Examples
+    --------
+    >>> from arcosim import ensure_built
+    >>> from arcosim.fmu.flexchain import defaults
+    >>> chain = MotionChain("bench", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3)
+    >>> runs = Runs(ensure_built(3), chain, ideal=True)
+    >>> motor = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": 0.0}
+    >>> run = runs.run(sensorless({**motor, **chain.plant_values()}), full_state=True)
+    >>> float(run.time[-1]), bool(abs(run.last[-1] - DISTANCE) < 0.01)  # s; within 1 %
+    (6.0, True)
+    """
 
     def __init__(
         self,
@@ -220,7 +375,7 @@ class Runs:
         """A move of ``distance`` from rest; with ``load``, the load-torque step during the hold."""
         step = LoadStep(self.chain.n, LOAD_TIME, LOAD_TORQUE) if load else None
         run = run_closed_loop(
-            self.folder, self.chain.n, controller, self.distance, DURATION,
+            self.folder, self.chain.n, controller, self.distance, MOTION_DURATION,
             plant=plant_settings(self.chain, self.ideal, self.seed, self.cpr), load=step,
             full_state=full_state,
         )  # fmt: skip

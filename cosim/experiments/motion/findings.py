@@ -30,7 +30,7 @@ FIGURE = "fig10_motion_control.png"
 #: The move of the last mass (rad), its profile's duration (s) and the run's length (s).
 DISTANCE = 1.0
 MOVE_TIME = 1.0
-DURATION = 6.0
+MOTION_DURATION = 6.0
 #: Every controller's current limit (A).
 I_MAX = 3.0
 #: The load torque on the last mass during the hold (N·m): a tenth of what 1 A gives.
@@ -73,6 +73,12 @@ class MoveScore:
         Largest |i_ref| (A).
     limit_cycle : float
         Peak-to-peak encoder angle of the motor over the last :data:`WINDOW` s (counts).
+
+    Examples
+    --------
+    >>> score = MoveScore(0.9, 1.0, 1e-4, 2.5, 1.0)
+    >>> score.as_dict()["settle_1"], score.peak_current  # s, A
+    (0.9, 2.5)
     """
 
     settle_1: float
@@ -87,9 +93,31 @@ class MoveScore:
 
 
 def score_move(run: LoopRun, target: float, distance: float, encoder_cpr: int) -> MoveScore:
-    """Score a run that moves the last mass by ``distance`` (rad) to ``target`` (rad) from t = 0.
+    """Score a run that moves the last mass by ``distance`` to ``target`` from t = 0.
 
-    ``encoder_cpr`` (counts per revolution) converts the limit cycle into counts.
+    Parameters
+    ----------
+    run : LoopRun
+        The closed-loop run (:func:`~arcosim.experiments.closed_loop.run_closed_loop`).
+    target : float
+        Where the last mass should come to rest (rad).
+    distance : float
+        The move (rad): the settling bands are ±1 % and ±0.5 % of it.
+    encoder_cpr : int
+        The encoder's counts per revolution (a count), to count the limit cycle in.
+
+    Returns
+    -------
+    MoveScore
+        Its settling times, residual, peak current and limit cycle.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 6.0005, 1e-3)
+    >>> last = np.minimum(t, 1.0)  # a ramp to 1 rad in 1 s, then still
+    >>> run = LoopRun(t, np.vstack([last, last]), last, 0 * t, 0 * t, np.full(6000, 0.5))
+    >>> score_move(run, 1.0, 1.0, 2000)
+    MoveScore(settle_1=0.991, settle_05=0.996, residual=0.0, peak_current=0.5, limit_cycle=0.0)
     """
     y = run.last
     return MoveScore(
@@ -352,7 +380,7 @@ def motion_markdown(results: MotionResults) -> str:
 On the bench chain and the five-mass chain (J = 0.2, 0.3, 0.25, 0.3, 0.2 g·m², every k =
 0.4 N·m/rad, B = 1.5·10⁻⁵ N·m·s/rad), each identified by `identify_drive` from a 20 s
 log of the same plant (the `identification` multi-sine; k_t and J_m known), a
-{DISTANCE:g} rad move of the last mass from rest, in {DURATION:g} s runs at 1 ms, current
+{DISTANCE:g} rad move of the last mass from rest, in {MOTION_DURATION:g} s runs at 1 ms, current
 limit {I_MAX:g} A, by four controllers: (a) a drive's cascade tuned out of the box, a
 velocity PI on the motor encoder at half the identified first mode on the total inertia
 (its zero at a quarter of that), a position P at a quarter of it, on a minimum-jerk

@@ -121,6 +121,13 @@ class ParameterFit:
         Model simulations used by the optimizer (a count).
     extra : dict
         Method-specific evidence (JSON-able).
+
+    Examples
+    --------
+    >>> fit = ParameterFit(["k", "B"], np.array([0.5, 1e-4]), np.array([0.01, 2e-5]),
+    ...                    np.array([0.4, 1e-4]), "a guess", 1e-3, 0.1, 5, 40)
+    >>> fit.as_dict(), fit.std_dict()["B"]  # N·m/rad, N·m·s/rad
+    ({'k': 0.5, 'B': 0.0001}, 2e-05)
     """
 
     names: list[str]

@@ -81,6 +81,11 @@ class Geometry:
         Tip inertia (kg·m²), ≥ 0.
     r_hub : float
         Clamp radius (m), ≥ 0.
+
+    Examples
+    --------
+    >>> Geometry(L=0.3, m_tip=0.005).link(EI=0.04, rhoA=0.03)  # N·m², kg/m
+    Link(EI=0.04, rhoA=0.03, L=0.3, m_tip=0.005, J_tip=0.0, r_hub=0.0)
     """
 
     L: float
@@ -158,11 +163,9 @@ def fit_link(
 
     Examples
     --------
-    With ``encoder`` and ``motor`` from a log, L = 0.4 m, a 20 g tip, a 12 g link:
-
-    >>> fit_link(encoder, motor, Geometry(0.4, 0.02), rhoA=0.012 / 0.4)  # doctest: +SKIP
-
-    A mass per length that is not > 0 is refused before the record is read:
+    A fit of a simulated link from its hub's record is the example of
+    :func:`arcosim.experiments.flexible_link.score_link`. A mass per length that is not
+    > 0 is refused before the record is read:
 
     >>> fit_link(None, None, Geometry(0.4), rhoA=0.0)
     Traceback (most recent call last):
@@ -562,10 +565,36 @@ def _least_squares(
 
 
 def modal_of(result: ParameterFit, geometry: Geometry, count: int | None = None) -> ModalModel:
-    """The fitted link's modal model (of :func:`fit_link`'s result), ``count`` modes
-    (default the fit's, with ρA given those above the band it kept too), the next
-    :data:`STATIC_MODES` in its quasi-static tip deflection; a mode beyond the fitted
-    damping ratios takes the last of them. ρA is the fitted or the given one."""
+    """The fitted link's modal model (of :func:`fit_link`'s result).
+
+    ``count`` modes, the next :data:`STATIC_MODES` in its quasi-static tip deflection; a
+    mode beyond the fitted damping ratios takes the last of them. ρA is the fitted or
+    the given one.
+
+    Parameters
+    ----------
+    result : ParameterFit
+        :func:`fit_link`'s result: ``EI`` (N·m²), ``rhoA`` (kg/m, or ``rhoA_given`` in
+        its ``extra``), ``zeta[i]`` (dimensionless).
+    geometry : Geometry
+        The link's length, tip and hub.
+    count : int, optional
+        Modes wanted (a count; default the fit's, with ρA given those above the band
+        it kept too).
+
+    Returns
+    -------
+    ModalModel
+        The link's modes.
+
+    Examples
+    --------
+    >>> fit = ParameterFit(["EI", "rhoA", "zeta[1]"], np.array([1.0, 1.0, 0.01]),
+    ...                    np.full(3, 1e-3), np.ones(3), "a guess", 0.1, 1.0, 5, 40)
+    >>> model = modal_of(fit, Geometry(L=1.0), 2)
+    >>> np.round(np.sqrt(model.frequency), 4).tolist(), model.damping.tolist()
+    ([1.8751, 4.6941], [0.01, 0.01])
+    """
     values = result.as_dict()
     zeta = [values[n] for n in result.names if n.startswith("zeta[")]
     above = int(result.extra.get("modes_above_band", 0))

@@ -68,6 +68,20 @@ def tip_motion(record: EncoderRecord, model: ModalModel, D_m: float, f_c: float)
     -------
     TipMotion
         ``w_tip`` (m), ``alpha_tip`` (rad), ``tau_reac`` (N·m), ``q`` over the record.
+
+    Examples
+    --------
+    >>> from arcosim import Actuator, encoder_record
+    >>> from arcosim.identification import Link, modal_model
+    >>> t = np.arange(1000) * 1e-3
+    >>> count = 2.0 * np.pi / 2000
+    >>> theta = np.floor(np.sin(3.0 * t) / count) * count
+    >>> motor = Actuator(J_mo=2.09e-5, k_to=0.0406)
+    >>> record = encoder_record(t, 0.1 * np.sin(3.0 * t), theta, motor, 2000)
+    >>> model = modal_model(Link(EI=1.0, rhoA=0.1, L=0.4), modes=1)
+    >>> motion = tip_motion(record, model, D_m=0.0, f_c=0.0)
+    >>> motion.w_tip.shape, motion.q.shape  # N samples, one mode
+    ((1000,), (1000, 1))
     """
     drive = drive_of(model, D_m, f_c)
     states = Kalman.of(record, drive).smoothed(record, drive)

@@ -33,7 +33,27 @@ def clamped_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, n
 
 
 def driving_point_modes(J: Sequence[float], k: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
-    """Clamped frequencies p (rad/s) and residues r (N·m/rad·s⁻²) of the chain, shape (n,)."""
+    """The clamped frequencies and residues of a chain: what the motor's side shows of it.
+
+    Parameters
+    ----------
+    J : sequence of float
+        Load inertias J_1 … J_n (kg·m²), shape ``(n,)``.
+    k : sequence of float
+        Stiffnesses k_1 … k_n (N·m/rad), shape ``(n,)``.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(p, r)``: clamped frequencies (rad/s), ascending, and residues
+        (N·m/rad·s⁻²), shape ``(n,)`` each; :func:`chain_from_modes` inverts them.
+
+    Examples
+    --------
+    >>> p, r = driving_point_modes([1e-3, 2e-3], [0.5, 0.8])
+    >>> np.round(p, 4).tolist(), np.round(r, 4).tolist()
+    ([11.2765, 39.6591], [47.1821, 202.8179])
+    """
     eigenvalues, phi = clamped_modes(J, k)
     return np.sqrt(eigenvalues), float(k[0]) ** 2 * phi[0] ** 2  # φ_{1i}
 
@@ -57,6 +77,12 @@ def chain_from_modes(p: Sequence[float], r: Sequence[float]) -> tuple[np.ndarray
     ------
     ValueError
         For non-positive or repeated frequencies, or non-positive residues.
+
+    Examples
+    --------
+    >>> J, k = chain_from_modes(*driving_point_modes([1e-3, 2e-3], [0.5, 0.8]))
+    >>> np.round(J, 9).tolist(), np.round(k, 9).tolist()  # kg·m², N·m/rad: back again
+    ([0.001, 0.002], [0.5, 0.8])
     """
     p = np.asarray(p, dtype=float)
     r = np.asarray(r, dtype=float)

@@ -47,6 +47,15 @@ class MotorRecord:
     velocity : ndarray or None
         That velocity (rad/s), shape ``(N,)``: the rigid drive's prediction of τ̂ reads
         its differences as the DOB does; None when not kept.
+
+    Examples
+    --------
+    >>> t = np.arange(1000) * 1e-3
+    >>> motor = Actuator(J_mo=2.09e-5, k_to=0.0406)
+    >>> record = motor_record(t, 0.1 * np.sin(3.0 * t), 3.0 * np.cos(3.0 * t),
+    ...                       np.sin(3.0 * t), motor, 100.0)
+    >>> isinstance(record, MotorRecord), record.h, record.g_dist  # s, rad/s
+    (True, 0.001, 100.0)
     """
 
     h: float
