@@ -6,6 +6,8 @@
   (``arcosim bench speed``, or ``python -m benchmarks.speed``);
 - :mod:`benchmarks.controller_speed`: the controller FMU's µs per step through fmpy for
   1, 3 and 5 masses (``python -m benchmarks.controller_speed``);
+- :mod:`benchmarks.part_margins`: the sensorless loop's decay under model errors with a
+  controller part switched off (``python -m benchmarks.part_margins --without bank``);
 - :mod:`benchmarks.public_records`: ``check`` and ``identify`` on public measured records
   of real drives against their published values (``arcosim bench public --data DIR``);
 - :mod:`benchmarks.memory`, :mod:`benchmarks.noise_envelope`: measurements run as scripts;

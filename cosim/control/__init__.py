@@ -18,5 +18,6 @@ from arcosim.lazy import public_api
 _API: dict[str, str] = {
     "ERROR": "arcosim.control.model_errors",
     "RANDOM_MODELS": "arcosim.control.model_errors",
+    "sensorless_decay": "arcosim.control.sensorless_loop",
 }
 __all__, __getattr__, __dir__ = public_api(__name__, _API, globals())

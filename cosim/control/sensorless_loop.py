@@ -85,6 +85,7 @@ def sensorless_loop(
     h: float,
     delay: int = 0,
     hold: bool = False,
+    without: frozenset[str] = frozenset(),
     **goals,
 ) -> SensorlessLoop:
     """The controller designed on ``model`` driving the plant ``truth``, through a 1 rad
@@ -111,6 +112,9 @@ def sensorless_loop(
         0: each command acts over the next step; 1: one step later.
     hold : bool
         Linearize at rest with the hold's dither running (above).
+    without : frozenset of str
+        The controller's parts switched off (``PARTS`` of
+        :mod:`~arcosim.fmu.flexchain.control.controller`; none by default, as the FMU runs).
     **goals
         ``control_mass``, ``move_time``, ``bandwidth``, ``i_max``, ``hold_dither`` for
         :func:`~arcosim.fmu.flexchain.control.design.design_controller`.
@@ -136,7 +140,9 @@ def sensorless_loop(
         )
     J, k, B = (indexed_values(truth, name) for name in ("J", "k", "B"))
     plant = PlantPhysics(truth["J_mo"], truth["k_to"], truth["D_m"], 0.0, J, k, B)
-    loop = SensorlessLoop(MotionController(design), plant, [0.0, 0.0, 0.0, 0.0], delay, hold)
+    loop = SensorlessLoop(
+        MotionController(design, without), plant, [0.0, 0.0, 0.0, 0.0], delay, hold
+    )
     wait = (1.0 + defaults.HOLD_DITHER_AFTER) * design.move_time if hold else design.move_time
     steps = round((wait + AFTER_MOVE) / h)
     within = deque(maxlen=max(1, round(SETTLE_WINDOW / h)))  # the command below i_max
@@ -249,13 +255,14 @@ def sensorless_decay(
     h: float,
     delay: int = 0,
     hold: bool = False,
+    without: frozenset[str] = frozenset(),
     **goals,
 ) -> tuple[float, float]:
     """The sensorless loop's slowest decay and where it is.
 
     Parameters
     ----------
-    truth, model, h, delay, hold, **goals
+    truth, model, h, delay, hold, without, **goals
         As :func:`sensorless_loop`.
 
     Returns
@@ -264,8 +271,16 @@ def sensorless_decay(
         The slowest decay rate (1/s; negative: growing) and that pole's frequency (rad/s);
         (−inf, nan) when the run did not come to rest (``SensorlessLoop.settled``): it
         diverged or saturated, and no pole describes it.
+
+    Examples
+    --------
+    >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5,
+    ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
+    >>> decay, at = sensorless_decay(chain, chain, h=1e-3)
+    >>> decay > 0.0  # 1/s: every pole of the linearized loop decays
+    True
     """
-    loop = sensorless_loop(truth, model, h=h, delay=delay, hold=hold, **goals)
+    loop = sensorless_loop(truth, model, h=h, delay=delay, hold=hold, without=without, **goals)
     if not loop.settled:
         return -math.inf, math.nan
     return slowest(np.linalg.eigvals(sensorless_jacobian(loop)), h)
