@@ -102,6 +102,15 @@ def run_control_scenario(
     Recording
         ``plant.<name>`` (sensors, the truth, every mass's angle and velocity) and
         ``controller.<name>`` signals, sample k at k h.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from arcosim import ensure_built
+    >>> short = dataclasses.replace(CONTROL_SCENARIOS["move"], duration=0.1)
+    >>> run = run_control_scenario(short, 3, ensure_built(3))
+    >>> run.time.shape, "controller.i_ref" in run.signals
+    ((101,), True)
     """
     steps = round(scenario.duration / h)
     time = np.arange(steps) * h
@@ -148,6 +157,15 @@ def move_summary(recording: Recording, n: int, target: float, hold: float = 2.0)
         of the target), ``residual_rms`` (rad, about the target over the last ``hold``
         s), ``final_error`` (rad), ``peak_current`` (A), ``motor_p2p`` (rad, the measured
         motor angle's range over the last ``hold`` s).
+
+    Examples
+    --------
+    >>> from arcosim import Recording
+    >>> t = np.arange(0.0, 3.0, 1e-3)
+    >>> run = Recording(t, {"plant.theta[1]": np.minimum(t, 1.0), "plant.theta_m": 0 * t,
+    ...                     "controller.i_ref": 0.5 * np.sin(t)})
+    >>> round(move_summary(run, 1, target=1.0, hold=1.0)["settling_1pct"], 3)  # s
+    0.99
     """
     t = recording.time
     last = recording[f"plant.theta[{n}]"]

@@ -70,6 +70,12 @@ class Results:
         Experiment 7: the moves by chain (:mod:`arcosim.experiments.motion.findings`).
     files : list of Path
         Every file written, ``report.md`` last.
+
+    Examples
+    --------
+    >>> found = Results(masses=3, scores=[0.02, 0.03, 0.05])
+    >>> found.masses, max(found.scores)  # a count; the worst angle score (dimensionless)
+    (3, 0.05)
     """
 
     actuator: dict[str, float] = field(default_factory=dict)

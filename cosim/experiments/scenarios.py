@@ -401,7 +401,27 @@ def run_scenario(
 def recording_columns(recording: Recording, log_only: bool = False) -> dict[str, np.ndarray]:
     """Columns for a CSV: ``time``, the log columns (plant's measured signals under
     the observer's input names), then, unless ``log_only``, every signal by its
-    qualified name."""
+    qualified name.
+
+    Parameters
+    ----------
+    recording : Recording
+        A run's time (s) and signals by qualified name (``plant.i_a`` in A, …).
+    log_only : bool
+        Only ``time`` and the log columns ``i_a`` (A), ``omega_m`` (rad/s), ``theta_m`` (rad).
+
+    Returns
+    -------
+    dict of str to ndarray
+        Column name → values, each of shape (samples,), in the order a CSV takes them.
+
+    Examples
+    --------
+    >>> from arcosim import Recording
+    >>> run = Recording(np.array([0.0, 1e-3]), {"plant.i_a": np.array([0.1, 0.2])})
+    >>> list(recording_columns(run, log_only=True))
+    ['time', 'i_a']
+    """
     columns = {"time": recording.time}
     for name in ("i_a", "omega_m", "theta_m"):
         key = f"plant.{name}"

@@ -32,6 +32,17 @@ def draw_tracking(tracked: TrackedChain, path: str | Path, force: bool = False) 
     -------
     Path
         The file written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from arcosim.host import TrackedChain
+    >>> run = TrackedChain(np.array([0.0, 1.0]), ("k[1]",), ("N.m/rad",),
+    ...     np.array([[1.0], [0.9]]), np.array([[0.1], [0.01]]), np.array([1.0]),
+    ...     np.array([0, 1]), np.array([0, 1]))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     draw_tracking(run, Path(folder) / "tracked.png").name
+    'tracked.png'
     """
     import matplotlib
 
