@@ -252,11 +252,26 @@ def ensure_built(n: int = 3, folder: Path | None = None) -> Path:
 def fmu_variables(folder: Path) -> dict[str, dict[str, object]]:
     """The plant's and the observer's variables in ``folder``, by name.
 
+    Parameters
+    ----------
+    folder : Path
+        A folder of built FMUs (:func:`ensure_built`), holding the plant's and the
+        observer's ``.fmu`` files under their recipes' file names.
+
     Returns
     -------
     dict
         ``{"plant": {name: fmpy ScalarVariable}, "observer": {...}}``, keyed as in
         ``--set plant.k[2]=0.2``.
+
+    Examples
+    --------
+    >>> variables = fmu_variables(ensure_built(3))
+    >>> sorted(variables)
+    ['observer', 'plant']
+    >>> gain = variables["observer"]["g_dist"]
+    >>> gain.causality, gain.type, gain.unit
+    ('parameter', 'Real', 'rad/s')
     """
     from fmpy import read_model_description
 

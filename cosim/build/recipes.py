@@ -99,6 +99,16 @@ CONTROL_SSP_NAME = "MotionControl.ssp"
 def check_masses(n: int) -> int:
     """Return ``n`` if it is a supported number of load masses.
 
+    Parameters
+    ----------
+    n : int
+        Number of load masses (a count), as given to ``--masses``.
+
+    Returns
+    -------
+    int
+        ``n`` itself.
+
     Raises
     ------
     UserError
@@ -118,6 +128,17 @@ def check_masses(n: int) -> int:
 
 def check_elements(elements: int) -> int:
     """Return ``elements`` if the link FMU can be built with that many elements.
+
+    Parameters
+    ----------
+    elements : int
+        Number of the link's Hermite finite elements (a count), as given to
+        ``--elements``.
+
+    Returns
+    -------
+    int
+        ``elements`` itself.
 
     Raises
     ------

@@ -18,7 +18,30 @@ INT_MIN, INT_MAX = -(2**31), 2**31 - 1
 
 
 def parse_assignment(text: str) -> tuple[str, str]:
-    """``"NAME=VALUE"`` → ``(NAME, VALUE)``; refuses text without ``=``."""
+    """``"NAME=VALUE"`` → ``(NAME, VALUE)``; refuses text without ``=``.
+
+    Parameters
+    ----------
+    text : str
+        One assignment as written after ``--set``, e.g. ``"observer.g_dist=200"``; blanks
+        around the name and the value are dropped.
+
+    Returns
+    -------
+    tuple of (str, str)
+        The name and the value, both as text (the value is typed later, from the FMU's
+        model description).
+
+    Raises
+    ------
+    UserError
+        When ``text`` has no ``=``, or nothing before or after it.
+
+    Examples
+    --------
+    >>> parse_assignment("observer.g_dist = 200")
+    ('observer.g_dist', '200')
+    """
     name, sep, value = text.partition("=")
     if not sep or not name.strip() or not value.strip():
         raise UserError(f"--set {_shown(text)!r}: write NAME=VALUE, e.g. observer.g_dist=200")
@@ -103,6 +126,15 @@ def split_overrides(
     UserError
         An assignment without a known FMU prefix, naming no variable of it or no
         parameter, or with a value of the wrong type.
+
+    Examples
+    --------
+    Variables stand in for fmpy's ``ScalarVariable`` objects (no FMU needed):
+
+    >>> from types import SimpleNamespace
+    >>> gain = SimpleNamespace(type="Real", causality="parameter")
+    >>> split_overrides(["observer.g_dist=200"], {"plant": {}, "observer": {"g_dist": gain}})
+    {'plant': {}, 'observer': {'g_dist': 200.0}}
     """
     result: dict[str, dict[str, Value]] = {prefix: {} for prefix in fmus}
     for text in assignments:

@@ -109,6 +109,16 @@ def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer
     dict
         Name → last value (in the variable's unit): a bool, an int or a float by the
         variable's FMI type.
+
+    Examples
+    --------
+    Any object with the instance's ``variables`` stands in for the FMU here:
+
+    >>> from types import SimpleNamespace
+    >>> fmu = SimpleNamespace(variables={"tau_reac_hat": SimpleNamespace(type="Real")})
+    >>> run = Recording(np.array([0.0, 0.001]), {"observer.tau_reac_hat": np.array([0.0, 0.25])})
+    >>> final_values(fmu, run)
+    {'tau_reac_hat': 0.25}
     """
     result = {}
     for key, series in recording.signals.items():
@@ -134,7 +144,42 @@ def parameter_sets(variables: Mapping[str, object], assignments: Sequence[str]) 
 
 
 def observer_parameters(fmu: FmuInstance, assignments: Sequence[str], mode: int | None) -> dict:
-    """``--set`` texts (observer parameters, no prefix) and ``--mode`` as typed values."""
+    """``--set`` texts (observer parameters, no prefix) and ``--mode`` as typed values.
+
+    Parameters
+    ----------
+    fmu : FmuInstance
+        The observer instance whose variables (their ``causality`` and FMI ``type``)
+        the texts are checked and typed against.
+    assignments : sequence of str
+        ``NAME=VALUE`` texts as given to ``--set``, e.g. ``"g_dist=200"`` (the value in
+        the variable's unit).
+    mode : int or None
+        The observer's ``mode`` parameter as given to ``--mode``; ``None`` leaves it
+        at the FMU's start value.
+
+    Returns
+    -------
+    dict
+        Parameter name → its typed start value (a bool, an int or a float by the
+        variable's FMI type), with ``"mode"`` when ``mode`` is given.
+
+    Raises
+    ------
+    UserError
+        A text without ``=``, naming no variable of the observer or no parameter, or
+        with a value of the wrong type.
+
+    Examples
+    --------
+    Any object with the instance's ``variables`` stands in for the FMU here:
+
+    >>> from types import SimpleNamespace
+    >>> gain = SimpleNamespace(type="Real", causality="parameter")
+    >>> observer = SimpleNamespace(variables={"g_dist": gain})
+    >>> observer_parameters(observer, ["g_dist=200"], mode=1)
+    {'g_dist': 200.0, 'mode': 1}
+    """
     parameters = parameter_sets(fmu.variables, assignments)
     if mode is not None:
         parameters["mode"] = mode

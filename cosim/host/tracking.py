@@ -128,6 +128,19 @@ def untracked_outputs(names: Sequence[str], n: int) -> list[str]:
     """``names`` (an observer's outputs) without the tracker's, which stay 0 while
     tracking is off: what a replay without tracking records, for ``n`` masses.
 
+    Parameters
+    ----------
+    names : sequence of str
+        Output names of the observer FMU, e.g. ``"d_hat"``, ``"k_track[1]"``.
+    n : int
+        Number of load masses (a count) the observer was built for.
+
+    Returns
+    -------
+    list of str
+        ``names`` in their order, without the tracked values, their σ and the
+        tracker's flags.
+
     Examples
     --------
     >>> untracked_outputs(["d_hat", "k_track[1]", "k_track_std[1]", "drift_alarm"], 1)

@@ -130,7 +130,35 @@ def check_ecos(fmu: Path) -> tuple[list[str], str | None]:
 
 def not_an_fmu(path: Path) -> str | None:
     """Why ``path`` cannot be validated at all (not a file, not a complete FMU zip,
-    an SSP), or None."""
+    an SSP), or None.
+
+    Parameters
+    ----------
+    path : Path
+        The file given to ``arcosim validate``.
+
+    Returns
+    -------
+    str or None
+        The reason, as a phrase that follows the file's name in a message; None when
+        ``path`` is a readable zip with a ``modelDescription.xml`` (what
+        :func:`validate` then checks).
+
+    Examples
+    --------
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> fmu = Path(folder.name) / "Plant.fmu"
+    >>> not_an_fmu(fmu)
+    'no such file'
+    >>> fmu.touch()
+    >>> not_an_fmu(fmu)
+    'an empty file, not an FMU'
+    >>> with zipfile.ZipFile(fmu, "w") as z:
+    ...     z.writestr("modelDescription.xml", "<fmiModelDescription/>")
+    >>> print(not_an_fmu(fmu))
+    None
+    >>> folder.cleanup()
+    """
     if not path.exists():
         return "no such file"
     if path.is_dir():

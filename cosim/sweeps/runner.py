@@ -288,6 +288,30 @@ def sweep(
     UserError
         A name or value the FMUs refuse, a results file that exists without ``resume``,
         a folder another sweep holds.
+
+    Examples
+    --------
+    A two-run grid over the observer's gain; :func:`draw_runs` shows the runs the
+    sweep would run:
+
+    >>> import tempfile
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = Path(folder.name) / "gains.toml"
+    >>> _ = path.write_text('''scenario = "rigid"
+    ... duration = 0.5
+    ... metrics = ["runtime"]
+    ... [vary]
+    ... "observer.g_dist" = { distribution = "grid", values = [100.0, 200.0] }
+    ... ''', encoding="utf-8")
+    >>> spec = load_spec(path)
+    >>> draw_runs(spec)
+    [{'observer.g_dist': 100.0}, {'observer.g_dist': 200.0}]
+
+    ``sweep(spec, Path(folder.name) / spec.name, workers=1)`` then runs them (a local
+    Dask cluster takes seconds to start) and returns the path of ``results.csv``, whose
+    rows :func:`read_results` reads.
+
+    >>> folder.cleanup()
     """
     folder = ensure_built(spec.masses, fmu_dir)
     fmus = {f"{r.name}.fmu": folder / f"{r.name}.fmu" for r in (PLANT, OBSERVER)}

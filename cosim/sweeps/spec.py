@@ -156,6 +156,21 @@ def load_spec(path: Path) -> SweepSpec:
     UserError
         The first mistake found, naming the file and the key; an empty spec (no key at
         all) too.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = Path(folder.name) / "gains.toml"
+    >>> _ = path.write_text('''scenario = "rigid"
+    ... duration = 0.5
+    ... [vary]
+    ... "observer.g_dist" = { distribution = "grid", values = [100.0, 200.0] }
+    ... ''', encoding="utf-8")
+    >>> spec = load_spec(path)
+    >>> spec.name, spec.scenario, spec.masses, spec.runs, spec.metrics
+    ('gains', 'rigid', 3, 2, ('k_error', 'B_error', 'runtime'))
+    >>> folder.cleanup()
     """
     from arcosim.experiments.scenarios import SCENARIOS
 

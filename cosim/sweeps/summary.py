@@ -39,7 +39,33 @@ def axis_label(name: str, units: Mapping[str, str]) -> str:
 
 
 def read_results(results: Path) -> list[dict[str, str]]:
-    """The rows of a results CSV, one per finished run (a cut-off last line is left out)."""
+    """The rows of a results CSV, one per finished run (a cut-off last line is left out).
+
+    Parameters
+    ----------
+    results : Path
+        A sweep's ``results.csv`` (:data:`arcosim.sweeps.RESULTS`), as :func:`sweep`
+        writes it.
+
+    Returns
+    -------
+    list of dict of str to str
+        One row per finished run: column → its text as written (an empty ``error``
+        for a run that succeeded). A last line cut off by an interrupted write is
+        left out.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> results = Path(folder.name) / "results.csv"
+    >>> _ = results.write_text('''run,observer.g_dist,runtime,error
+    ... 0,100.0,0.35,
+    ... 1,200.0,0.0''', encoding="utf-8")
+    >>> read_results(results)
+    [{'run': '0', 'observer.g_dist': '100.0', 'runtime': '0.35', 'error': ''}]
+    >>> folder.cleanup()
+    """
     with open(results, newline="", encoding="utf-8") as f:
         return [row for row in csv.DictReader(f) if complete(row)]
 
