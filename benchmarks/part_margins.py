@@ -25,21 +25,17 @@ import random
 from arcosim.control import sensorless_decay
 from arcosim.experiments import markdown_table
 from arcosim.fmu.flexchain import PARTS, defaults
+from benchmarks.control_margins import CHAINS, params
 
 #: The five-mass chain of ``benchmarks.control_margins`` (kg·m², N·m/rad, N·m·s/rad).
-J = (2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4)
-K = (0.4, 0.3, 0.5, 0.35, 0.45)
-B = (1.5e-5,) * 5
+J, K, B = CHAINS["five masses"]
 #: The control step (s): the project's.
 H = defaults.STEP
 
 
 def chain(j_scale: list[float], k_scale: list[float]) -> dict[str, float]:
     """The five-mass chain by the observer's names, each J_i and k_i scaled."""
-    values = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M}
-    for i, (j, k, b, fj, fk) in enumerate(zip(J, K, B, j_scale, k_scale), start=1):
-        values |= {f"J[{i}]": j * fj, f"k[{i}]": k * fk, f"B[{i}]": b}
-    return values
+    return params([j * f for j, f in zip(J, j_scale)], [k * f for k, f in zip(K, k_scale)], B)
 
 
 def main(argv: list[str] | None = None) -> None:

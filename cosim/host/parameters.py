@@ -49,11 +49,7 @@ def observer_values(n: int, assignments: Sequence[str]) -> dict[str, float]:
     from arcosim.fmu.arobserver.fmu import ReactionTorqueObserver
 
     variables = ReactionTorqueObserver.interface(n)
-    values: dict[str, float] = {
-        name: float(v.start)
-        for name, v in variables.items()
-        if v.causality == "parameter" and v.type in ("Real", "Integer")
-    }
+    values = _defaults(variables)
     values.update({k: float(v) for k, v in parameter_sets(variables, assignments).items()})
     return values
 
@@ -88,11 +84,7 @@ def controller_values(n: int, assignments: Sequence[str]) -> dict[str, float]:
     from arcosim.fmu.arcontroller.fmu import ActionReactionController
 
     variables = ActionReactionController.interface(n)
-    values = {
-        name: float(v.start)
-        for name, v in variables.items()
-        if v.causality == "parameter" and v.type in ("Real", "Integer")
-    }
+    values = _defaults(variables)
     for text in assignments:
         name, value = parse_assignment(text)
         check_name(name, variables, "the controller")
@@ -130,3 +122,12 @@ def controller_problems(n: int, values: Mapping[str, float]) -> list[str]:
         "Checked", (ActionReactionController,), {"n_masses": n, "value": lambda _, k: values[k]}
     )
     return checked.check_parameters(checked.__new__(checked))
+
+
+def _defaults(variables: Mapping) -> dict[str, float]:
+    """An FMU class's Real and Integer parameters at their start values (each in its unit)."""
+    return {
+        name: float(v.start)
+        for name, v in variables.items()
+        if v.causality == "parameter" and v.type in ("Real", "Integer")
+    }
