@@ -78,7 +78,7 @@ def settling(runs: Runs, controller: object, full_state: bool = False) -> float:
 def reach(chain_index: int, seeds: Sequence[int]) -> list[dict[str, object]]:
     """One row per seed and model: the bound, the shipped controller, the best fixed
     member and the controller without d̂ (settling times, s)."""
-    chain = CHAINS[chain_index]
+    chain = list(CHAINS.values())[chain_index]
     folder = ensure_built(chain.n)
     rows = []
     for seed in seeds:
@@ -160,7 +160,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
     args = p.parse_args(argv)
     started = time.perf_counter()
-    print(f"{CHAINS[args.chain].name}, seeds {args.seeds}", flush=True)
+    print(f"{list(CHAINS)[args.chain]}, seeds {args.seeds}", flush=True)
     text = markdown(reach(args.chain, args.seeds))
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)

@@ -35,19 +35,18 @@ import argparse
 import json
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from arcosim import UserError, ensure_built
+from arcosim import Chain, UserError, ensure_built
 from arcosim.experiments import (
     DISTANCE,
     I_MAX,
     MOVE_TIME,
     CascadeController,
     LoopRun,
-    MotionChain,
     MoveScore,
     Runs,
     cascade_gains,
@@ -66,18 +65,19 @@ from arcosim.host import INT_MAX
 from benchmarks import progress
 
 #: The chains: lowest modes 19.7, 17.1 and 13.4 rad/s (motor free), damped at 0.05–0.2 %.
-CHAINS = (
-    MotionChain("two-mass, heavy tip", (5e-4, 1.5e-3), (0.3, 0.15), (1e-5, 1e-5)),
-    MotionChain("three-mass, soft middle", (4e-4, 3e-4, 8e-4), (0.3, 0.12, 0.25), (1e-5,) * 3),
-    MotionChain("four-mass, soft", (3e-4, 4e-4, 3e-4, 5e-4), (0.15, 0.12, 0.15, 0.1), (1e-5,) * 4),
-)
+#: By their names in tables (kg·m², N·m/rad, N·m·s/rad).
+CHAINS = {
+    "two-mass, heavy tip": Chain(J=(5e-4, 1.5e-3), k=(0.3, 0.15), B=(1e-5, 1e-5)),
+    "three-mass, soft middle": Chain(J=(4e-4, 3e-4, 8e-4), k=(0.3, 0.12, 0.25), B=(1e-5,) * 3),
+    "four-mass, soft": Chain(J=(3e-4, 4e-4, 3e-4, 5e-4), k=(0.15, 0.12, 0.15, 0.1), B=(1e-5,) * 4),
+}
 #: The models per seed, in the table's order.
 MODELS = ("identified", "random errors", "J +10 %, k −10 %", "J −10 %, k +10 %")
 CRITERIA = ("settles", "residual", "near_bound", "no_limit_cycle")
 
 
 def score_seed(
-    chain: MotionChain,
+    chain: Chain,
     folder: Path,
     seed: int,
     corners: bool,
@@ -163,7 +163,7 @@ def geometry(distance: float, encoder_cpr: int) -> str:
 def run(
     out: Path,
     seeds: Sequence[int],
-    chains: Sequence[MotionChain],
+    chains: Mapping[str, Chain],
     progress: Callable[[str], None],
     encoder_cpr: int = ENCODER_CPR,
     distance: float = DISTANCE,
@@ -176,19 +176,19 @@ def run(
     per-seed results, the time (s)."""
     started = time.perf_counter()
     results: dict[str, dict] = {}
-    for chain in chains:
+    for name, chain in chains.items():
         folder = ensure_built(chain.n)
-        modes = chain_modes({"J_mo": defaults.J_M, **chain.plant_values()})[0]
+        modes = chain_modes({"J_mo": defaults.J_M, **chain.parameters()})[0]
         per_seed = {}
         for seed in seeds:
-            progress(f"{chain.name}: seed {seed}")
+            progress(f"{name}: seed {seed}")
             per_seed[str(seed)] = found = score_seed(
                 chain, folder, seed, seed == seeds[0], encoder_cpr, distance, without
             )
             failed = not all(all(m["criteria"].values()) for m in found.values())
             if stop_on_failure and failed:
                 break
-        results[chain.name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
+        results[name] = {"lowest_mode": float(modes[0]), "seeds": per_seed}
         if stop_on_failure and failed:
             break
     heading = f"Encoder: {encoder_cpr} counts per revolution. {geometry(distance, encoder_cpr)}"
@@ -333,7 +333,7 @@ def _execute(args: argparse.Namespace) -> int:
             f"--target-offset must be −1 … 1 counts past 1 rad, got {args.target_offset} "
             "(default 0)"
         )
-    chains = CHAINS[:1] if args.quick else CHAINS
+    chains = dict(list(CHAINS.items())[:1]) if args.quick else CHAINS
     seeds = range(1, args.seeds + 1)
     distance = target_distance(args.target_offset, args.encoder_cpr)
     result = run(

@@ -50,7 +50,6 @@ from arcosim.experiments import (
     MOVE_TIME,
     CascadeController,
     LoopRun,
-    MotionChain,
     OpenLoop,
     cascade_gains,
     chain_modes,
@@ -68,14 +67,13 @@ from benchmarks import control_accuracy, progress
 from benchmarks.simulators.thirdparty_plant import FMU_FILE, ThirdPartyChain, where
 
 #: The chain: control_accuracy's first (lowest mode 19.7 rad/s).
-_OURS = control_accuracy.CHAINS[0]
-CHAIN = MotionChain(_OURS.name, _OURS.J, _OURS.k, _OURS.B)
+NAME, CHAIN = next(iter(control_accuracy.CHAINS.items()))
 #: The motor's viscous friction (N·m·s/rad, the motor instance's damper); no Coulomb.
 D_M = defaults.D_M
 #: Runge–Kutta steps per 1 ms step in the runs (a count).
 SUBSTEPS = 1
 #: The same chain on the project's plant FMU (its start values).
-OWN_PLANT = {**CHAIN.plant_values(), "D_m": D_M, "f_c": 0.0}
+OWN_PLANT = {**CHAIN.parameters(), "D_m": D_M, "f_c": 0.0}
 #: The coupling check's current step (A) and its length (s), and the run's length (s).
 STEP_CURRENT, STEP_LENGTH, FREE_RUN = 0.2, 0.5, 2.0
 
@@ -128,7 +126,7 @@ def coupling(
 ) -> dict[str, object]:
     """The assembled chain against ``MotorChainPlant`` (same chain, f_c = 0, ideal
     sensors): modes and a current step's angles over ``duration`` (s)."""
-    truth = {"J_mo": defaults.J_M, "D_m": D_M, **CHAIN.plant_values()}
+    truth = {"J_mo": defaults.J_M, "D_m": D_M, **CHAIN.parameters()}
     modes, zeta = chain_modes(truth)
     with open_plant(folder, 1, ideal=True, substeps=substeps) as plant:
         A, _ = plant.jacobian()
@@ -197,7 +195,7 @@ def identification_errors(result: DriveIdentification) -> dict[str, object]:
     0, when the truth lies within it)."""
     p, s = {**result.friction, **result.parameters}, result.std
     bounds = dict(result.report().get("bounds", {}))
-    truth = {"D_m": D_M, "f_c": 0.0, **CHAIN.plant_values()}
+    truth = {"D_m": D_M, "f_c": 0.0, **CHAIN.parameters()}
     rows = {}
     for name, true in truth.items():
         if name not in p:
@@ -288,7 +286,7 @@ def run(
         (out / "thirdparty.json").write_text(json.dumps(partial, indent=1, default=str), "utf-8")
     lowest = check["modes"][0]
     controlled = {s: r["models"] for s, r in per_seed.items() if "models" in r}
-    moves = {f"third-party FMU chain, {CHAIN.name}": {"lowest_mode": lowest,
+    moves = {f"third-party FMU chain, {NAME}": {"lowest_mode": lowest,
                                                       "seeds": controlled}}  # fmt: skip
     tables = {
         "coupling": coupling_table(check),

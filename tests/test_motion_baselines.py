@@ -258,10 +258,10 @@ def test_experiment_on_the_bench_has_the_four_rows(fmus) -> None:
     from arcosim.experiments.motion.findings import DISTANCE, score_move
 
     params = {**BENCH, "f_c": defaults.F_C, "encoder_cpr": 2000, "g_dist": defaults.G_DIST}
-    runs = Runs(fmus, CHAINS[0], False).four(params)
+    runs = Runs(fmus, CHAINS["bench (n = 3)"], False).four(params)
     found = ChainFindings(n=3, moves={k: score_move(r, DISTANCE, DISTANCE, 2000)
                                       for k, r in runs.items()})  # fmt: skip
-    rows = move_rows({CHAINS[0].name: found})
+    rows = move_rows({"bench (n = 3)": found})
     assert [r[1] for r in rows] == list(CONTROLLERS) == list(runs)
     cascade, shaped = found.moves[CONTROLLERS[0]], found.moves[CONTROLLERS[1]]
     assert cascade.settle_1 == math.inf and cascade.residual > 5e-3
@@ -275,7 +275,7 @@ def test_runs_give_the_plant_the_encoder_asked_for(fmus) -> None:
     from arcosim.experiments.motion.findings import MOTION_DURATION
 
     push = OpenLoop(np.full(round(MOTION_DURATION / defaults.STEP), 0.1))
-    run = Runs(fmus, CHAINS[0], False, encoder_cpr=20000).run(push)
+    run = Runs(fmus, CHAINS["bench (n = 3)"], False, encoder_cpr=20000).run(push)
     counts = run.theta_m / (2 * math.pi / 20000)  # whole fine counts, as a 2000 would be too
     assert np.allclose(counts, np.round(counts), atol=1e-6) and np.ptp(counts) > 100
     coarse = run.theta_m / (2 * math.pi / 2000)
@@ -312,7 +312,9 @@ def test_a_bench_seed_identifies_designs_and_scores_with_its_encoder(monkeypatch
     monkeypatch.setattr(bench, "design_parameters", lambda r, i, c: seen.setdefault("design", c))
     monkeypatch.setattr(bench, "Runs", runs)
     with pytest.raises(StoppedError):
-        bench.score_seed(bench.CHAINS[0], None, 1, False, encoder_cpr=8192, distance=1.5)
+        bench.score_seed(
+            bench.CHAINS["two-mass, heavy tip"], None, 1, False, encoder_cpr=8192, distance=1.5
+        )
     assert seen == {"log": 8192, "design": 8192, "runs": (8192, 1.5)}
 
 

@@ -30,7 +30,7 @@ from tests.control_runs import ACTUATOR, BENCH_2, FIVE, closed_loop, observer_pa
 H = 1e-3
 COUNT = 2 * math.pi / 2000  # one encoder count (rad)
 #: `arcosim bench control`'s four-mass chain: 31.7 rad/(N·m) from the motor to the last mass.
-FOUR = {key: getattr(CHAINS[-1], key) for key in ("J", "k", "B")}
+FOUR = {key: getattr(CHAINS["four-mass, soft"], key) for key in ("J", "k", "B")}
 
 
 def _true_loop(design, chain: dict) -> np.ndarray:
@@ -153,7 +153,7 @@ def test_a_target_half_way_between_two_edges_holds_one_count(monkeypatch) -> Non
     within 0.3 count of one edge, it holds one. The price is the shift, at most 0.3 count
     (0.94 mrad) at the last mass: the residual stays within the benchmark's criterion for
     this chain, 0.1 × its cascade's 12.5 mrad."""
-    two = {key: getattr(CHAINS[0], key) for key in ("J", "k", "B")}
+    two = {key: getattr(CHAINS["two-mass, heavy tip"], key) for key in ("J", "k", "B")}
     target = 318.5 * COUNT
     for delay in (0, 1):
         run = closed_loop(two, target=target, delay=delay)

@@ -56,7 +56,6 @@ _API: dict[str, str] = {
     "CascadeController": "arcosim.experiments.motion.baselines",
     "cascade_gains": "arcosim.experiments.motion.baselines",
     "chain_modes": "arcosim.experiments.motion.baselines",
-    "MotionChain": "arcosim.experiments.motion.experiment",
     "identify_chain": "arcosim.experiments.motion.experiment",
     "design_parameters": "arcosim.experiments.motion.experiment",
     "sensorless": "arcosim.experiments.motion.experiment",

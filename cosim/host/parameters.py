@@ -12,7 +12,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from arcosim.errors import UserError
-from arcosim.host.overrides import check_name, parse_assignment, typed_value
 from arcosim.host.replay import parameter_sets
 
 
@@ -85,12 +84,10 @@ def controller_values(n: int, assignments: Sequence[str]) -> dict[str, float]:
 
     variables = ActionReactionController.interface(n)
     values = _defaults(variables)
-    for text in assignments:
-        name, value = parse_assignment(text)
-        check_name(name, variables, "the controller")
+    for name, value in parameter_sets(variables, assignments, "the controller").items():
         if name not in values:
-            raise UserError(f"--set {text!r}: {name} is not a parameter of the controller")
-        values[name] = float(typed_value(name, value, variables[name].type))
+            raise UserError(f"--set {name}: not a Real or Integer parameter of the controller")
+        values[name] = float(value)
     return values
 
 

@@ -129,13 +129,15 @@ def final_values(fmu: FmuInstance, recording: Recording, prefix: str = "observer
     return result
 
 
-def parameter_sets(variables: Mapping[str, object], assignments: Sequence[str]) -> dict:
-    """``--set`` texts (observer parameters, no prefix) as typed values, checked against
-    the observer's variables (anything with ``causality`` and ``type``, by name)."""
+def parameter_sets(
+    variables: Mapping[str, object], assignments: Sequence[str], owner: str = "the observer"
+) -> dict:
+    """``--set`` texts (parameters of ``owner``, no prefix) as typed values, checked against
+    its variables (anything with ``causality`` and ``type``, by name)."""
     parameters: dict[str, float | int | bool] = {}
     for text in assignments:
         name, value = parse_assignment(text)
-        check_name(name, variables, "the observer")
+        check_name(name, variables, owner)
         var = variables[name]
         if var.causality != "parameter":
             raise UserError(f"--set {text!r}: {name} is an {var.causality}, not a parameter")

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arcosim.fmu.flexchain.chain import spring_matrix
+from arcosim.fmu.flexchain.chain import Chain, spring_matrix
 
 #: The cascade's velocity bandwidth as a fraction of the chain's lowest mode.
 VELOCITY_FRACTION = 0.5
@@ -32,18 +32,6 @@ OUTER_FRACTION = 0.25
 #: the encoder's backward difference jumps by a whole count per step (3.1 rad/s at 2000
 #: counts and 1 ms).
 VELOCITY_FILTER = 5.0
-
-
-def chain_vectors(params: Mapping[str, float]) -> tuple[list[float], list[float], list[float]]:
-    """``J``, ``k``, ``B`` of the load chain (kg·m², N·m/rad, N·m·s/rad), each shape ``(n,)``.
-
-    Examples
-    --------
-    >>> chain_vectors({"J[1]": 1e-3, "k[1]": 0.5, "B[1]": 1e-5})
-    ([0.001], [0.5], [1e-05])
-    """
-    n = sum(1 for name in params if name.startswith("J["))
-    return tuple([float(params[f"{p}[{i}]"]) for i in range(1, n + 1)] for p in "JkB")
 
 
 def chain_modes(params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -68,18 +56,8 @@ def chain_modes(params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
     >>> round(float(f[0]), 6), abs(float(z[0])) < 1e-12  # sqrt(k (1/J_m + 1/J_1)), undamped
     (2.0, True)
     """
-    J, k, B = chain_vectors(params)
-    n = len(J)
-    M = np.diag([float(params["J_mo"]), *J])
-    C = np.array(spring_matrix(B))
-    C[0, 0] += float(params.get("D_m", 0.0))
-    A = np.block(
-        [
-            [np.zeros((n + 1, n + 1)), np.eye(n + 1)],
-            [-np.linalg.solve(M, np.array(spring_matrix(k))), -np.linalg.solve(M, C)],
-        ]
-    )
-    poles = np.linalg.eigvals(A)
+    chain = Chain.from_parameters({"D_m": 0.0, **params})
+    poles = np.linalg.eigvals(np.array(chain.state_space()[0]))
     size = np.abs(poles)
     # one of each oscillating pair; the rigid body's two poles at (or rounded near) 0 drop
     poles = poles[(poles.imag > 1e-9) & (size > 1e-6 * np.max(size))]
@@ -278,7 +256,8 @@ def cascade_modes(
     damping : ndarray
         Damping ratios (dimensionless), shape ``(M,)``.
     """
-    J, k, B = chain_vectors(params)
+    chain = Chain.from_parameters(params)
+    J, k, B = chain.J, chain.k, chain.B
     m = len(J) + 1
     inverse = np.linalg.inv(np.diag([float(params["J_mo"]), *J]))
     C = np.array(spring_matrix(B))

@@ -20,7 +20,6 @@ realistic sensors (2000-count encoder, 5 mA current noise) unless ``ideal``.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -52,67 +51,30 @@ from arcosim.experiments.motion.findings import (
 )
 from arcosim.experiments.scenarios import IDENTIFICATION_DURATION, identification_current
 from arcosim.fmu.flexchain import defaults
+from arcosim.fmu.flexchain.chain import Chain
 from arcosim.fmu.flexchain.defaults import ENCODER_CPR, G_DIST, STEP
 from arcosim.identification.drive_identification import DriveIdentification, identify_drive
 from arcosim.outputs import save_figure
 
-
-@dataclass(frozen=True)
-class MotionChain:
-    """A plant's chain for the motion experiment: its name and its n masses and springs.
-
-    Parameters
-    ----------
-    name : str
-        Its label in tables.
-    J : tuple of float
-        Load inertias J_1 … J_n (kg·m²), shape ``(n,)``.
-    k : tuple of float
-        Spring stiffnesses k_1 … k_n (N·m/rad), shape ``(n,)``.
-    B : tuple of float
-        Spring dampings B_1 … B_n (N·m·s/rad), shape ``(n,)``.
-
-    Examples
-    --------
-    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
-    >>> chain.n, chain.plant_values()["k[2]"]
-    (2, 0.4)
-    """
-
-    name: str
-    J: tuple[float, ...]
-    k: tuple[float, ...]
-    B: tuple[float, ...]
-
-    @property
-    def n(self) -> int:
-        """Number of load masses (a count)."""
-        return len(self.J)
-
-    def plant_values(self) -> dict[str, float]:
-        """The plant FMU's ``J[i]``, ``k[i]``, ``B[i]``."""
-        return {f"{p}[{i}]": v[i - 1] for p, v in zip("JkB", (self.J, self.k, self.B))
-                for i in range(1, self.n + 1)}  # fmt: skip
-
-
-#: The experiment's chains: the bench, and the accuracy benchmark's five-mass chain.
-CHAINS = (
-    MotionChain("bench (n = 3)", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3),
-    MotionChain("five-mass", (2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4), (0.4,) * 5, (1.5e-5,) * 5),
-)
+#: The experiment's chains by their names in tables: the bench, and the accuracy
+#: benchmark's five-mass chain (kg·m², N·m/rad, N·m·s/rad).
+CHAINS = {
+    "bench (n = 3)": Chain(J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3),
+    "five-mass": Chain(J=(2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4), k=(0.4,) * 5, B=(1.5e-5,) * 5),
+}
 
 
 def plant_settings(
-    chain: MotionChain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
+    chain: Chain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
 ) -> dict[str, float]:
     """The plant FMU's start values: the chain, the noise seed, the sensors (an encoder
     of ``encoder_cpr`` counts per revolution and 5 mA current noise, none if ``ideal``)."""
     sensors = {"encoder_cpr": 0, "i_noise_std": 0.0} if ideal else {"encoder_cpr": encoder_cpr}
-    return {**chain.plant_values(), "seed": seed, **sensors}
+    return {**chain.parameters(motor="J_m"), "seed": seed, **sensors}
 
 
 def identify_chain(
-    folder: Path, chain: MotionChain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
+    folder: Path, chain: Chain, ideal: bool, seed: int = SEED, encoder_cpr: int = ENCODER_CPR
 ) -> DriveIdentification:
     """The chain as :func:`arcosim.identify_drive` finds it in a log of the plant.
 
@@ -124,7 +86,7 @@ def identify_chain(
     ----------
     folder : Path
         Folder of FMUs built for ``chain.n`` masses (:func:`arcosim.ensure_built`).
-    chain : MotionChain
+    chain : Chain
         The plant's chain.
     ideal : bool
         Exact sensors (no current noise, an exact encoder) and the friction known.
@@ -141,7 +103,7 @@ def identify_chain(
     Examples
     --------
     >>> from arcosim import ensure_built
-    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
+    >>> chain = arcosim.Chain(J=(2e-4, 3e-4), k=(0.4, 0.4), B=(1e-5, 1e-5))
     >>> result = identify_chain(ensure_built(2), chain, ideal=True)
     >>> [round(J / true - 1.0, 2) for J, true in zip(result.chain.J, chain.J)]  # rel. error
     [0.0, 0.0]
@@ -186,7 +148,7 @@ def design_parameters(
     Examples
     --------
     >>> from arcosim import ensure_built
-    >>> chain = MotionChain("two-mass", (2e-4, 3e-4), (0.4, 0.4), (1e-5, 1e-5))
+    >>> chain = arcosim.Chain(J=(2e-4, 3e-4), k=(0.4, 0.4), B=(1e-5, 1e-5))
     >>> params = design_parameters(identify_chain(ensure_built(2), chain, True), True)
     >>> params["encoder_cpr"], round(params["k[1]"], 2)
     (0, 0.4)
@@ -290,9 +252,9 @@ def sensorless(params: Mapping[str, float], h: float = STEP, without: frozenset[
     Examples
     --------
     >>> from arcosim.fmu.flexchain import defaults
-    >>> chain = MotionChain("bench", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3)
+    >>> chain = arcosim.Chain(J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3)
     >>> motor = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": 0.0}
-    >>> controller = sensorless({**motor, **chain.plant_values()})
+    >>> controller = sensorless({**motor, **chain.parameters()})
     >>> abs(controller.step(STEP, 1.0, 0.0, 0.0, 0.0)) <= I_MAX  # A
     True
     """
@@ -330,7 +292,7 @@ class Runs:
     ----------
     folder : Path
         Folder of FMUs built for ``chain.n`` masses (:func:`arcosim.ensure_built`).
-    chain : MotionChain
+    chain : Chain
         The plant's chain.
     ideal : bool
         Exact sensors (no current noise, an exact encoder).
@@ -348,10 +310,10 @@ class Runs:
     --------
     >>> from arcosim import ensure_built
     >>> from arcosim.fmu.flexchain import defaults
-    >>> chain = MotionChain("bench", defaults.J, (defaults.K,) * 3, (defaults.B,) * 3)
+    >>> chain = arcosim.Chain(J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3)
     >>> runs = Runs(ensure_built(3), chain, ideal=True)
     >>> motor = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": 0.0}
-    >>> run = runs.run(sensorless({**motor, **chain.plant_values()}), full_state=True)
+    >>> run = runs.run(sensorless({**motor, **chain.parameters()}), full_state=True)
     >>> float(run.time[-1]), bool(abs(run.last[-1] - DISTANCE) < 0.01)  # s; within 1 %
     (6.0, True)
     """
@@ -359,7 +321,7 @@ class Runs:
     def __init__(
         self,
         folder: Path,
-        chain: MotionChain,
+        chain: Chain,
         ideal: bool,
         progress: Callable[[int], object] = lambda _steps: None,
         seed: int = SEED,
@@ -394,13 +356,15 @@ class Runs:
 
 def run_chain(
     folder: Path,
-    chain: MotionChain,
+    name: str,
+    chain: Chain,
     ideal: bool,
     status: Callable[[str], object],
     progress: Callable[[int], object],
 ) -> tuple[ChainFindings, dict[str, LoopRun]]:
-    """The experiment on one chain; its findings and the four nominal runs (the figure's)."""
-    status(f"motion control, {chain.name}: identification")
+    """The experiment on the chain called ``name``; its findings and the four nominal runs
+    (the figure's)."""
+    status(f"motion control, {name}: identification")
     result = identify_chain(folder, chain, ideal)
     progress(round(IDENTIFICATION_DURATION / STEP))
     params = design_parameters(result, ideal)
@@ -416,16 +380,16 @@ def run_chain(
         + ", ".join(f"{w:.1f}" for w, _ in shaped_modes(params, gains))
         + " rad/s",
     )
-    status(f"motion control, {chain.name}: the four controllers")
+    status(f"motion control, {name}: the four controllers")
     nominal = runs.four(params)
     found.moves = {k: score_move(r, DISTANCE, DISTANCE, runs.cpr) for k, r in nominal.items()}
-    status(f"motion control, {chain.name}: load-torque step")
+    status(f"motion control, {name}: load-torque step")
     found.loads = {
         k: score_load(r, DISTANCE, DISTANCE, LOAD_TIME, runs.cpr)
         for k, r in runs.four(params, load=True).items()
     }
     for label, (fJ, fk) in model_errors(chain.n, ERROR_SEEDS).items():
-        status(f"motion control, {chain.name}: model error {label}")
+        status(f"motion control, {name}: model error {label}")
         wrong = scaled(params, fJ, fk)
         found.errors[label] = tuple(
             score_move(runs.run(sensorless(wrong), full_state=full), DISTANCE, DISTANCE, runs.cpr)
@@ -434,7 +398,7 @@ def run_chain(
     return found, nominal
 
 
-def _identification_error(chain: MotionChain, result: DriveIdentification) -> dict[str, float]:
+def _identification_error(chain: Chain, result: DriveIdentification) -> dict[str, float]:
     """The largest |error| of the identified J_i and k_i against the plant's (%)."""
     p = result.parameters
     return {
@@ -474,9 +438,9 @@ def motion_control(
     """
     results: MotionResults = {}
     nominal = {}
-    for chain in CHAINS:
+    for name, chain in CHAINS.items():
         folder = bench_folder if chain.n == 3 else ensure_built(chain.n)
-        results[chain.name], nominal[chain.name] = run_chain(folder, chain, ideal, status, progress)
+        results[name], nominal[name] = run_chain(folder, name, chain, ideal, status, progress)
     return results, figure_motion(nominal, out / FIGURE)
 
 
