@@ -53,8 +53,8 @@ What it reports:
   :data:`SCORE_BLOCK` of the memory (a Newey–West-like estimate in constant memory),
   ``1 / (1 − λ²)`` the forgetting weights' sum of squares, ``P₀⁻¹`` the prior's share.
   The DOB's filter, the prefilter, the encoder and what the model leaves out colour the
-  score for far longer than a step: ``P`` alone, the covariance for white innovations,
-  made σ several times too small and the alarm fire on healthy runs. The cubic-cost
+  score for far longer than a step, and ``P`` alone, the covariance for white
+  innovations, counts each sample as new. The cubic-cost
   sandwich is formed once a block; between, σ_j² is ``P_jj`` times its ratio then;
 * ``valid``: the motion is persistently exciting for every stiffness and the Coulomb
   friction: each one's ``P_jj`` is at most ``(EXCITED_SHARE · PRIOR_STD)²``, so
@@ -174,9 +174,8 @@ EXCITED_SHARE = 0.5
 #: (batch means): a block, 3 s at the default minute, is long beside the correlation of
 #: the prefiltered score (the prefilter's 20 ms, the chain's modes, a 1-s move), and the
 #: memory holds 2/this = 40 blocks' worth of weight, so the covariance is known to
-#: about √(1/40) ≈ 16 %. With the AR(1) inflation of the innovation at lag one instead,
-#: the two-mass healthy run raised 3 alarms after its first minute: the score's
-#: correlation lasts far longer than one lag tells.
+#: about √(1/40) ≈ 16 %. The AR(1) inflation of the innovation at lag one it replaces
+#: saw the prefilter's colour, not a score correlated over seconds.
 SCORE_BLOCK = 0.05
 
 
