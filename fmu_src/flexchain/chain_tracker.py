@@ -54,8 +54,8 @@ What it reports:
   ``1 / (1 − λ²)`` the forgetting weights' sum of squares, ``P₀⁻¹`` the prior's share.
   The DOB's filter, the prefilter, the encoder and what the model leaves out colour the
   score for far longer than a step, and ``P`` alone, the covariance for white
-  innovations, counts each sample as new. The cubic-cost
-  sandwich is formed once a block; between, σ_j² is ``P_jj`` times its ratio then;
+  innovations, counts each sample as new. The cubic-cost sandwich is formed once a
+  block; between, σ_j² is ``P_jj`` times its ratio to it then;
 * ``valid``: the motion is persistently exciting for every stiffness and the Coulomb
   friction: each one's ``P_jj`` is at most ``(EXCITED_SHARE · PRIOR_STD)²``, so
   what the motion taught about it outweighs the prior (:data:`EXCITED_SHARE`). ``P_jj``
@@ -469,7 +469,7 @@ class ChainTracker:
         self.block_steps += 1
         self.block_time += h
         if self.block_time >= SCORE_BLOCK * self.tracking_time:
-            self.close_block()
+            self.close_block(lam)
         p = self.p
         # the prior's information, forgotten as the data's, renewed at the same rate
         # (stabilized forgetting): each step pulls p towards p0 by (1 − λ) P P0⁻¹ (p0 − p)
@@ -503,9 +503,11 @@ class ChainTracker:
         for i in range(n, 2 * n + 2):
             p[i] = min(max(p[i], 0.0), DISSIPATION_MAX)
 
-    def close_block(self) -> None:
+    def close_block(self, lam: float) -> None:
         """Fold the present block's score into its long-run covariance Ω (batch means,
-        weighted as the memory weighs its samples) and start a new block."""
+        weighted as the memory weighs its samples), start a new block, and take the
+        ratio of the sandwich to ``P``'s diagonal at ``lam``, the last step's forgetting
+        factor (dimensionless)."""
         decay = max(0.0, 1.0 - self.block_time / self.tracking_time)
         g, steps = self.block_score, self.block_steps
         for row, gi in zip(self.score_covariance, g):
@@ -515,17 +517,18 @@ class ChainTracker:
         self.block_score = [0.0] * len(g)
         self.block_time, self.block_steps = 0.0, 0
         P = self.P
-        self.ratio = [v / P[i][i] for i, v in enumerate(self.variances()[: len(self.ratio)])]
+        v = self.variances(lam)
+        self.ratio = [v[i] / P[i][i] for i in range(len(self.ratio))]
 
-    def variances(self) -> list[float]:
+    def variances(self, lam: float) -> list[float]:
         """The tracked parameters' variances in units of their scales squared, shape
         ``(2n + 3,)``: the sandwich ``P (P₀⁻¹ + Ω / (1 − λ²)) P``, the prior's share and
         the data's, Ω the score's long-run covariance per step (batch means over
         :data:`SCORE_BLOCK`), ``Σ λ^2age = 1 / (1 − λ²)`` the weights' sum of squares
-        (λ at the last step). White innovations give about P / 2 where the data rule;
-        correlated ones, what their correlation costs; at rest, the prior."""
+        at the forgetting factor ``lam`` (dimensionless, < 1). White innovations give
+        about P / 2 where the data rule; correlated ones, what their correlation costs;
+        at rest, the prior."""
         P, size = self.P, len(self.P)
-        lam = 1.0 - (self.h_d or 1e-3) / self.tracking_time
         w = self.score_weight
         data = 1.0 / ((1.0 - lam * lam) * w) if w > 0.0 else 0.0
         M = [
