@@ -68,6 +68,7 @@ def test_at_rest_it_learns_nothing():
     assert tr.P == prior
     assert not tr.valid and not tr.alarm
     assert tr.values()[:2] == list(K2)
+    assert tr.stds()[:2] == pytest.approx([PRIOR_STD * k for k in K2], rel=1e-12)
 
 
 @pytest.mark.slow
@@ -175,3 +176,30 @@ def test_no_alarm_while_friction_is_not_taught():
     tr.learnt = tr.tracking_time
     tr.judge()
     assert not tr.valid and not tr.alarm
+
+
+def sigma_k1(rho: float, steps: int = 8000) -> float:
+    """σ of k_1 (in units of its scale) after ``steps`` least-squares steps on a constant
+    regressor and an AR(1) error of unit variance and lag-one correlation ``rho``, with a
+    memory of 2 s at 1 ms (40 score blocks of 50 steps)."""
+    rng = np.random.default_rng(3)
+    tr = ChainTracker(J2, K2, B2, defaults.F_C, defaults.D_M, G, NoiseModel(1e-3, 1e-4, 1.0),
+                      0.0, 0.0, 2.0, 0.05)  # fmt: skip
+    psi = [1.0] + [0.0] * (len(tr.p) - 1)
+    e = 0.0
+    for _ in range(steps):
+        e = rho * e + math.sqrt(1.0 - rho * rho) * rng.standard_normal()
+        tr.learn(H, e, psi)
+    return tr.stds()[0] / tr.scale[0]
+
+
+@pytest.mark.slow
+def test_sigma_grows_with_the_scores_correlation():
+    """The sandwich σ against the long-run variance: an AR(1) score of ρ = 0.9 carries
+    (1 + ρ)/(1 − ρ) = 19 times a white one's variance; batch means over 50-step blocks
+    see 19 − 2ρ/(50 (1 − ρ)²)·(1 − ρ⁵⁰) ≈ 15.4 of it, each estimate to about √(2/40)
+    (40 blocks' weight in the memory), so the ratio of the two is 15.4 within a factor
+    of 1.5 (some 2σ of the pair). The covariance ``P`` alone, for white innovations,
+    would give the same σ to both."""
+    ratio = (sigma_k1(0.9) / sigma_k1(0.0)) ** 2
+    assert 15.4 / 1.5 < ratio < 15.4 * 1.5, ratio
