@@ -32,7 +32,7 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
     | {"t", "_moved", "_h", "still"}
-    | {"open_loop", "score", "factors", "_other"}  # the bank's choice: a switch, not a state
+    | {"_other"}  # the estimator's other gain's designs: a cache
 )
 #: When the loop is linearized: this long after the move ends (s).
 AFTER_MOVE = 0.6
@@ -147,7 +147,7 @@ def sensorless_loop(
     steps = round((wait + AFTER_MOVE) / h)
     within = deque(maxlen=max(1, round(SETTLE_WINDOW / h)))  # the command below i_max
     for k in range(steps + (round(QUIET_WAIT / h) if hold else 0)):
-        if k >= steps and loop.controller.bank.quiet:
+        if k >= steps and loop.controller.estimator.quiet:
             break
         advance(loop)
         within.append(abs(loop.signals[3]) < design.i_max)
@@ -226,9 +226,6 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     if loop.hold:
         paths = [p for p in paths if p[:2] != ("controller", "dither") or p[2] == "observer"]
         paths = [p for p in paths if p[:2] != ("controller", "edge")]
-    # of the estimator bank, the member the feedback takes: the others feed nothing back
-    pick = ("controller", "bank", "members", loop.controller.bank.pick)
-    paths = [p for p in paths if p[:3] != pick[:3] or p[:4] == pick]
     z0 = np.array([_get(loop, p) for p in paths])
 
     def stepped(path=None, value=0.0) -> np.ndarray:

@@ -18,7 +18,7 @@ from .. import defaults
 
 @dataclass(frozen=True)
 class Sample:
-    """One step of a move as the bank's estimators took it.
+    """One step of a move as the controller's estimator took it.
 
     Attributes
     ----------
@@ -40,7 +40,7 @@ class Sample:
 
 
 class MoveRecord:
-    """What a move gives the bank's estimators, one step at a time (module doc).
+    """What a move gives the controller's estimator, one step at a time (module doc).
 
     Parameters
     ----------
