@@ -32,6 +32,7 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
     | {"t", "_moved", "_h", "still"}
+    | {"elapsed", "_trusted_for"}  # the move's record's clocks (kept with the refit off)
     | {"_other"}  # the estimator's other gain's designs: a cache
 )
 #: When the loop is linearized: this long after the move ends (s).
