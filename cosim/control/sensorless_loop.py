@@ -43,7 +43,7 @@ AFTER_MOVE = 0.6
 #: observer, and the hold's edge keeper (``hold_edge``: a switch between edges of the
 #: encoder, which the exact angle here does not have; its low-pass would show as a pole).
 HOLD_UNPERTURBED = frozenset({"target"})
-#: With ``hold``: how much longer the run may go on for the estimators to take the hold's
+#: With ``hold``: how much longer the run may go on for the estimator to take the hold's
 #: gain (s; the controller switches once the controlled mass is still).
 QUIET_WAIT = 2.0
 #: The loop counts as come to rest when, over this last stretch of the run (s), the command
@@ -97,8 +97,8 @@ def sensorless_loop(
     (:mod:`~arcosim.fmu.flexchain.control.hold_dither`: the feedback's motor angle and velocity from
     the dither's observer, as in the runs), while the plant's angle stays exact and
     friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts and
-    then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain (if they
-    never do, it is linearized with the move's, as the FMU would run on).
+    then, up to :data:`QUIET_WAIT` more, until the estimator runs the hold's gain (if it
+    never does, it is linearized with the move's, as the FMU would run on).
 
     Parameters
     ----------

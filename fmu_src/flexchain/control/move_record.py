@@ -27,7 +27,7 @@ class Sample:
     tau_reac_hat : float
         τ̂_reac at its end (N·m).
     theta_m : float
-        The motor angle the estimators took there (rad).
+        The motor angle the estimator took there (rad).
     trusted : bool
         Whether the DOB's friction was known over the last
         ``defaults.REFINE_TRUST_AFTER`` s (module doc).
@@ -87,7 +87,7 @@ class MoveRecord:
         tau_reac_hat : float
             τ̂_reac at its end (N·m).
         theta_m : float
-            The motor angle the estimators take (rad).
+            The motor angle the estimator takes (rad).
         heading : float
             The direction the DOB was told the motor runs (−1, 0 or +1).
         """
