@@ -7,7 +7,7 @@
 - :mod:`benchmarks.controller_speed`: the controller FMU's µs per step through fmpy for
   1, 3 and 5 masses (``python -m benchmarks.controller_speed``);
 - :mod:`benchmarks.part_margins`: the sensorless loop's decay under model errors with a
-  controller part switched off (``python -m benchmarks.part_margins --without bank``);
+  controller part switched off (``python -m benchmarks.part_margins --without move_refit``);
 - :mod:`benchmarks.public_records`: ``check`` and ``identify`` on public measured records
   of real drives against their published values (``arcosim bench public --data DIR``);
 - :mod:`benchmarks.memory`, :mod:`benchmarks.noise_envelope`: measurements run as scripts;
@@ -33,7 +33,6 @@ The rows and their parts:
   without a user's mistake (``arcosim bench verdict``);
 - :mod:`benchmarks.control_accuracy`: sensorless motion control against its four criteria
   (``arcosim bench control``); :mod:`benchmarks.control_margins`, the controller's margins;
-  :mod:`benchmarks.bank_reach`, how far the estimator bank reaches;
 - :mod:`benchmarks.fleet_accuracy`: the fleet's drift alarms and its scaling
   (``arcosim bench fleet``); :mod:`benchmarks.fleet_store`, the rows per second its
   store takes (``python -m benchmarks.fleet_store``);

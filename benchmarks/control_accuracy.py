@@ -308,8 +308,8 @@ def parse_without(text: str) -> frozenset[str]:
 
     Examples
     --------
-    >>> sorted(parse_without("bank,move_refit"))
-    ['bank', 'move_refit']
+    >>> sorted(parse_without("hold_gain,move_refit"))
+    ['hold_gain', 'move_refit']
     """
     parts = frozenset(p.strip() for p in text.split(",") if p.strip())
     unknown = sorted(parts - set(PARTS))

@@ -12,7 +12,7 @@ friction, so that the loop is linear).
 
 Run::
 
-    python -m benchmarks.part_margins --without bank [--error 0.3] [--seeds 6]
+    python -m benchmarks.part_margins --without move_refit [--error 0.3] [--seeds 6]
 
 About 2 s per model on the 2-core machine.
 """

@@ -91,7 +91,7 @@ def test_a_hold_that_grows_where_the_move_decays_is_named_with_its_way_out() -> 
 def test_the_five_mass_chain_is_refused_at_thirty_percent_naming_the_model(
     capsys, tmp_path: Path
 ) -> None:
-    """Robust to ±20 % with the bank refined from the move (docs/control.md#margins); at
+    """Robust to ±20 % with the model refitted from the move (docs/control.md#margins); at
     ±30 % a random model's error grows at the chain's top modes: exit 1, the model and the
     frequency named, and the smaller error it passes."""
     path = chain_file(tmp_path, "five masses")

@@ -1,5 +1,6 @@
-"""The bank's chain refined from a move (``move_fit``): which samples count, what the fit
-recovers mass by mass, when it refuses, and the controller's refined model on a plant."""
+"""The controller's chain refitted from a move (``move_fit``, ``refined_estimator``): which
+samples count, what the fit recovers mass by mass, when it refuses, and the controller's
+refitted model on a plant."""
 
 from __future__ import annotations
 
@@ -9,8 +10,8 @@ import pytest
 
 from arcosim.fmu.flexchain import defaults
 from arcosim.fmu.flexchain.control.controller import shaped_step
-from arcosim.fmu.flexchain.control.estimator_bank import EstimatorBank
 from arcosim.fmu.flexchain.control.move_fit import MoveRecord, Sample, fit_chain
+from arcosim.fmu.flexchain.control.refined_estimator import RefinedEstimator
 from arcosim.fmu.flexchain.load_observer import LoadTorqueObserver
 from arcosim.fmu.flexchain.model_observer import NoiseModel
 from tests.control_runs import closed_loop
@@ -21,7 +22,7 @@ TRUE_J = (3e-4, 4e-4, 3e-4)
 TRUE_K = (0.15, 0.12, 0.15)
 B = (1e-5,) * 3
 #: The model's errors, a different one on every J_i and k_i (no pair of common factors
-#: reproduces them: the bank's members cannot).
+#: on every J_i and every k_i reproduces them).
 J_ERR = (1.08, 0.93, 1.05)
 K_ERR = (0.92, 1.07, 0.95)
 
@@ -90,39 +91,39 @@ def test_the_fit_refuses_what_the_data_cannot_support():
     assert fit_chain(estimator(TRUE_J, stiff), samples, **wide) is None
 
 
-def test_refine_replaces_the_chosen_member_and_ends_the_choice():
+def test_refine_replaces_the_estimator_and_ends_the_record():
     model_J = tuple(j * e for j, e in zip(TRUE_J, J_ERR))
     model_k = tuple(k * e for k, e in zip(TRUE_K, K_ERR))
-    bank = EstimatorBank(estimator(model_J, model_k))
-    bank.restart()
+    refined = RefinedEstimator(estimator(model_J, model_k))
+    refined.restart()
     for sample in move_samples(TRUE_J, TRUE_K):
-        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 1.0)
-    pick, before = bank.pick, bank.chosen
-    fit = bank.refine()
-    assert fit is bank.fit and bank.refined and bank.record is None
-    assert bank.pick == pick and bank.chosen is not before
-    start_J = bank.chosen.J
-    assert start_J == pytest.approx([a * f for a, f in zip(before.J, fit.J_factors)], rel=0.08)
-    # the refined member's estimate follows the truth's state: the fit's model run with
-    # the Kalman correction over the move
-    replayed = estimator(bank.chosen.J, bank.chosen.k)
+        refined.step(sample.h, sample.tau_reac_hat, sample.theta_m, 1.0)
+    before = refined.filter
+    fit = refined.refine()
+    assert fit is refined.fit and refined.refined
+    assert refined.record is None and refined.start is None
+    assert refined.filter is not before and refined.belief is fit.belief
+    # the factors count from the chain as designed, which was the estimator's
+    assert refined.filter.J == pytest.approx([a * f for a, f in zip(model_J, fit.J_factors)])
+    assert refined.filter.k == pytest.approx([a * f for a, f in zip(model_k, fit.k_factors)])
+    # the refitted estimate follows the truth's state: the fit's model run with the
+    # Kalman correction over the move from the move's start
+    replayed = estimator(refined.filter.J, refined.filter.k)
     for sample in move_samples(TRUE_J, TRUE_K):
         replayed.step(sample.h, sample.tau_reac_hat, sample.theta_m)
-    assert bank.chosen.s == pytest.approx(replayed.s, abs=1e-12)
-    scores = list(bank.score)
-    bank.step(H, 0.0, 0.7, True, 1.0)  # no more choosing, nor scoring, until a restart
-    assert bank.score == scores and bank.refine() is None
+    assert refined.filter.s == pytest.approx(replayed.s, abs=1e-12)
+    refined.step(H, 0.0, 0.7, 1.0)  # the record ended: nothing more to refit from
+    assert refined.record is None and refined.refine() is None
 
 
-def test_a_refusal_keeps_the_member():
-    bank = EstimatorBank(estimator(TRUE_J, TRUE_K))
-    bank.restart()
+def test_a_refusal_keeps_the_estimator():
+    refined = RefinedEstimator(estimator(TRUE_J, TRUE_K))
+    refined.restart()
     for sample in move_samples(TRUE_J, TRUE_K):
-        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 0.0)  # no heading
-    before, scores = bank.chosen, list(bank.score)
-    assert bank.refine() is None and bank.chosen is before and not bank.refined
-    bank.step(H, 0.0, 0.7, True, 0.0)  # the choice goes on as without the refinement
-    assert bank.score != scores and bank.record is None
+        refined.step(sample.h, sample.tau_reac_hat, sample.theta_m, 0.0)  # no heading
+    before = refined.filter
+    assert refined.refine() is None and refined.filter is before and not refined.refined
+    assert refined.belief is None and refined.record is None
 
 
 #: The four-mass chain of ``arcosim bench control`` (modes from about 10 rad/s).
@@ -133,16 +134,16 @@ FOUR = dict(J=(3e-4, 4e-4, 3e-4, 5e-4), k=(0.15, 0.12, 0.15, 0.1), B=(1e-5,) * 4
 @pytest.mark.parametrize("a, b", [(1.1, 0.9), (0.9, 1.1)])
 def test_the_controller_refines_towards_the_plant(a, b):
     """On the four-mass chain's Python plant (2000-count encoder, 5 mA current noise),
-    designed on every J_i × a and every k_i × b: after the move the chosen model is
-    within 3 % of the plant on every J_i and k_i. The bank's own grid (±7 %) reaches
-    3.8 % at best (measured: 2.3 % and 3.8 % on its nearest member; refined, at most 2.3 %)."""
+    designed on every J_i × a and every k_i × b (10 % off): after the move the refitted
+    model is within 3 % of the plant on every J_i and k_i, a third of the error it was
+    designed with."""
     model = dict(FOUR, J=tuple(a * j for j in FOUR["J"]), k=tuple(b * k for k in FOUR["k"]))
     run = closed_loop(FOUR, model, stop=1.0)
-    bank = run.extra["controller"].bank
-    assert bank.fit is not None and bank.refined
-    chosen = bank.chosen
-    for found, true in zip(chosen.J + chosen.k, FOUR["J"] + FOUR["k"]):
-        assert abs(math.log(found / true)) < 0.03
+    refined = run.extra["controller"].estimator
+    assert refined.fit is not None and refined.refined
+    found = refined.filter
+    for value, true in zip(found.J + found.k, FOUR["J"] + FOUR["k"]):
+        assert abs(math.log(value / true)) < 0.03
 
 
 def test_a_model_that_already_predicts_the_move_is_not_refitted():
@@ -152,21 +153,20 @@ def test_a_model_that_already_predicts_the_move_is_not_refitted():
     assert fit_chain(estimator(TRUE_J, TRUE_K), samples) is None
 
 
-def test_a_refined_bank_keeps_its_fit_on_a_weak_move_and_rests_its_choice():
+def test_a_refitted_model_is_kept_on_a_weak_move():
     model_J = tuple(j * e for j, e in zip(TRUE_J, J_ERR))
     model_k = tuple(k * e for k, e in zip(TRUE_K, K_ERR))
-    bank = EstimatorBank(estimator(model_J, model_k))
+    refined = RefinedEstimator(estimator(model_J, model_k))
     strong = move_samples(TRUE_J, TRUE_K, duration=0.7, move_time=0.5)  # a faster move
-    bank.restart()
+    refined.restart()
     for sample in strong:
-        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 1.0)
-    first = bank.refine()
+        refined.step(sample.h, sample.tau_reac_hat, sample.theta_m, 1.0)
+    first = refined.refine()
     assert first is not None and first.cost_before > defaults.REFINE_AGAIN
-    refined, beliefs = bank.chosen, list(bank.beliefs)
-    # the next move: the refined model predicts it within REFINE_AGAIN, so no refit; the
-    # choice rests for good once a member was refined
-    bank.restart()
+    model, belief = refined.filter, refined.belief
+    # the next move: the refitted model predicts it within REFINE_AGAIN, so no refit
+    refined.restart()
     for sample in move_samples(TRUE_J, TRUE_K):
-        bank.step(sample.h, sample.tau_reac_hat, sample.theta_m, True, 1.0)
-    assert bank.score == [0.0] * len(bank.members)  # not scored: the choice rests
-    assert bank.refine() is None and bank.chosen.J == refined.J and bank.beliefs == beliefs
+        refined.step(sample.h, sample.tau_reac_hat, sample.theta_m, 1.0)
+    assert refined.refine() is None and refined.filter.J == model.J
+    assert refined.belief is belief

@@ -126,7 +126,7 @@ class ControllerMargins:
     ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
     >>> found = arcosim.controller_margins(chain, h=1e-3, random_models=0)
     >>> found.robust, round(found.worst.decay, 1)  # 1/s: the slowest of the two corners
-    (True, 3.9)
+    (True, 4.0)
     """
 
     design: ControllerDesign

@@ -32,7 +32,8 @@ from arcosim.plant.motorchain.physics import PlantPhysics
 UNPERTURBED = frozenset(
     {"_models", "_designs", "design", "settings", "a", "b", "a_stuck", "b_stuck"}
     | {"t", "_moved", "_h", "still"}
-    | {"open_loop", "score", "factors", "_other"}  # the bank's choice: a switch, not a state
+    | {"elapsed", "_trusted_for"}  # the move's record's clocks (kept with the refit off)
+    | {"_other"}  # the estimator's other gain's designs: a cache
 )
 #: When the loop is linearized: this long after the move ends (s).
 AFTER_MOVE = 0.6
@@ -42,7 +43,7 @@ AFTER_MOVE = 0.6
 #: observer, and the hold's edge keeper (``hold_edge``: a switch between edges of the
 #: encoder, which the exact angle here does not have; its low-pass would show as a pole).
 HOLD_UNPERTURBED = frozenset({"target"})
-#: With ``hold``: how much longer the run may go on for the estimators to take the hold's
+#: With ``hold``: how much longer the run may go on for the estimator to take the hold's
 #: gain (s; the controller switches once the controlled mass is still).
 QUIET_WAIT = 2.0
 #: The loop counts as come to rest when, over this last stretch of the run (s), the command
@@ -96,8 +97,8 @@ def sensorless_loop(
     (:mod:`~arcosim.fmu.flexchain.control.hold_dither`: the feedback's motor angle and velocity from
     the dither's observer, as in the runs), while the plant's angle stays exact and
     friction stays out; the loop is run to :data:`AFTER_MOVE` after the dither starts and
-    then, up to :data:`QUIET_WAIT` more, until the estimators run the hold's gain (if they
-    never do, it is linearized with the move's, as the FMU would run on).
+    then, up to :data:`QUIET_WAIT` more, until the estimator runs the hold's gain (if it
+    never does, it is linearized with the move's, as the FMU would run on).
 
     Parameters
     ----------
@@ -147,7 +148,7 @@ def sensorless_loop(
     steps = round((wait + AFTER_MOVE) / h)
     within = deque(maxlen=max(1, round(SETTLE_WINDOW / h)))  # the command below i_max
     for k in range(steps + (round(QUIET_WAIT / h) if hold else 0)):
-        if k >= steps and loop.controller.bank.quiet:
+        if k >= steps and loop.controller.estimator.quiet:
             break
         advance(loop)
         within.append(abs(loop.signals[3]) < design.i_max)
@@ -226,9 +227,6 @@ def sensorless_jacobian(loop: SensorlessLoop) -> np.ndarray:
     if loop.hold:
         paths = [p for p in paths if p[:2] != ("controller", "dither") or p[2] == "observer"]
         paths = [p for p in paths if p[:2] != ("controller", "edge")]
-    # of the estimator bank, the member the feedback takes: the others feed nothing back
-    pick = ("controller", "bank", "members", loop.controller.bank.pick)
-    paths = [p for p in paths if p[:3] != pick[:3] or p[:4] == pick]
     z0 = np.array([_get(loop, p) for p in paths])
 
     def stepped(path=None, value=0.0) -> np.ndarray:

@@ -75,7 +75,7 @@ _API: dict[str, str] = {
     "step_model": ".model_observer",
     "NOISE_RANGE": ".model_observer",
     "NOISE_RATIO": ".model_observer",
-    "EstimatorBank": ".control.estimator_bank",
+    "RefinedEstimator": ".control.refined_estimator",
     "PARTS": ".control.controller",
     "LINK_ELEMENTS": ".defaults",
 }

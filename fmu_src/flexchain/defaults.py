@@ -117,20 +117,7 @@ CONTROL_MOVING_SPEED = 0.6
 #: chain's corners (`arcosim bench control`) settled at 2.45 and 1.81 s against full-state
 #: bounds of 1.52 and 1.38 s; with the edges at 1.45 and 1.73 s (docs/design/dob-heading.md).
 SLIDING_INTERVAL = 10e-3
-#: The controller's estimator bank (:mod:`~arcosim.fmu.flexchain.control.estimator_bank`): every
-#: J_i, and independently every k_i, of the chain scaled by each of these (dimensionless;
-#: 3 × 3 models, the chain itself among them). ±7 %, not the ±10 % the controller is
-#: scored at, so that its corners are not in the bank (docs/design/estimator-bank.md).
-BANK_SCALES = (0.93, 1.0, 1.07)
-#: The time over which a member's squared open-loop error of τ̂_reac is averaged (s).
-BANK_MEMORY = 0.5
-#: The bank moves to another member only when its score is below (1 − this) × the present
-#: one's (dimensionless): with none, the choice changed between members that predict alike.
-BANK_HYSTERESIS = 0.3
-#: The bank chooses from a move's response only: from its start until this share of the
-#: move time after it (dimensionless).
-BANK_CHOICE_AFTER = 0.5
-#: The bank refines its chosen model's every J_i and k_i from a move's response
+#: The controller refits its estimator's every J_i and k_i from a move's response
 #: (:mod:`~arcosim.fmu.flexchain.control.move_fit`) this share of the move time after the move's
 #: start (dimensionless). On `arcosim bench control`'s four-mass chain (20 seeds, 42 runs;
 #: a prototype) 0.6, 0.7 and 0.8 met all four criteria on 36, 38 and 35 (none, 23): the
@@ -161,7 +148,7 @@ REFINE_MIN_TRUSTED_TIME = 0.05
 #: the model's errors from the noise (on the four-mass chain of `arcosim bench control` the
 #: identified chain's cost was 0.5–1.2, ±10 % models' 1.7–177) …
 REFINE_MIN_EVIDENCE = 3.0
-#: … the least cost at which a member already refined refits (dimensionless): a later
+#: … the least cost at which a model already refitted refits (dimensionless): a later
 #: move starts from a hold's estimates, not from rest, and a fit on the four-mass chain's
 #: return moves (cost 5–7) took the model from 1.8 % to 5–8 % off the plant …
 REFINE_AGAIN = 20.0
@@ -169,7 +156,7 @@ REFINE_AGAIN = 20.0
 #: over the trusted time; dimensionless): the chain model cannot explain the data (there,
 #: 0.033–0.060 after every fit; a master alternating 1 and 0.5 ms steps left 0.40) …
 REFINE_MAX_MISFIT = 0.15
-#: … and factors outside this range from the member's model as first built
+#: … and factors outside this range from the chain as designed
 #: (dimensionless).
 REFINE_FACTOR_RANGE = (0.5, 2.0)
 #: At most this many Levenberg–Marquardt iterations …

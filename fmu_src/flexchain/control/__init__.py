@@ -9,8 +9,8 @@ Modules, in the order data flows:
   below a count at rest, for the hold's dither.
 * :mod:`~arcosim.fmu.flexchain.control.move_record` — the samples of a move kept for its fit.
 * :mod:`~arcosim.fmu.flexchain.control.move_fit` — the chain refitted from a finished move.
-* :mod:`~arcosim.fmu.flexchain.control.estimator_bank` — the load estimators the controller
-  chooses between.
+* :mod:`~arcosim.fmu.flexchain.control.refined_estimator` — the chain's estimator, refitted
+  from each move.
 * :mod:`~arcosim.fmu.flexchain.control.encoder_edge` — the encoder edge a slow motor crosses.
 * :mod:`~arcosim.fmu.flexchain.control.hold_edge` — holding near an encoder edge.
 * :mod:`~arcosim.fmu.flexchain.control.hold_dither` — the dither that holds against sticking.

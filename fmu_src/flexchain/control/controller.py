@@ -6,10 +6,10 @@ target ``theta_ref`` and damps the chain, from the motor's current and encoder o
 * **estimates**: the observer's model-based estimator with its load-torque state on mass
   L (:class:`~arcosim.fmu.flexchain.observer.Observer`, mode 2, estimator 1, the same
   code as the observer FMU, its gain designed for ``defaults.CONTROL_TORQUE_NOISE_STD``),
-  run on the chain and on its models with every J_i and k_i scaled
-  (:class:`~arcosim.fmu.flexchain.control.estimator_bank.EstimatorBank`, the one whose model
-  predicts τ̂_reac best chosen), gives every load angle and velocity and the torque d̂ on
-  mass L; the motor's angle enters as measured (the middle of its count), its velocity,
+  its chain refitted from each move
+  (:class:`~arcosim.fmu.flexchain.control.refined_estimator.RefinedEstimator`), gives every
+  load angle and velocity and the torque d̂ on mass L; the motor's angle enters as
+  measured (the middle of its count), its velocity,
   where Coulomb friction is cancelled, as the backward difference of the encoder's last
   crossed edge (:class:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge`: 0 for a
   dither across one edge), in the feedback and the DOB alike; the DOB is told the
@@ -51,9 +51,9 @@ from ..dob import clamp, settle_sticking, sign
 from ..observer import Observer, ObserverSettings
 from .design import ControllerDesign, design_controller
 from .encoder_edge import CrossedEdge
-from .estimator_bank import EstimatorBank
 from .hold_dither import HoldDither
 from .hold_edge import hold_edge
+from .refined_estimator import RefinedEstimator
 
 __all__ = ["PARTS", "MotionController", "design_controller", "shaped_step"]
 
@@ -61,9 +61,8 @@ __all__ = ["PARTS", "MotionController", "design_controller", "shaped_step"]
 #: added to meet the control benchmark's criteria (docs/control.md, "What each part buys"):
 #: the hold's dither, the hold near an edge, the hold's estimator gain, the DOB told the
 #: heading from the encoder's edges and from the reference, the chain model's torque over
-#: a stuck step, the estimator bank (its one member on the chain kept), the move's refit
-#: and the crossed edge's velocity (the plain difference instead). Every part is on by
-#: default; switching one off is for measuring what it buys.
+#: a stuck step, the move's refit and the crossed edge's velocity (the plain difference
+#: instead). Every part is on by default; switching one off is for measuring what it buys.
 PARTS = (
     "hold_dither",
     "hold_edge",
@@ -71,7 +70,6 @@ PARTS = (
     "edge_heading",
     "sliding_heading",
     "sticking_settle",
-    "bank",
     "move_refit",
     "crossed_edge",
 )
@@ -212,11 +210,9 @@ class MotionController:
             torque_noise_std=defaults.CONTROL_TORQUE_NOISE_STD,
         )
         self.observer = Observer(settings, theta_m0, 0.0)
-        # the estimator on the chain and on its scaled models (estimator_bank); the
-        # observer keeps its DOB and offset, the bank owns the estimators
-        scales = defaults.BANK_SCALES if "bank" in self.parts else (1.0,)
-        self.bank = EstimatorBank(self.observer.estimator, scales)
-        self.bank.hold_gain = "hold_gain" in self.parts
+        # the observer keeps its DOB and offset; the estimator, refitted from each move,
+        # is the controller's (refined_estimator)
+        self.estimator = RefinedEstimator(self.observer.estimator, "hold_gain" in self.parts)
         self.observer.estimator = None
         self.offset = settings.angle_offset()
         # the crossed edge's velocity only with an encoder and the friction cancelled:
@@ -264,7 +260,7 @@ class MotionController:
             ``i_ref`` (A).
         """
         obs = self.observer
-        est = self.bank.chosen
+        est = self.estimator.filter
         t0 = self.theta0
         dob = obs.dob
         # the velocity of the last crossed edge, not of the count (a dither across one
@@ -288,17 +284,16 @@ class MotionController:
         drive = theta_m + obs.offset if dither is None else th_m + t0 - self.offset + obs.offset
         if dob.sticking and "sticking_settle" in self.parts:
             settle_sticking(dob, est, h, drive)
-        choosing = self.t - self._moved < defaults.BANK_CHOICE_AFTER * self.design.move_time
-        bank = self.bank
-        bank.step(h, dob.tau_reac_hat, drive, choosing, heading)
-        record = bank.record
+        estimator = self.estimator
+        estimator.step(h, dob.tau_reac_hat, drive, heading)
+        record = estimator.record
         if (
             record is not None
             and record.elapsed >= self._refine_after - 0.5 * h
             and "move_refit" in self.parts
         ):
-            bank.refine()  # every J_i and k_i from the move so far (move_fit)
-        est = bank.chosen
+            estimator.refine()  # every J_i and k_i from the move so far (move_fit)
+        est = estimator.filter
         # the motor's own states as measured: its observer's (model-based) estimates of
         # them cost the loop its stability under a 10 % model error (docs/control.md)
         x = [th_m, *(a - t0 for a in est.theta), omega_m, *est.omega]
@@ -312,24 +307,24 @@ class MotionController:
 
         It runs from ``defaults.HOLD_DITHER_AFTER`` move times after the target path
         stops until the next move, where the design has one (``dither_current`` > 0);
-        the estimators take the hold's gain while mass L is still (``EstimatorBank.settle``).
+        the estimator takes the hold's gain while mass L is still (``RefinedEstimator.settle``).
         """
         design = self._design_for(h)
         if self.path.moves:
             if self._first_move or self.t - self._moved > 1.5 * h:  # a move starts:
-                self.bank.restart()  # the bank chooses and records anew
+                self.estimator.restart()  # it records the move anew
                 self._first_move = False
             self._moved = self.t
         rest = self.t - self._moved >= defaults.HOLD_DITHER_AFTER * design.move_time
         if not (rest and design.dither_current > 0.0 and "hold_dither" in self.parts):
             self.dither = None
-            self.bank.set_quiet(False)
+            self.estimator.set_quiet(False)
             return self.i_ref
         if self.dither is None or self.dither.design.h != h:
             self.dither = HoldDither(design)
             self.dither.start(x[0], x[design.n + 1])
-        self.bank.settle(h, abs(self.theta_hat_ctrl - self.path.target))
-        if self.edge is not None and self.bank.quiet:  # near an edge once mass L is still
+        self.estimator.settle(h, abs(self.theta_hat_ctrl - self.path.target))
+        if self.edge is not None and self.estimator.quiet:  # near an edge once mass L is still
             self.edge.step(h, self._needed, self._any_edge)
         elif self.edge is not None:  # the edge and the low-pass start when it is
             self.edge.reset()

@@ -13,9 +13,9 @@ averages it into the motor's angle and velocity below a count, for the state fee
 (both) and the estimator's input (the angle). The velocity carries the dither's periodic
 error (about 0.7 rad/s rms at 125 Hz with the observer's poles at 300 rad/s); fed back with
 the estimator on the identified chain alone, it made the five-mass chain diverge with its
-model's J 10 % high and k 10 % low. With the estimator bank
-(:mod:`~arcosim.fmu.flexchain.control.estimator_bank`), which moves to a model near the truth,
-that chain holds one count there (docs/design/hold-dither.md).
+model's J 10 % high and k 10 % low. With the estimator's chain refitted from the move
+(:mod:`~arcosim.fmu.flexchain.control.refined_estimator`), which takes the model near the
+truth, that chain holds one count there (docs/design/hold-dither.md).
 
 Friction is cancelled along the dither's velocity, which the motor follows; what the
 slow motion meets then is a viscous friction of about ``2 f_c / v_peak`` per rad/s, the

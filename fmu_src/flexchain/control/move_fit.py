@@ -1,12 +1,12 @@
 """Every J_i and k_i of the controller's chain refined from a move's own response.
 
-The estimator bank (:mod:`~arcosim.fmu.flexchain.control.estimator_bank`) scales every J_i by one
-factor and every k_i by another: errors that differ from mass to mass change the chain's
-mode shapes, which no such pair reproduces, and on a four-mass chain with independent
-±10 % errors the controller then settled up to 2 × slower than the same gains on the
-true states (docs/design/move-refit.md). A move excites the chain enough to tell them apart:
+The controller's estimator runs on the chain it was designed on; with that chain's J_i
+and k_i off, each by its own error, the estimator rings off the chain's modes, and on a
+four-mass chain with independent ±10 % errors the controller settled up to 2 × slower
+than the same gains on the true states (docs/design/move-refit.md). A move excites the
+chain enough to tell the errors apart:
 :class:`~arcosim.fmu.flexchain.control.move_record.MoveRecord` keeps, from the move's start,
-what the bank's estimators take (τ̂_reac and the motor angle, each step), and
+what the estimator takes (τ̂_reac and the motor angle, each step), and
 :func:`fit_chain` finds the factors on every J_i
 and k_i whose model, run open loop from the estimator's state at the move's start,
 predicts that τ̂_reac best.
@@ -37,7 +37,7 @@ The fit is Levenberg–Marquardt on these residuals with forward-difference Jaco
 (2n open-loop runs per iteration; the common factors' columns are sums of the masses'),
 each sample weighted by the time it stands for. What a fit learnt (its :class:`Belief`:
 the parameters and their precision) is the next fit's prior, and the factors count from
-the member's model as first built. It refuses (returns ``None``) what the data cannot
+the chain as designed. It refuses (returns ``None``) what the data cannot
 support: trusted samples spanning less than ``defaults.REFINE_MIN_TRUSTED_TIME``, a
 model that already predicts the move within the noise (``defaults.REFINE_MIN_EVIDENCE``),
 factors outside ``defaults.REFINE_FACTOR_RANGE``, a fit that still misses the data
@@ -352,8 +352,8 @@ def fit_chain(
         The move's steps (:class:`~arcosim.fmu.flexchain.control.move_record.MoveRecord`).
     origin : tuple of Sequence[float], optional
         The chain the prior is centred on and the factors are counted from, ``(J, k)``
-        (kg·m², N·m/rad); default the start's own. The bank gives its member's model as
-        first built, so that moves after moves do not carry the model away from it.
+        (kg·m², N·m/rad); default the start's own. The controller gives the chain as
+        designed, so that moves after moves do not carry the model away from it.
     belief : Belief, optional
         What earlier moves told of the parameters (a :class:`ChainFit`'s ``belief``,
         the start's model at its mean); default :func:`prior_belief` of the spreads.
@@ -382,8 +382,8 @@ def fit_chain(
     --------
     >>> chain = {"J_mo": 2.09e-5, "k_to": 0.0406, "D_m": 2e-5, "f_c": 2e-3,
     ...          "J[1]": 5e-4, "k[1]": 0.16, "B[1]": 1e-5}
-    >>> bank = arcosim.MotionController(arcosim.design_controller(chain, h=1e-3)).bank
-    >>> fit_chain(bank.chosen, []) is None  # no trusted sample: nothing to fit
+    >>> estimator = arcosim.MotionController(arcosim.design_controller(chain, h=1e-3)).estimator
+    >>> fit_chain(estimator.filter, []) is None  # no trusted sample: nothing to fit
     True
     """
     n = len(start.J)

@@ -18,7 +18,7 @@ from .. import defaults
 
 @dataclass(frozen=True)
 class Sample:
-    """One step of a move as the bank's estimators took it.
+    """One step of a move as the controller's estimator took it.
 
     Attributes
     ----------
@@ -27,7 +27,7 @@ class Sample:
     tau_reac_hat : float
         τ̂_reac at its end (N·m).
     theta_m : float
-        The motor angle the estimators took there (rad).
+        The motor angle the estimator took there (rad).
     trusted : bool
         Whether the DOB's friction was known over the last
         ``defaults.REFINE_TRUST_AFTER`` s (module doc).
@@ -40,7 +40,7 @@ class Sample:
 
 
 class MoveRecord:
-    """What a move gives the bank's estimators, one step at a time (module doc).
+    """What a move gives the controller's estimator, one step at a time (module doc).
 
     Parameters
     ----------
@@ -87,7 +87,7 @@ class MoveRecord:
         tau_reac_hat : float
             τ̂_reac at its end (N·m).
         theta_m : float
-            The motor angle the estimators take (rad).
+            The motor angle the estimator takes (rad).
         heading : float
             The direction the DOB was told the motor runs (−1, 0 or +1).
         """
