@@ -17,30 +17,30 @@ from __future__ import annotations
 
 import numpy as np
 
-from arcosim import controller_margins
+from arcosim import Chain, controller_margins
 from arcosim.fmu.flexchain import defaults
 
 H = 1e-3
+#: The bench's motor under the observer's names (kg·m², N·m/A, N·m·s/rad, N·m).
 MOTOR = {"J_mo": defaults.J_M, "k_to": defaults.K_T, "D_m": defaults.D_M, "f_c": defaults.F_C}
+#: The chains by their names in the table (kg·m², N·m/rad, N·m·s/rad).
 CHAINS = {
-    "bench, two masses": (defaults.J[:2], (defaults.K,) * 2, (defaults.B,) * 2),
-    "bench, three masses": (defaults.J, (defaults.K,) * 3, (defaults.B,) * 3),
-    "five masses": ((2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4), (0.4, 0.3, 0.5, 0.35, 0.45), (1.5e-5,) * 5),
+    "bench, two masses": Chain(J=defaults.J[:2], k=(defaults.K,) * 2, B=(defaults.B,) * 2),
+    "bench, three masses": Chain(J=defaults.J, k=(defaults.K,) * 3, B=(defaults.B,) * 3),
+    "five masses": Chain(
+        J=(2e-4, 3e-4, 2.5e-4, 3e-4, 2e-4), k=(0.4, 0.3, 0.5, 0.35, 0.45), B=(1.5e-5,) * 5
+    ),
 }
 
 
-def params(J, k, B) -> dict[str, float]:
-    """The chain under the observer's names, the bench's motor."""
-    out = dict(MOTOR)
-    for name, values in (("J", J), ("k", k), ("B", B)):
-        out.update({f"{name}[{i + 1}]": v for i, v in enumerate(values)})
-    return out
+def params(chain: Chain) -> dict[str, float]:
+    """The chain under the observer's names, with the bench's motor."""
+    return {**MOTOR, **chain.parameters()}
 
 
-def margins(J, k, B) -> dict[str, object]:
+def margins(chain: Chain) -> dict[str, object]:
     """One row of the table."""
-    chain = params(J, k, B)
-    found = controller_margins(chain, h=H)
+    found = controller_margins(params(chain), h=H)
     fs = found.full_state
     hold = [case.decay for case in found.hold]  # the model exact, the corners, [the worst]
     return {
@@ -65,7 +65,7 @@ def margins(J, k, B) -> dict[str, object]:
 def main() -> None:
     """Print the table."""
     for name, chain in CHAINS.items():
-        row = margins(*chain)
+        row = margins(chain)
         print(name, {key: np.round(np.asarray(v, float), 2).tolist() for key, v in row.items()})
 
 

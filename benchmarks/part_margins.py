@@ -20,6 +20,7 @@ About 2 s per model on the 2-core machine.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import random
 
 from arcosim.control import sensorless_decay
@@ -27,15 +28,16 @@ from arcosim.experiments import markdown_table
 from arcosim.fmu.flexchain import PARTS, defaults
 from benchmarks.control_margins import CHAINS, params
 
-#: The five-mass chain of ``benchmarks.control_margins`` (kg·m², N·m/rad, N·m·s/rad).
-J, K, B = CHAINS["five masses"]
+#: The five-mass chain of ``benchmarks.control_margins``.
+FIVE = CHAINS["five masses"]
 #: The control step (s): the project's.
 H = defaults.STEP
 
 
 def chain(j_scale: list[float], k_scale: list[float]) -> dict[str, float]:
     """The five-mass chain by the observer's names, each J_i and k_i scaled."""
-    return params([j * f for j, f in zip(J, j_scale)], [k * f for k, f in zip(K, k_scale)], B)
+    J = [j * f for j, f in zip(FIVE.J, j_scale)]
+    return params(dataclasses.replace(FIVE, J=J, k=[k * f for k, f in zip(FIVE.k, k_scale)]))
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -48,7 +50,7 @@ def main(argv: list[str] | None = None) -> None:
     unknown = sorted(without - set(PARTS))
     if unknown:
         parser.error(f"unknown part(s) {unknown}: name them from {PARTS}")
-    e, n = args.error, len(J)
+    e, n = args.error, FIVE.n
     models = {
         f"J +{e:.0%}, k −{e:.0%}": chain([1 + e] * n, [1 - e] * n),
         f"J −{e:.0%}, k +{e:.0%}": chain([1 - e] * n, [1 + e] * n),

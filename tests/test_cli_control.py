@@ -26,10 +26,10 @@ def refusal(capsys, *argv: object) -> str:
 
 def chain_file(tmp_path: Path, name: str) -> Path:
     """A whole-chain report holding one of the margins table's chains."""
-    values = {key: v for key, v in params(*CHAINS[name]).items() if key[0] in "JkB"}
+    values = {key: v for key, v in params(CHAINS[name]).items() if key[0] in "JkB"}
     values.pop("J_mo")
     path = tmp_path / "chain.json"
-    path.write_text(json.dumps({"masses": len(CHAINS[name][0]), **values}), encoding="utf-8")
+    path.write_text(json.dumps({"masses": CHAINS[name].n, **values}), encoding="utf-8")
     return path
 
 
@@ -74,7 +74,7 @@ def test_a_hold_that_grows_where_the_move_decays_is_named_with_its_way_out() -> 
 
     from arcosim.control.margins import LoopDecay, controller_margins
 
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     found = controller_margins(chain, h=1e-3, random_models=0)
     assert found.robust and len(found.hold) == 3
     growing = LoopDecay("J +10 %, k −10 %, at rest with the dither", -0.5, 78.0)
@@ -148,7 +148,7 @@ def test_a_run_that_never_comes_to_rest_is_not_linearized() -> None:
     the loop is reported as not at rest instead."""
     from arcosim.control.sensorless_loop import sensorless_decay, sensorless_loop
 
-    chain = params(*CHAINS["bench, three masses"])
+    chain = params(CHAINS["bench, three masses"])
     assert not sensorless_loop(chain, chain, h=0.01, delay=1).settled
     decay, frequency = sensorless_decay(chain, chain, h=0.01, delay=1)
     assert decay == -float("inf") and frequency != frequency

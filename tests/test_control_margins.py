@@ -27,7 +27,7 @@ def test_an_exact_model_puts_the_state_feedbacks_poles_in_the_loop() -> None:
     """Separation: with the model exact, the loop's poles are the state feedback's
     (eig(F − g K)) and the estimator's; the finite differences (relative step 1e-6 on a
     linear map) leave each within 1e-6 of its own."""
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     loop = sensorless_loop(chain, chain, h=H)
     design = loop.controller.design
     feedback = np.linalg.eigvals(np.array(design.F) - np.outer(design.g, design.K))
@@ -53,8 +53,8 @@ def test_the_sensorless_loop_is_stable_with_the_model_ten_percent_off(
     alone (``without={"move_refit"}``) the five-mass J +10 %, k −10 % corner grew at
     its top modes, where the estimator rang; the move's refit takes the model back to
     the chain."""
-    chain = params(*CHAINS[name])
-    error = next(e for e in corners(len(CHAINS[name][0])) if e.name == CORNERS[corner])
+    chain = params(CHAINS[name])
+    error = next(e for e in corners(CHAINS[name].n) if e.name == CORNERS[corner])
     decay, _ = sensorless_decay(chain, error.apply(chain), h=H, hold=hold)
     assert decay > 0.0
 
@@ -62,7 +62,7 @@ def test_the_sensorless_loop_is_stable_with_the_model_ten_percent_off(
 def test_the_hold_is_linearized_with_its_dither_running_and_decays_on_the_exact_model() -> None:
     """hold=True: the dither runs at the linearized state, the dither's own path is not
     a state (no pole at 1 from it), and with the model exact every pole decays."""
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     loop = sensorless_loop(chain, chain, h=H, hold=True)
     assert loop.controller.dither is not None
     poles = np.linalg.eigvals(sensorless_jacobian(loop))
@@ -79,7 +79,7 @@ def test_the_move_refits_the_model_to_the_chain(factors) -> None:
     (whose top modes the wrong model failed): over one move of the linear loop the
     estimator's chain is refitted to the plant, within REFIT_TOLERANCE on every J_i and
     k_i; the exact model predicts the move within the noise and is kept as it is."""
-    chain = params(*CHAINS["five masses"])
+    chain = params(CHAINS["five masses"])
     scale = {"J[": factors[0], "k[": factors[1]}
     model = {key: v * scale.get(key[:2], 1.0) for key, v in chain.items()}
     estimator = sensorless_loop(chain, model, h=H).controller.estimator
@@ -97,7 +97,7 @@ def test_at_rest_the_estimator_runs_the_holds_gain_until_the_next_move() -> None
     hold's gain (unmodelled torque × HOLD_TORQUE_NOISE_SCALE: it corrects less from
     τ̂_reac); a new target gives back the move's gain, the one designed at the start, bit
     for bit, and the estimates carry on from where they were."""
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     loop = sensorless_loop(chain, chain, h=H, hold=True)
     controller = loop.controller
     estimator = controller.estimator
@@ -125,7 +125,7 @@ def test_the_holds_gain_waits_for_the_mass_to_be_still_and_leaves_for_a_load_ste
     """RefinedEstimator.settle: the hold's gain after HOLD_QUIET_TIME within HOLD_QUIET_ANGLE
     of the target (not sooner, the clock restarting whenever the estimate strays), the
     move's back as soon as it is more than HOLD_QUIET_LEAVE off."""
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     estimator = sensorless_loop(chain, chain, h=H).controller.estimator
     near, far = 0.5 * defaults.HOLD_QUIET_ANGLE, 1.5 * defaults.HOLD_QUIET_LEAVE
     steps = round(defaults.HOLD_QUIET_TIME / H)
@@ -149,7 +149,7 @@ def test_the_jacobian_leaves_the_loop_as_it_was() -> None:
     every float of the loop, and every design, is the same after as before."""
     from arcosim.control.sensorless_loop import _leaves
 
-    chain = params(*CHAINS["bench, two masses"])
+    chain = params(CHAINS["bench, two masses"])
     loop = sensorless_loop(chain, chain, h=H)
     paths = _leaves(loop, skip=frozenset())
     before = [_value(loop, p) for p in paths]
