@@ -16,9 +16,9 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
   [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m by more than :data:`BALANCE_SIGMAS`
   of its standard errors names the current scale, k_t and the time column. The line is
   fitted under a Hann window (a slow load's motion leaks into it as 1/k³ of the bins
-  between them, not 1/k), and its standard errors are Newey–West's: what the line's fit
-  leaves (the other lines, a slow load's motion) is coloured, and a white residual's σ
-  was ten times too small on a slow-load log.
+  between them, not 1/k); its standard error is the noise near the line (the local
+  level of the periodogram of what the fit leaves, between the lines), and the lines
+  the window merges with it bound its error by a factor (:func:`merged_line_factor`).
 - :func:`record_length`: fewer than :data:`LEAST_PERIODS` periods of the lowest line the
   current shows.
 
@@ -35,8 +35,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from arcosim.identification.excitation.periodic import noise_level
 from arcosim.identification.excitation.spectrum import ExcitationSpectrum
-from arcosim.identification.fit.newey_west import long_run_covariance, significance_lag
 
 #: Largest factor (dimensionless) between the RMS speed the angle's differences give
 #: over the logged step and the RMS logged ω_m. Both measure the same motion; the
@@ -58,8 +58,12 @@ LEAST_PERIODS = 3.0
 #: The torque balance's inertia counts as implausible only when it lies this many of its
 #: standard errors outside the plausible range (the three-sigma rule: under Gaussian
 #: errors a plausible log crosses one bound by chance 0.13 % of the time). The rate holds
-#: only with a σ that holds: Newey–West's over the coloured residual of the line's fit.
+#: only with a σ that holds: the noise's near the line, the lines beside it apart.
 BALANCE_SIGMAS = 3.0
+#: Half the Hann window's main lobe (bins of 2π/T): lines closer than this to the
+#: balance's line leak into its estimate (:func:`merged_line_factor`); beyond it the
+#: window's sidelobes, falling as 1/k³, keep them out.
+MAIN_LOBE = 2.0
 #: Least periods (a count) of a line the record must hold for the line to count as
 #: resolved: the record's frequency grid is 2π/T, and the Hann window's main lobe spans
 #: two bins either side of a line, so a line under two bins (two periods) from 0 shares
@@ -179,12 +183,13 @@ def torque_balance(
     if found is None:
         return None
     J, sigma = found
-    # implausible only beyond the balance's own uncertainty: a slow load's motion, or a
-    # line the encoder barely sees, widens it (BALANCE_SIGMAS standard errors)
+    # implausible only beyond the balance's own uncertainty: the noise near the line
+    # (BALANCE_SIGMAS standard errors), and the lines a window merges with it
+    merged = merged_line_factor(float(time[-1] - time[0]), lowest)
     if (
-        INERTIA_LOW * J_m - BALANCE_SIGMAS * sigma
+        INERTIA_LOW * J_m / merged - BALANCE_SIGMAS * sigma
         <= J
-        <= INERTIA_HIGH * J_m + BALANCE_SIGMAS * sigma
+        <= INERTIA_HIGH * J_m * merged + BALANCE_SIGMAS * sigma
     ):
         return None
     return (
@@ -193,6 +198,27 @@ def torque_balance(
         f"{INERTIA_HIGH:g} × J_m): check the current's scale (--scale i_a=…; A or mA?), "
         "k_t (--set k_to=…) and the time column's unit (--scale time=…)"
     )
+
+
+def merged_line_factor(duration: float, lowest: float) -> float:
+    """The factor (dimensionless, ≥ 1) the torque balance's inertia at the line
+    ``lowest`` (rad/s) may err by, either way, from the excitation's lines the Hann
+    window merges with it in a record of ``duration`` s.
+
+    Lines within :data:`MAIN_LOBE` bins (2π/T each) of the balance's line share its
+    window's main lobe, and its estimate takes part of each (half of one a bin away):
+    a multi-sine's low end has its lines 1–2 bins apart. Below the chain's first mode
+    they move the current and the angle alike, the angle weighted by 1/ω², so the
+    inertia read lies between (ω/ω_n)² and (ω_n/ω)² times the chain's, ω_n the farthest
+    such line: a bound, not a noise (the standard error does not cover it).
+
+    Examples
+    --------
+    >>> round(merged_line_factor(20.0, 3.0), 2)   # lines up to 0.63 rad/s away
+    1.46
+    """
+    reach = MAIN_LOBE * 2.0 * np.pi / max(duration, 1e-300)
+    return float((1.0 + reach / lowest) ** 2)
 
 
 def balance_inertia(
@@ -206,7 +232,7 @@ def balance_inertia(
     """Total inertia (kg·m²) of the torque balance at the line ``lowest`` (see
     :func:`torque_balance`; arguments alike), or None when there is no line or motion;
     with ``with_error``, ``(J, σ_J)``: σ_J (kg·m²) from the two line fits' standard
-    errors (:func:`_line_amplitude`'s, Newey–West's), propagated to first order."""
+    errors (:func:`_line_amplitude`'s, the noise's near the line), propagated to first order."""
     theta = np.asarray(theta_m, float)
     if not lowest or lowest <= 0 or len(theta) < 16:
         return None
@@ -231,21 +257,25 @@ def _line_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> tuple[complex, fl
     rad) is more than a cubic trend can follow, and under uniform weights its remnant
     leaks into the line as 1/k of the bins k between them (the balance of a slow-load
     log read −33 × J_m where the chain has 58); the Hann window's sidelobes fall as
-    1/k³. The error: what the fit leaves is coloured (the other lines, a slow load's
-    motion), so it is Newey–West's, with the bandwidth at which the residual's
-    autocorrelation falls inside its white-noise band
-    (:func:`~arcosim.identification.fit.newey_west.significance_lag`): the residual's
-    power near ``w``, not its mean power. It counts the neighbouring lines' power, which
-    the window mostly keeps out of the estimate, so it errs large (on 40 lines 3–150
-    rad/s the scatter is a fifth of it or less), never small."""
+    1/k³. The error: the noise near ``w``, the local noise level of the Hann periodogram
+    of what the fit leaves, read between the lines (its lower quartile,
+    :func:`~arcosim.identification.excitation.periodic.noise_level`, the level every
+    line of the excitation is detected against): a weighted line estimate
+    2·Σ wₜxₜe^(−jωt)/Σ wₜ errs by √(2·level)/Σ wₜ in each of its cosine and sine. What
+    the fit leaves also holds the excitation's other lines, the ones beside ``w`` a
+    window merges with it included; they are not noise, and a long-run variance of
+    the whole residual (Newey–West's) counted them: it erred large by five times or
+    more on 40 lines 3–150 rad/s, and missed a time column in ms on half the seeds."""
     span = t[-1] if t[-1] > 0 else 1.0
     s = t / span
     X = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(s), s, s**2, s**3])
-    root = np.sqrt(np.hanning(len(t)))[:, None]  # weighted least squares on root-scaled rows
+    window = np.hanning(len(t))
+    root = np.sqrt(window)[:, None]  # weighted least squares on root-scaled rows
     c, *_ = np.linalg.lstsq(X * root, x * root[:, 0], rcond=None)
-    residual = (x - X @ c) * root[:, 0]
-    covariance = long_run_covariance(X * root, residual, significance_lag(residual, 1))
-    return complex(c[0], -c[1]), float(np.sqrt(max(np.trace(covariance[:2, :2]) / 2.0, 0.0)))
+    power = np.abs(np.fft.rfft((x - X @ c) * window)) ** 2
+    at = int(np.clip(np.rint(w * len(t) * (t[1] - t[0]) / (2.0 * np.pi)), 1, len(power) - 1))
+    level = float(noise_level(power[1:])[at - 1])
+    return complex(c[0], -c[1]), float(np.sqrt(2.0 * level) / window.sum())
 
 
 def resolved_lowest(spectrum: ExcitationSpectrum | None, duration: float) -> float | None:
