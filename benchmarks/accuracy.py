@@ -22,7 +22,9 @@ then run again on the recorded logs, offline, in every configuration (the same
 The bench also gets the honesty check of B's standard error (over ``--b-seeds`` seeds)
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
 within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accuracy.py``:
-three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
+three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode;
+``--whole-chain-only`` runs them alone), each with the verdict's count (trusted k of N),
+like the field and excitation rows after them.
 Then the excitation rows (``benchmarks/excitation_accuracy.py``: an off-grid multi-sine,
 a square-wave reference in a position loop, a PRBS; check agreeing with identify).
 Last, the load torque rows (``benchmarks/load_accuracy.py``: the two- and five-mass chains,
