@@ -22,7 +22,9 @@ then run again on the recorded logs, offline, in every configuration (the same
 The bench also gets the honesty check of B's standard error (over ``--b-seeds`` seeds)
 and B on records of 2.5 … 20 s (3 seeds each): the record length B needs to come
 within 10 %. Then the whole-chain identification rows (``benchmarks/chain_accuracy.py``:
-three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode).
+three chains, the ``identification`` scenario, ``--b-seeds`` seeds; one in quick mode;
+``--whole-chain-only`` runs them alone), each with the verdict's count (trusted k of N),
+like the field and excitation rows after them.
 Then the excitation rows (``benchmarks/excitation_accuracy.py``: an off-grid multi-sine,
 a square-wave reference in a position loop, a PRBS; check agreeing with identify).
 Last, the load torque rows (``benchmarks/load_accuracy.py``: the two- and five-mass chains,
@@ -290,15 +292,20 @@ def run(
     progress: Callable[[str], None] = print,
     load_torque_only: bool = False,
     beam_only: bool = False,
+    whole_chain_only: bool = False,
 ) -> dict[str, object]:
     """Run the benchmark, write ``accuracy.md`` and ``accuracy.json`` into ``out``
     (``load_torque_only``: only the load torque rows, ``load_torque.md``/``.json``;
-    ``beam_only``: only the flexible-link rows, ``beam.md``/``.json``)."""
+    ``beam_only``: only the flexible-link rows, ``beam.md``/``.json``;
+    ``whole_chain_only``: only the whole-chain rows of the project's chains,
+    ``whole_chain.md``/``.json``)."""
     started = time.perf_counter()
     if load_torque_only:
         return _load_torque_rows(out, max(b_seeds, seeds), quick, progress, started)
     if beam_only:
         return _beam_rows(out, max(b_seeds, seeds), quick, progress, started)
+    if whole_chain_only:
+        return _whole_chain_rows(out, max(b_seeds, seeds), quick, progress, started)
     cases = CASES[:1] if quick else CASES
     seed_list = list(range(1, seeds + 1))
     results = {case.name: score_case(case, seed_list, progress) for case in cases}
@@ -337,15 +344,10 @@ def run(
             if shortest is not None
             else "\nB not within 10 % on any record length tried.\n"
         )
-    chains = chain_accuracy.CHAINS[:1] if quick else chain_accuracy.CHAINS
     chain_seeds = list(range(1, (1 if quick else max(b_seeds, seeds)) + 1))
-    whole = {c.name: chain_accuracy.score_chain(c, chain_seeds, progress) for c in chains}
-    summary["whole_chain"] = whole
-    text += (
-        "\nWhole-chain identification (`--method whole-chain --masses auto`, scenario "
-        f"`identification`, {len(chain_seeds)} seeds; only the actuator known):\n\n"
-        + chain_accuracy.markdown(whole)
-    )
+    chain_text, chain_summary = _whole_chain_table(chain_seeds, quick, progress)
+    text += chain_text
+    summary.update(chain_summary)
     names = list(field_accuracy.ROWS)[:1] if quick else list(field_accuracy.ROWS)
     field_rows, _ = field_accuracy.score_rows(names, chain_seeds, progress)
     summary["whole_chain_field"] = field_rows
@@ -392,6 +394,33 @@ def _load_torque_table(
             + load_accuracy.bandwidth_markdown(trade)
         )
     return text, summary
+
+
+def _whole_chain_table(
+    seeds: Sequence[int], quick: bool, progress: Callable[[str], None]
+) -> tuple[str, dict[str, object]]:
+    """The whole-chain rows of the project's chains (:mod:`benchmarks.chain_accuracy`;
+    quick: the bench)."""
+    chains = chain_accuracy.CHAINS[:1] if quick else chain_accuracy.CHAINS
+    whole = {c.name: chain_accuracy.score_chain(c, seeds, progress) for c in chains}
+    text = (
+        "\nWhole-chain identification (`--method whole-chain --masses auto`, scenario "
+        f"`identification`, {len(seeds)} seeds; only the actuator known):\n\n"
+        + chain_accuracy.markdown(whole)
+    )
+    return text, {"whole_chain": whole}
+
+
+def _whole_chain_rows(
+    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
+) -> dict[str, object]:
+    seeds = list(range(1, (1 if quick else count) + 1))
+    text, summary = _whole_chain_table(seeds, quick, progress)
+    summary["seconds"] = time.perf_counter() - started
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "whole_chain.md").write_text(text, encoding="utf-8")
+    (out / "whole_chain.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    return {"table": text, **summary, "files": ("whole_chain.md", "whole_chain.json")}
 
 
 def _beam_table(
@@ -458,6 +487,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="only the flexible-link rows (as many seeds as the whole-chain rows), into "
         "beam.md/.json",
     )
+    p.add_argument(
+        "--whole-chain-only",
+        action="store_true",
+        help="only the whole-chain rows of the project's three chains (as many seeds as "
+        "--b-seeds or --seeds, the larger), into whole_chain.md/.json",
+    )
     p.add_argument("--out", type=Path, default=Path("reports"), help="folder for the table")
     p.set_defaults(execute=_execute)
 
@@ -473,6 +508,7 @@ def _execute(args: argparse.Namespace) -> int:
         progress=progress,
         load_torque_only=args.load_torque_only,
         beam_only=args.beam_only,
+        whole_chain_only=args.whole_chain_only,
     )
     print(result["table"])
     md, js = result.get("files", ("accuracy.md", "accuracy.json"))

@@ -2,10 +2,12 @@
 
 Three chains, realistic sensors, the ``identification`` scenario (40 lines 3–150
 rad/s, 3 A peak, 20 s), one run per seed; only the actuator is known, the number of
-masses is read from the record (``masses="auto"``). Per chain: how often the right n
-was chosen, the largest |error| of any J_i and k_i over the seeds, how often the B_i
-lie within 2 standard errors of the truth (all, and the worst B_i over the seeds),
-and the identification's time.
+masses is read from the record (``masses="auto"``), through
+:func:`~arcosim.identify_drive` as ``arcosim identify`` runs it. Per chain: how often
+the verdict was ``trusted`` (the reasons of every untrusted seed kept), how often the
+right n was chosen, the largest |error| of any J_i and k_i over the seeds, how often
+the B_i lie within 2 standard errors of the truth (all, and the worst B_i over the
+seeds), and the identification's time.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from arcosim import SCENARIOS, encoder_record, identify_whole_chain, motor_record
+from arcosim import SCENARIOS, identify_drive
 from arcosim.experiments import markdown_table, percent_error
 from benchmarks.cases import ACTUATOR, CASES, ENCODER_CPR, G_DIST, Case, run_case
 
@@ -33,18 +35,33 @@ CHAINS = (
 
 
 def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None]) -> dict:
-    """Whole-chain identification of ``case`` over ``seeds`` (JSON-able summary)."""
+    """Whole-chain identification of ``case`` over ``seeds`` (JSON-able summary): the
+    verdict per seed (``untrusted`` maps each untrusted seed to its reasons), n, the
+    errors (%) and the B_i's standard errors (% of the truth)."""
     chosen, J_errors, k_errors, B_errors, B_sigmas, seconds = [], [], [], [], [], []
+    verdicts: list[str] = []
+    untrusted: dict[str, list[str]] = {}
     for seed in seeds:
         progress(f"whole chain, {case.name}: seed {seed}")
         log = run_case(case, SCENARIOS["identification"], seed)
-        record = motor_record(
-            log["time"], log["i_a"], log["omega_m"], log["theta_m"], ACTUATOR, G_DIST
-        )
         started = time.perf_counter()
-        encoder = encoder_record(log["time"], log["i_a"], log["theta_m"], ACTUATOR, ENCODER_CPR)
-        choice = identify_whole_chain(record, "auto", encoder)
+        result = identify_drive(
+            log["time"],
+            log["i_a"],
+            log["omega_m"],
+            log["theta_m"],
+            k_t=ACTUATOR.k_to,
+            J_m=ACTUATOR.J_mo,
+            encoder_cpr=ENCODER_CPR,
+            D_m=ACTUATOR.D_m,
+            f_c=ACTUATOR.f_c,
+            g_dist=G_DIST,
+        )
         seconds.append(time.perf_counter() - started)
+        choice = result.choice
+        verdicts.append(result.verdict.word)
+        if not result.verdict.trusted:
+            untrusted[str(seed)] = list(result.verdict.reasons)
         chosen.append(choice.n)
         if choice.n != case.n:
             continue
@@ -59,6 +76,9 @@ def score_chain(case: Case, seeds: Sequence[int], progress: Callable[[str], None
     right = [n == case.n for n in chosen]
     return {
         "seeds": len(seeds),
+        "trusted": verdicts.count("trusted"),
+        "verdicts": verdicts,
+        "untrusted_reasons": untrusted,
         "masses_chosen": chosen,
         "right_n": int(sum(right)),
         "J_error_percent": J_errors,
@@ -75,6 +95,7 @@ def markdown(rows: dict[str, dict]) -> str:
     """The whole-chain table."""
     header = [
         "chain",
+        "trusted",
         "n right",
         "max abs J_i error %",
         "max abs k_i error %",
@@ -94,6 +115,7 @@ def markdown(rows: dict[str, dict]) -> str:
         cells.append(
             [
                 name,
+                f"{r['trusted']} of {r['seeds']}",
                 f"{r['right_n']} of {r['seeds']}",
                 worst["J_error_percent"],
                 worst["k_error_percent"],

@@ -14,7 +14,8 @@ k_t, J_m and the counts given), ``masses="auto"``; each excitation from
 - **PRBS**: a ±1 A maximum-length sequence (14 bits) held 4 samples (its band to about
   1100 rad/s), open loop.
 
-Per seed (the seed changes the noise, the phases, the sequence): n, J_i, k_i (errors in
+Per seed (the seed changes the noise, the phases, the sequence): the verdict (the
+reasons of an untrusted seed in the JSON), n, J_i, k_i (errors in
 %), B_i, D_m, f_c within 2σ (a friction term left out or at its bound: its reported bound
 above the truth), and whether ``check`` agrees with ``identify``: ``check``
 ok exactly when ``identify`` fits, and every ``check`` warning among ``identify``'s.
@@ -112,6 +113,7 @@ def markdown(summaries: dict[str, dict]) -> str:
     """The table."""
     header = [
         "row",
+        "trusted",
         "n right",
         "max abs J_i err %",
         "max abs k_i err %",
@@ -127,6 +129,7 @@ def markdown(summaries: dict[str, dict]) -> str:
         cells.append(
             [
                 name,
+                f"{s['trusted']} of {s['seeds']}",
                 f"{s['n_right']} of {s['seeds']}",
                 f"{s['max_abs_J_error_percent']:.2f}",
                 f"{s['max_abs_k_error_percent']:.2f}",

@@ -10,7 +10,8 @@ time of the identification.
 
 Run: ``python -m benchmarks.field_accuracy [--seeds 20] [--first-seed 1] [--rows NAME ...]
 [--out FILE.json]``
-(prints the markdown table); ``--speed`` times the identification instead (five-mass and
+(prints the markdown table; ``--merge A.json B.json …`` tabulates runs made in parts);
+``--speed`` times the identification instead (five-mass and
 three-mass at 1 kHz, three-mass at 4 kHz, 20 s; five-mass 10 and 40 s for the growth
 with record length).
 """
@@ -363,7 +364,8 @@ def _rigid_scores(out: dict, result, row: Row) -> dict:
 
 
 def summary(results: list[dict], row: Row) -> dict:
-    """Counts over seeds: n right, largest |J_i|, |k_i| error, B_i (and J_i, k_i) within 2σ."""
+    """Counts over seeds: trusted (and each untrusted seed's reasons), n right, largest
+    |J_i|, |k_i| error, B_i (and J_i, k_i) within 2σ."""
     right = [r for r in results if r.get("n") == row.drive.n]
 
     def inside(key: str) -> tuple[int, int]:
@@ -374,10 +376,12 @@ def summary(results: list[dict], row: Row) -> dict:
         return max((abs(e) for r in right for e in r.get(key, ())), default=float("nan"))
 
     trusted = sum(r.get("verdict") == "trusted" for r in results)
+    untrusted = {str(r["seed"]): r["reasons"] for r in results if r.get("verdict") == "untrusted"}
     if row.expect:
         return {
             "seeds": len(results),
             "trusted": trusted,
+            "untrusted_reasons": untrusted,
             "cause_named": sum(bool(r.get("cause_named")) for r in results),
             "refused": sum("error" in r for r in results),
             "extend_the_lines": sum(bool(r.get("extend_the_lines")) for r in results),
@@ -394,6 +398,7 @@ def summary(results: list[dict], row: Row) -> dict:
         return {
             "seeds": len(results),
             "trusted": trusted,
+            "untrusted_reasons": untrusted,
             "n_right": len(right),
             "n_chosen": [r.get("n") for r in results],
             "max_abs_J_load_error_percent": max(errors, default=float("nan")),
@@ -405,6 +410,7 @@ def summary(results: list[dict], row: Row) -> dict:
     return {
         "seeds": len(results),
         "trusted": trusted,
+        "untrusted_reasons": untrusted,
         "n_right": len(right),
         "n_chosen": [r.get("n") for r in results],
         "max_abs_J_error_percent": worst("J"),
@@ -558,6 +564,16 @@ def score_rows(
     return summaries, results
 
 
+def merged(paths: Sequence[Path]) -> dict[str, dict]:
+    """The summaries of several runs' JSON files (``--out`` of runs over other seeds or
+    rows), their runs pooled per row, in the order of :data:`ROWS`."""
+    runs: dict[str, list[dict]] = {}
+    for path in paths:
+        for name, rows in json.loads(path.read_text())["runs"].items():
+            runs.setdefault(name, []).extend(rows)
+    return {name: summary(runs[name], row) for name, row in ROWS.items() if name in runs}
+
+
 def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = print) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
@@ -565,9 +581,13 @@ def main(argv: Sequence[str] | None = None, progress: Callable[[str], None] = pr
     parser.add_argument("--rows", nargs="*", default=list(ROWS))
     parser.add_argument("--out", type=Path)
     parser.add_argument("--speed", action="store_true", help="time the speed rows instead")
+    parser.add_argument("--merge", type=Path, nargs="*", help="only tabulate these --out files")
     args = parser.parse_args(argv)
     if args.speed:
         print(speed_markdown(speed()))
+        return 0
+    if args.merge:
+        print(markdown(merged(args.merge)))
         return 0
     summaries, results = score_rows(
         args.rows, range(args.first_seed, args.first_seed + args.seeds), progress
