@@ -77,6 +77,14 @@ def test_an_inertia_or_stiffness_within_three_sigma_of_zero_is_unresolved():
     assert "k[2]" in unresolved({"k[2]": 0.4}, {})  # no σ: at a bound
 
 
+def test_an_unresolved_rigid_load_names_the_motor_inertia_not_fewer_masses():
+    """n = 0 (the HSM150's record with its catalog J given as J_mo: J_load 8.6e-16 ± 0)
+    has no mass to drop: the reason names J_mo and not --masses."""
+    rigid = unresolved({"J_load": 8.55e-16}, {"J_load": 0.0})
+    assert "--set J_mo" in rigid and "--masses" not in rigid
+    assert "--masses" in unresolved({"J[1]": 3e-4}, {"J[1]": 1.1e-4})
+
+
 @functools.cache
 def _log(seed: int = 0) -> field_sim.Log:
     drive = field_sim.Drive(

@@ -158,6 +158,12 @@ def unresolved(parameters: dict[str, float], std: dict[str, float]) -> str | Non
     True
     >>> unresolved({"J[1]": 7e-11, "k[1]": 0.3}, {"J[1]": 2e-6, "k[1]": 3e-5})[:42]
     'the record does not resolve J[1] = 7e-11 ±'
+
+    A rigid drive (n = 0) has no masses to drop: its load inertia at 0 says the motor
+    inertia given already holds the drive's whole inertia.
+
+    >>> "--set J_mo" in unresolved({"J_load": 1e-15}, {"J_load": 0.0})
+    True
     """
     weak = [
         name
@@ -170,6 +176,13 @@ def unresolved(parameters: dict[str, float], std: dict[str, float]) -> str | Non
     listed = ", ".join(
         f"{name} = {parameters[name]:.3g} ± {std.get(name, float('nan')):.2g}" for name in weak
     )
+    if weak == ["J_load"]:  # n = 0: fewer masses is no remedy
+        return (
+            f"the record does not resolve {listed} (within {LEAST_T:g} standard errors of "
+            "0): the motor inertia given may already be the drive's whole inertia (give the "
+            "motor's own, --set J_mo=…), or excite the drive more (a larger current, a "
+            "longer record)"
+        )
     return (
         f"the record does not resolve {listed} (within {LEAST_T:g} standard errors of 0): "
         "excite the drive more (a larger current, lines around every mode, a longer "
