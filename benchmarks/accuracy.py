@@ -300,12 +300,13 @@ def run(
     ``whole_chain_only``: only the whole-chain rows of the project's chains,
     ``whole_chain.md``/``.json``)."""
     started = time.perf_counter()
-    if load_torque_only:
-        return _load_torque_rows(out, max(b_seeds, seeds), quick, progress, started)
-    if beam_only:
-        return _beam_rows(out, max(b_seeds, seeds), quick, progress, started)
-    if whole_chain_only:
-        return _whole_chain_rows(out, max(b_seeds, seeds), quick, progress, started)
+    for only, table, stem in (
+        (load_torque_only, _load_torque_table, "load_torque"),
+        (beam_only, _beam_table, "beam"),
+        (whole_chain_only, _whole_chain_table, "whole_chain"),
+    ):
+        if only:
+            return _rows_alone(out, max(b_seeds, seeds), quick, progress, started, table, stem)
     cases = CASES[:1] if quick else CASES
     seed_list = list(range(1, seeds + 1))
     results = {case.name: score_case(case, seed_list, progress) for case in cases}
@@ -411,18 +412,6 @@ def _whole_chain_table(
     return text, {"whole_chain": whole}
 
 
-def _whole_chain_rows(
-    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
-) -> dict[str, object]:
-    seeds = list(range(1, (1 if quick else count) + 1))
-    text, summary = _whole_chain_table(seeds, quick, progress)
-    summary["seconds"] = time.perf_counter() - started
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "whole_chain.md").write_text(text, encoding="utf-8")
-    (out / "whole_chain.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
-    return {"table": text, **summary, "files": ("whole_chain.md", "whole_chain.json")}
-
-
 def _beam_table(
     seeds: Sequence[int], quick: bool, progress: Callable[[str], None]
 ) -> tuple[str, dict[str, object]]:
@@ -438,28 +427,24 @@ def _beam_table(
     return text, {"flexible_link": rows}
 
 
-def _beam_rows(
-    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
+def _rows_alone(
+    out: Path,
+    count: int,
+    quick: bool,
+    progress: Callable[[str], None],
+    started: float,
+    table: Callable[..., tuple[str, dict[str, object]]],
+    stem: str,
 ) -> dict[str, object]:
+    """One group of rows alone (``table``: seeds 1 … ``count``, one in quick mode), written
+    as ``STEM.md`` and ``STEM.json`` into ``out``, with the wall time (s)."""
     seeds = list(range(1, (1 if quick else count) + 1))
-    text, summary = _beam_table(seeds, quick, progress)
+    text, summary = table(seeds, quick, progress)
     summary["seconds"] = time.perf_counter() - started
     out.mkdir(parents=True, exist_ok=True)
-    (out / "beam.md").write_text(text, encoding="utf-8")
-    (out / "beam.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
-    return {"table": text, **summary, "files": ("beam.md", "beam.json")}
-
-
-def _load_torque_rows(
-    out: Path, count: int, quick: bool, progress: Callable[[str], None], started: float
-) -> dict[str, object]:
-    seeds = list(range(1, (1 if quick else count) + 1))
-    text, summary = _load_torque_table(seeds, quick, progress)
-    summary["seconds"] = time.perf_counter() - started
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "load_torque.md").write_text(text, encoding="utf-8")
-    (out / "load_torque.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
-    return {"table": text, **summary, "files": ("load_torque.md", "load_torque.json")}
+    (out / f"{stem}.md").write_text(text, encoding="utf-8")
+    (out / f"{stem}.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    return {"table": text, **summary, "files": (f"{stem}.md", f"{stem}.json")}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

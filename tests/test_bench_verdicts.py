@@ -48,3 +48,29 @@ def test_the_chain_table_prints_the_verdict_count() -> None:
     table = chain_accuracy.markdown({"two-mass": row})
     assert "| two-mass | 1 of 2 | 2 of 2 |" in table
     assert table.splitlines()[0].startswith("| chain | trusted | n right |")
+
+
+def test_a_group_of_accuracy_rows_runs_alone_into_its_own_files(tmp_path: Path, monkeypatch):
+    """``bench accuracy --beam-only`` / ``--load-torque-only`` / ``--whole-chain-only``: that
+    group's table alone, on seeds 1 … max(seeds, b_seeds) (one in quick mode), written as
+    ``STEM.md`` and ``STEM.json``."""
+    from benchmarks import accuracy
+
+    for flag, name, stem in (
+        ("beam_only", "_beam_table", "beam"),
+        ("load_torque_only", "_load_torque_table", "load_torque"),
+        ("whole_chain_only", "_whole_chain_table", "whole_chain"),
+    ):
+        seen = []
+
+        def table(seeds, quick, progress, stem=stem, seen=seen):
+            seen.append(list(seeds))
+            return f"{stem} table", {stem: 1}
+
+        monkeypatch.setattr(accuracy, name, table)
+        out = tmp_path / stem
+        result = accuracy.run(out, 2, 3, False, lambda _: None, **{flag: True})
+        assert seen == [[1, 2, 3]] and result["table"] == f"{stem} table"
+        assert (out / f"{stem}.md").read_text() == f"{stem} table"
+        assert json.loads((out / f"{stem}.json").read_text())[stem] == 1
+        assert result["files"] == (f"{stem}.md", f"{stem}.json")
