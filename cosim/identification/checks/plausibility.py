@@ -66,11 +66,11 @@ BALANCE_SIGMAS = 3.0
 MAIN_LOBE = 2.0
 #: Least periods (a count) of a line the record must hold for the line to count as
 #: resolved: the record's frequency grid is 2π/T, and the Hann window's main lobe spans
-#: two bins either side of a line, so a line under two bins (two periods) from 0 shares
-#: its lobe with bin 0, the record's mean and the trend the detrend removed: the record
-#: cannot tell it from them (the remnant of 40 lines' partial periods reads as a "line"
-#: of 1.1 periods, 13 % of the lines' amplitude, on one seed in five).
-RESOLVED_PERIODS = 2.0
+#: :data:`MAIN_LOBE` bins either side of a line, so a line under two bins (two periods)
+#: from 0 shares its lobe with bin 0, the record's mean and the trend the detrend
+#: removed: the record cannot tell it from them (the remnant of 40 lines' partial periods
+#: reads as a "line" of 1.1 periods, 13 % of the lines' amplitude, on one seed in five).
+RESOLVED_PERIODS = MAIN_LOBE
 #: Least number of periods (a count) of the lowest mode a record should hold: its
 #: spectrum's resolution 2π/T is then at most a tenth of the mode, and the fit's start
 #: transients (a few periods of the slowest motion) leave most of the record. The 20 s
