@@ -167,11 +167,8 @@ def score_rows(
 
 def merged(paths: Sequence[Path]) -> dict[str, dict]:
     """The summaries of several runs' JSON files (``--out`` of runs over other seeds or
-    rows), their runs pooled per row."""
-    runs: dict[str, list[dict]] = {}
-    for path in paths:
-        for name, rows in json.loads(path.read_text())["runs"].items():
-            runs.setdefault(name, []).extend(rows)
+    rows), their runs pooled per row (:func:`benchmarks.field_accuracy.pooled_runs`)."""
+    runs = field_accuracy.pooled_runs(paths)
     return {name: summary(rows, ROWS[name]) for name, rows in runs.items()}
 
 

@@ -564,13 +564,20 @@ def score_rows(
     return summaries, results
 
 
-def merged(paths: Sequence[Path]) -> dict[str, dict]:
-    """The summaries of several runs' JSON files (``--out`` of runs over other seeds or
-    rows), their runs pooled per row, in the order of :data:`ROWS`."""
+def pooled_runs(paths: Sequence[Path]) -> dict[str, list[dict]]:
+    """The per-seed runs of several runs' JSON files (``--out`` of runs over other seeds
+    or rows), pooled per row name, in the files' order."""
     runs: dict[str, list[dict]] = {}
     for path in paths:
         for name, rows in json.loads(path.read_text())["runs"].items():
             runs.setdefault(name, []).extend(rows)
+    return runs
+
+
+def merged(paths: Sequence[Path]) -> dict[str, dict]:
+    """The summaries of several runs' JSON files (:func:`pooled_runs`), in the order of
+    :data:`ROWS`."""
+    runs = pooled_runs(paths)
     return {name: summary(runs[name], row) for name, row in ROWS.items() if name in runs}
 
 
