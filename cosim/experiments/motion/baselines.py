@@ -56,7 +56,7 @@ def chain_modes(params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
     >>> round(float(f[0]), 6), abs(float(z[0])) < 1e-12  # sqrt(k (1/J_m + 1/J_1)), undamped
     (2.0, True)
     """
-    chain = Chain.from_parameters({"D_m": 0.0, **params})
+    chain = Chain.from_parameters(params)  # D_m absent: 0 (Chain.state_space)
     poles = np.linalg.eigvals(np.array(chain.state_space()[0]))
     size = np.abs(poles)
     # one of each oscillating pair; the rigid body's two poles at (or rounded near) 0 drop
