@@ -95,6 +95,7 @@ ArcosimError        -- base of every error arcosim raises for a user to fix
 UserError           -- a bad argument, file or datum
 BuildError          -- an FMU could not be built
 IdentificationError -- a record or setting the identification cannot work with
+RefusedFitError     -- a record that cannot support a whole-chain fit (exit status 1)
 ChainFileError      -- a chain file read_chain cannot read
 
 The paper's experiments and the report are the command ``arcosim reproduce``
@@ -200,6 +201,7 @@ _API = {
     "UserError": "arcosim.errors",
     "BuildError": "arcosim.errors",
     "IdentificationError": "arcosim.identification.errors",
+    "RefusedFitError": "arcosim.identification.errors",
     "ChainFileError": "arcosim.chainfile",
 }
 _names, __getattr__, __dir__ = public_api("arcosim", _API, globals())

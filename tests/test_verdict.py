@@ -159,8 +159,10 @@ def test_a_constant_current_is_refused_naming_it(tmp_path, capsys):
     path = _write(tmp_path / "constant.csv", log, np.full(len(log.time), 0.5))
     assert main(["check", path]) == 1
     assert "the current i_a is constant" in capsys.readouterr().out
-    assert main(["identify", path, "--method", "whole-chain"]) == 2
+    # a refusal of the data, exit 1 as check's; a usage error is 2
+    assert main(["identify", path, "--method", "whole-chain"]) == 1
     assert "the current i_a is constant" in capsys.readouterr().err
+    assert main(["identify", path, "--method", "whole-chain", "--masses", "x"]) == 2
 
 
 @pytest.mark.slow

@@ -158,9 +158,9 @@ def test_whole_chain_reads_n_from_the_record_unless_given(tmp_path, capsys) -> N
     """Without --masses the whole-chain fit searches n as `check` assumes; given, it fits n."""
     log = tmp_path / "log.csv"
     log.write_text("time,i_a,omega_m,theta_m\n0,0,0,0\n0.001,0,0,0\n0.002,0,0,0\n")
-    assert main(["identify", str(log), "--method", "whole-chain"]) == 2
+    assert main(["identify", str(log), "--method", "whole-chain"]) == 1
     assert "n = 0 … " in capsys.readouterr().err
-    assert main(["identify", str(log), "--method", "whole-chain", "--masses", "2"]) == 2
+    assert main(["identify", str(log), "--method", "whole-chain", "--masses", "2"]) == 1
     assert "n = 2 (" in capsys.readouterr().err
 
 

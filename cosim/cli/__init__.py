@@ -24,6 +24,9 @@ Whatever goes wrong, a user sees one line on stderr, never a Python traceback:
 
 * a bad argument, file or value (:class:`~arcosim.errors.ArcosimError`, or an
   argument argparse refuses): ``arcosim: error: …`` and exit status 2;
+* a record that cannot support the fit asked of it
+  (:class:`~arcosim.identification.errors.RefusedFitError`, the log ``arcosim check`` says is
+  not ok): ``arcosim: error: …`` and exit status 1;
 * Python warnings (numpy's, a build's) are collected and printed after a command
   that succeeds, each once, as ``arcosim: warning: …``; a refusal prints only its line;
 * Ctrl-C: ``arcosim: interrupted`` and exit status 130;
@@ -45,7 +48,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from arcosim import ArcosimError, __version__
+from arcosim import ArcosimError, RefusedFitError, __version__
 from arcosim.cli import (
     bench,
     build,
@@ -63,7 +66,7 @@ from arcosim.cli import (
 from arcosim.cli.identify import command as identify
 
 #: Exit status of a refused input, and of an internal error (sysexits' EX_SOFTWARE).
-EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 2, 70, 130
+EXIT_REFUSED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 70, 130
 #: Exit status when the output's reader went away, as a tool killed by SIGPIPE.
 EXIT_BROKEN_PIPE = 141
 
@@ -127,7 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return code
     except ArcosimError as error:
         print(f"arcosim: error: {one_line(str(error))}", file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_REFUSED if isinstance(error, RefusedFitError) else EXIT_USAGE
     except KeyboardInterrupt:
         print("arcosim: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -27,7 +27,7 @@ from arcosim.identification.checks.noise_floor import (
     weak_mode_floor_warning,
 )
 from arcosim.identification.checks.verdict import Verdict, judge, unresolved
-from arcosim.identification.errors import IdentificationError
+from arcosim.identification.errors import IdentificationError, RefusedFitError
 from arcosim.identification.fit.encoder_fit import RIGID_LOAD
 from arcosim.identification.fit.motor_friction import without_friction
 from arcosim.identification.fit.periodic_misfit import (
@@ -241,11 +241,13 @@ def identify_drive(
 
     Raises
     ------
-    IdentificationError
+    RefusedFitError
         A record that cannot support the chain (the message names the missing or weak
         mode and what would fix the record, after the log's implausible units or length
-        when :func:`~arcosim.identification.checks.log_check.log_plausibility` found any), or
-        settings the fit cannot use.
+        when :func:`~arcosim.identification.checks.log_check.log_plausibility` found any):
+        :class:`~arcosim.identification.errors.RefusedFitError`, an ``IdentificationError``.
+    IdentificationError
+        Settings the fit cannot use.
 
     Examples
     --------
@@ -288,7 +290,7 @@ def identify_drive(
     plausibility = decision.plausibility
     if decision.problems:
         # the warnings first (the log's implausible units or length lead), as check says
-        raise IdentificationError("; ".join(decision.warnings + decision.problems))
+        raise RefusedFitError("; ".join(decision.warnings + decision.problems))
     record, encoder = decision.record, decision.encoder
     try:
         choice = identify_whole_chain(
@@ -299,10 +301,9 @@ def identify_drive(
             reading=decision.reading,
             spectrum=decision.spectrum,
         )
-    except IdentificationError as error:
-        if not plausibility:
-            raise
-        raise IdentificationError(f"{'; '.join(plausibility)}; the fit: {error}") from error
+    except IdentificationError as error:  # the record supports no chain: a refusal
+        why = f"{'; '.join(plausibility)}; the fit: {error}" if plausibility else str(error)
+        raise RefusedFitError(why) from error
     fit = choice.fit
     parameters = fit.as_dict()
     floor_findings = _against_floor(time, i_a, choice, decision, k_t, J_m, encoder_cpr, g_dist)

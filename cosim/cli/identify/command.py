@@ -52,7 +52,7 @@ Contract (scripts rely on it)::
   under the model's, and ``FILE.csv`` (``arcosim.cli.identify.plot``). The report
   starts with the verdict (``"verdict": "trusted" | "untrusted"`` and ``"reasons"`` in
   the JSON; :mod:`arcosim.identification.checks.verdict`); exit status 0 when trusted, 3 when
-  the fit was made but is not trusted (printed and written all the same), 2 when it
+  the fit was made but is not trusted (printed and written all the same), 1 when it
   refuses. ``--verbose`` adds the structure choice's evidence to the text.
 * ``--method load-torque [--chain FIT.json]``: the external torque on one load mass over
   time, from the motor alone (``arcosim.identification.load_torque``: the observer FMU's estimator 1
