@@ -158,3 +158,20 @@ def test_the_identified_chain_is_the_chain_its_report_file_holds(tmp_path: Path)
         "J_mo": 2.09e-5,
         **result.observer_parameters(),
     }
+
+
+def test_every_parameter_a_chain_or_a_fit_names_has_its_unit() -> None:
+    """The report prints a unit beside every value: each name the chain gives the FMUs
+    (both motor-inertia spellings), and the fit's own (a rigid drive's load inertia, a
+    load torque), has one, and the inertias, stiffnesses and torques read as such."""
+    from arcosim.identification.drive_identification import DriveIdentification
+
+    chain = Chain(J=(1e-3, 2e-3), k=(0.5, 0.3), B=(1e-4, 2e-4), J_m=2e-5, D_m=1e-5, f_c=2e-3)
+    names = {*chain.parameters(), *chain.parameters(motor="J_m")}
+    units = {name: Chain.unit(name) for name in names}
+    assert {units[n] for n in ("J[2]", "J_mo", "J_m")} == {"kg·m²"}
+    assert units["k[1]"] == "N·m/rad" and units["f_c"] == "N·m"
+    rigid = DriveIdentification(0, {"J_load": 1e-4, "tau_load": 0.1}, {}, {}, friction={"f_c": 0})
+    assert rigid.units == {"J_load": "kg·m²", "tau_load": "N·m", "f_c": "N·m"}
+    with pytest.raises(KeyError):
+        Chain.unit("g_dist")

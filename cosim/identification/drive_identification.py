@@ -28,7 +28,7 @@ from arcosim.identification.checks.noise_floor import (
 )
 from arcosim.identification.checks.verdict import Verdict, judge, unresolved
 from arcosim.identification.errors import IdentificationError, RefusedFitError
-from arcosim.identification.fit.encoder_fit import RIGID_LOAD
+from arcosim.identification.fit.encoder_fit import FIT_UNITS, RIGID_LOAD
 from arcosim.identification.fit.motor_friction import without_friction
 from arcosim.identification.fit.periodic_misfit import (
     chain_drive,
@@ -114,6 +114,19 @@ class DriveIdentification:
             return None
         return Chain.from_parameters({**self.friction, **self.parameters}, self.std, self.masses)
 
+    @property
+    def units(self) -> dict[str, str]:
+        """The SI unit of every parameter of the result (:attr:`parameters` and the
+        friction), by name.
+
+        Examples
+        --------
+        >>> DriveIdentification(1, {"J[1]": 1e-3, "k[1]": 0.5}, {}, {}).units
+        {'J[1]': 'kg·m²', 'k[1]': 'N·m/rad'}
+        """
+        names = dict.fromkeys([*self.parameters, *self.friction])
+        return {name: FIT_UNITS.get(name) or Chain.unit(name) for name in names}
+
     def observer_parameters(self) -> dict[str, float]:
         """The observer FMU's parameters that estimate every load angle with this chain.
 
@@ -149,6 +162,7 @@ class DriveIdentification:
         out.update(self.parameters)
         out.update({k: v for k, v in self.friction.items() if k not in out})  # given
         out["std"] = dict(self.std)
+        out["units"] = self.units
         out.update(
             start=fit.start_note,
             velocity=record.velocity_source,

@@ -25,6 +25,17 @@ INDEXED = ("J", "k", "B")
 #: The motor inertia's parameter name in the observer and controller FMUs (the plant's is
 #: ``J_m``); the observer adds its identified error ``dJm`` to it.
 MOTOR_INERTIA = "J_mo"
+#: The SI unit of each parameter, by its name before ``[`` (the FMUs' parameter names; the
+#: plant's motor inertia is ``J_m``).
+UNITS = {
+    "J": "kg·m²",
+    "k": "N·m/rad",
+    "B": "N·m·s/rad",
+    MOTOR_INERTIA: "kg·m²",
+    "J_m": "kg·m²",
+    "D_m": "N·m·s/rad",
+    "f_c": "N·m",
+}
 
 
 @dataclass(frozen=True)
@@ -159,6 +170,32 @@ class Chain:
             raise ValueError("Chain: J_m is not known: give the motor inertia (J_m)")
         D_m = 0.0 if self.D_m is None else self.D_m
         return state_space(self.J_m, gain, D_m, self.J, self.k, self.B)
+
+    @staticmethod
+    def unit(name: str) -> str:
+        """The SI unit of a chain parameter named as the FMUs name it (:data:`UNITS`).
+
+        Parameters
+        ----------
+        name : str
+            ``J[i]``, ``k[i]``, ``B[i]``, ``J_mo``, ``J_m``, ``D_m`` or ``f_c``.
+
+        Returns
+        -------
+        str
+            Its unit, e.g. ``"N·m/rad"``.
+
+        Raises
+        ------
+        KeyError
+            For a name that is not a chain parameter.
+
+        Examples
+        --------
+        >>> Chain.unit("k[2]"), Chain.unit("f_c")
+        ('N·m/rad', 'N·m')
+        """
+        return UNITS[name.split("[", 1)[0]]
 
     def parameters(self, motor: str = MOTOR_INERTIA) -> dict[str, float]:
         """The values under the FMUs' parameter names, as ``--set`` and the FMUs take them.

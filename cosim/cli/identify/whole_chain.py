@@ -9,7 +9,7 @@ import argparse
 import json
 import sys
 
-from arcosim import DriveIdentification, DriveLog, identify_drive, tool_keys
+from arcosim import Chain, DriveIdentification, DriveLog, identify_drive, tool_keys
 from arcosim.cli.identify.options import EXIT_UNTRUSTED, write_report
 from arcosim.cli.identify.plot import write_plot
 from arcosim.cli.parameters import actuator_of, defaults_note, set_names
@@ -106,15 +106,17 @@ def _print_report(
         print(f"  reason: {reason}")
     print(f"{samples} samples, whole-chain fit ({result.masses} masses):")
     bounds = report.get("bounds", {})
+    units = {**result.units, **{key: Chain.unit(key) for key in bounds if key not in result.units}}
     for key, value in result.parameters.items():
         if key in bounds:
             print(
-                f"  {key:8s} ≤ {bounds[key]:.2g}  (at its bound 0: the record does not resolve it)"
+                f"  {key:8s} ≤ {bounds[key]:.2g} {units[key]}  (at its bound 0: the record does "
+                "not resolve it)"
             )
         else:
-            print(f"  {key:8s} {value:.6g}  ± {result.std[key]:.2g}")
-    for key in set(bounds) - set(result.parameters):
-        print(f"  {key:8s} ≤ {bounds[key]:.2g}  (left out by the selection rule)")
+            print(f"  {key:8s} {value:.6g} ± {result.std[key]:.2g} {units[key]}")
+    for key in sorted(set(bounds) - set(result.parameters)):
+        print(f"  {key:8s} ≤ {bounds[key]:.2g} {units[key]}  (left out by the selection rule)")
     for key, text in result.assumptions.items():
         print(f"  assumption, {key}: {text}")
     for text in result.warnings:

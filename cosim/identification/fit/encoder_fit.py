@@ -72,6 +72,10 @@ MAX_ITERATIONS = 40
 
 #: The rigid drive's (n = 0) one chain parameter: the load inertia J_total − J_m (kg·m²).
 RIGID_LOAD = "J_load"
+#: The SI units of the fit's parameters that are not the chain's
+#: (:data:`arcosim.fmu.flexchain.chain.UNITS` holds those): the rigid drive's load
+#: inertia and a modelled load torque.
+FIT_UNITS = {RIGID_LOAD: "kg·m²", "tau_load": "N·m"}
 
 
 def chain_size(n: int) -> int:
