@@ -44,7 +44,8 @@ Contract (scripts rely on it)::
   prints ``J[i]``, ``k[i]``, ``B[i]``, ``D_m``, ``f_c`` (the observer's own parameter
   names; the text output ends with the ``--set`` line, ``estimator=1`` included, that
   estimates every load angle with them), their standard errors under ``std`` and SI
-  units under ``units``, the evidence (modes seen and their residue t values, weak modes, criterion per n tried).
+  units under ``units``, the evidence (modes seen and their residue t values, weak
+  modes, criterion per n tried).
   Needs a constant sample step and an excitation that rings every mode (``arcosim
   simulate --scenario identification``: 40 lines 3–150 rad/s, 3 A, 20 s); it refuses
   exactly when ``arcosim check`` says not ok (one set of decisions).
