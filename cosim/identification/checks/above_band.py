@@ -235,4 +235,3 @@ def above_band_test(
     dof = 2 * len(w) - design.shape[1]
     p_value = float(stats.chi2.sf(statistic, dof))
     return AboveBand(statistic, dof, p_value, len(w), float(top))
-

@@ -238,9 +238,7 @@ def decide_log(
     return decision
 
 
-def _above_band(
-    decision: LogDecision, i_a: np.ndarray, theta_m: np.ndarray, g_dist: float
-) -> None:
+def _above_band(decision: LogDecision, i_a: np.ndarray, theta_m: np.ndarray, g_dist: float) -> None:
     """When the excitation reaches above 3·g_dist, whether a mode lies there
     (:func:`~arcosim.identification.checks.above_band.above_band_test`), and the doubt
     it leaves (``i_a`` A, ``theta_m`` rad, shape ``(N,)``; ``g_dist`` rad/s)."""
