@@ -84,17 +84,30 @@ class AboveBand:
         level :data:`LEVEL`: a mode lies there."""
         return self.p_value < LEVEL
 
+    @property
+    def limit(self) -> float:
+        """The statistic's 1 − :data:`LEVEL` quantile under a drive without a mode above
+        the band (dimensionless).
+
+        Examples
+        --------
+        >>> round(AboveBand(210.0, 200, 0.3, 103, 300.0).limit)
+        268
+        """
+        return float(stats.chi2.isf(LEVEL, self.dof))
+
     def text(self) -> str:
         """The statistic for the user.
 
         Examples
         --------
-        >>> AboveBand(910.0, 200, 1e-90, 103, 300.0).text()
-        'χ² = 910 on 200 degrees of freedom over 103 bins above 300 rad/s'
+        >>> AboveBand(910.0, 200, 1e-90, 103, 300.0).text()[:60]
+        'χ² = 910 over 103 bins above 300 rad/s, where a drive withou'
         """
         return (
-            f"χ² = {self.statistic:.3g} on {self.dof} degrees of freedom over {self.bins} "
-            f"bins above {self.top:.3g} rad/s"
+            f"χ² = {self.statistic:.3g} over {self.bins} bins above {self.top:.3g} rad/s, "
+            f"where a drive without a mode exceeds {self.limit:.3g} once in "
+            f"{1.0 / LEVEL:.0f} records"
         )
 
 

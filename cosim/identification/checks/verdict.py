@@ -234,7 +234,7 @@ def excitation_above_band(
     >>> smooth = AboveBand(210.0, 200, 0.3, 103, 300.0)
     >>> excitation_above_band(spectrum, 100.0, smooth) is None
     True
-    >>> excitation_above_band(spectrum, 100.0, AboveBand(9e5, 400, 0.0, 203, 300.0))[:42]
+    >>> excitation_above_band(spectrum, 100.0, AboveBand(9e5, 400, 0.0, 203, 300.0))[:41]
     "the motor's response above the 300 rad/s "
     """
     top = dob_band(g_dist)
@@ -249,8 +249,8 @@ def excitation_above_band(
     if test is not None:
         return (
             f"the motor's response above the {top:.3g} rad/s the disturbance observer "
-            f"passes (3·g_dist) departs from a drive without a mode there ({test.text()}, "
-            f"p = {test.p_value:.1g}): a mode lies above the band, unseen by the fit, and "
+            f"passes (3·g_dist) departs from a drive without a mode there ({test.text()}): "
+            "a mode lies above the band, unseen by the fit, and "
             f"the chain below takes up its response; {remedy}"
         )
     return (
