@@ -21,6 +21,10 @@ exactly when ``identify`` goes on to fit, and every warning ``check`` gives,
   Nyquist frequency π/h warns (a mode above it folds into the band; only a faster
   sample rate helps); the lines' count and band are reported, not judged — the modes
   are;
+- above the band: an excitation reaching above 3·g_dist is tested for a mode there
+  (:func:`~arcosim.identification.checks.above_band.above_band_test`), a doubt when one
+  lies there or the record cannot tell
+  (:func:`~arcosim.identification.checks.verdict.excitation_above_band`);
 - the modes the fit reads (:func:`~arcosim.identification.fit.whole_chain.first_reading`,
   the fit's own first step) against the fit's own rule
   (:func:`~arcosim.identification.fit.whole_chain.refusal`), a problem when it refuses;
