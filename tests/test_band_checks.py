@@ -119,3 +119,11 @@ def test_a_noise_bin_near_a_spurious_mode_does_not_drive_it():
 
     log = verdict_accuracy.simulate(verdict_accuracy.ROWS["k_t given 10 % high"], 0)
     assert not driven_modes(log.i_a, H, np.array([250.0]))[0]
+
+
+def test_a_record_too_short_for_the_test_keeps_the_doubt():
+    """Under 40 samples a segment (16 segments): fewer bins than the test needs."""
+    log = _log("PRBS", 1)
+    spectrum = excitation_spectrum(log.i_a[:600], H)
+    assert above_band_test(log.i_a[:600], log.theta_m[:600], H, 300.0, 1500.0) is None
+    assert "too little response there" in excitation_above_band(spectrum, G_DIST, None)

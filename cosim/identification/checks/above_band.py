@@ -221,6 +221,8 @@ def above_band_test(
     True
     """
     i_a, theta_m = np.asarray(i_a, dtype=float), np.asarray(theta_m, dtype=float)
+    if len(i_a) < 4 * LEAST_BINS * max(periods, SEGMENTS):  # a segment under 2·LEAST_BINS bins
+        return None
     current, angle, length, stride = _segments(i_a, theta_m, periods)
     count = len(current)
     w = 2.0 * np.pi * np.fft.rfftfreq(length, h)
