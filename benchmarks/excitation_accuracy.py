@@ -93,6 +93,7 @@ def run_seed(row: ExcitationRow, seed: int) -> dict:
     fitted = "error" not in out
     out["check_ok"] = report.ok
     out["check_warnings"] = list(report.warnings)
+    out["above_band"] = report.above_band
     among = all(w in out.get("warnings", []) or w in out.get("error", "") for w in report.warnings)
     out["agree"] = bool(report.ok == fitted and among)
     return out

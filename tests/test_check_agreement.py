@@ -96,13 +96,6 @@ def test_check_agrees_with_identify(case: str, tmp_path: Path, capsys) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="a known false alarm: a PRBS excites up to about 1.2e3 rad/s, above 3·g_dist, and "
-    "the band check doubts every such record although this drive has no mode up there "
-    "(arcosim.identification.checks.verdict.excitation_above_band is a blanket doubt, not a "
-    "test of what lies above the band); bench accuracy's PRBS row is trusted on 0 of 20",
-)
 def test_a_prbs_log_of_a_drive_without_a_mode_above_the_band_is_trusted(tmp_path: Path, capsys):
     """The excitation row's PRBS log (its drive's modes all below 3·g_dist = 300 rad/s):
     the fit is right (n and J_i, k_i, see bench accuracy), so its verdict should be too."""

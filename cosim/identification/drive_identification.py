@@ -330,6 +330,7 @@ def identify_drive(
         unresolved(parameters, std),
         driving_point_modes(chain[0], chain[1])[0] if choice.n else [],
         decision.spectrum,
+        (i_a, decision.step),
     )
     return DriveIdentification(
         masses=choice.n,

@@ -11,6 +11,8 @@ log_check       -- can a log support identification? (check_log, CheckReport)
 noise_floor     -- the residual the encoder's counts and the current's noise explain
 frf             -- the measured response torque → motor speed (H1 at the lines, Welch,
                    indirect), the model's, the residual against the noise floor
+above_band      -- does a mode lie above 3·g_dist? the response there against a drive's
+                   mode-free form, a χ² test (above_band_test, AboveBand)
 verdict         -- is a fit trusted? the reasons when not, each naming what to check
                    (Verdict, judge)
 """

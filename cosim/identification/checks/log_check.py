@@ -70,6 +70,11 @@ class CheckReport:
     weak : list of tuple of float
         Stable poles seen whose residue t value is below the fit's threshold (rad/s, t
         value): too weakly excited modes (t ≥ :data:`WEAK_T`), or not modes.
+    above_band : str
+        When the excitation reaches above 3·g_dist and the record can tell, whether a
+        mode lies there and the test's statistic
+        (:func:`~arcosim.identification.checks.above_band.above_band_test`); empty
+        otherwise.
     """
 
     ok: bool
@@ -87,6 +92,7 @@ class CheckReport:
     modes: list[float] = field(default_factory=list)
     t_values: list[float] = field(default_factory=list)
     weak: list[tuple[float, float]] = field(default_factory=list)
+    above_band: str = ""
 
     def text(self) -> str:
         """A few lines for the user."""
@@ -109,6 +115,8 @@ class CheckReport:
             )
             + self._weak_text(),
         ]
+        if self.above_band:
+            out.append(f"above the band: {self.above_band}")
         out += [f"problem: {p}" for p in self.problems]
         out += [f"warning: {w}" for w in self.warnings]
         if not self.ok:
@@ -246,6 +254,9 @@ def report_of(decision: LogDecision, theta: np.ndarray, encoder_cpr: int) -> Che
         shown = np.array([w for w in report.lines if w <= decision.band])
         if len(shown) and encoder_cpr > 0:
             report.line_t = line_visibility(theta, decision.step, shown, 2 * np.pi / encoder_cpr)
+    test = decision.above_test
+    if test is not None:
+        report.above_band = f"{'a mode' if test.mode else 'no mode'} ({test.text()})"
     if decision.detected is not None:
         report.modes = [float(w) for w in decision.detected.frequency]
         report.t_values = [float(t) for t in decision.detected.t_value]

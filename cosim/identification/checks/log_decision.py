@@ -21,6 +21,10 @@ exactly when ``identify`` goes on to fit, and every warning ``check`` gives,
   Nyquist frequency π/h warns (a mode above it folds into the band; only a faster
   sample rate helps); the lines' count and band are reported, not judged — the modes
   are;
+- above the band: an excitation reaching above 3·g_dist is tested for a mode there
+  (:func:`~arcosim.identification.checks.above_band.above_band_test`), a doubt when one
+  lies there or the record cannot tell
+  (:func:`~arcosim.identification.checks.verdict.excitation_above_band`);
 - the modes the fit reads (:func:`~arcosim.identification.fit.whole_chain.first_reading`,
   the fit's own first step) against the fit's own rule
   (:func:`~arcosim.identification.fit.whole_chain.refusal`), a problem when it refuses;
@@ -35,6 +39,7 @@ import numpy as np
 
 from arcosim.fmu.flexchain.defaults import G_DIST, VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
+from arcosim.identification.checks.above_band import AboveBand, above_band_test
 from arcosim.identification.checks.plausibility import (
     mode_record_length,
     plausibility_warnings,
@@ -42,7 +47,7 @@ from arcosim.identification.checks.plausibility import (
 )
 from arcosim.identification.checks.verdict import excitation_above_band
 from arcosim.identification.errors import IdentificationError
-from arcosim.identification.excitation.band import search_band
+from arcosim.identification.excitation.band import dob_band, search_band
 from arcosim.identification.excitation.spectrum import ExcitationSpectrum, excitation_spectrum
 from arcosim.identification.fit.encoder_fit import STUCK_VELOCITY_COUNTS
 from arcosim.identification.fit.whole_chain import first_reading, refusal
@@ -83,8 +88,12 @@ class LogDecision:
     plausibility : list of str
         The plausibility findings among the warnings (a refusal names them first).
     above_band : str or None
-        The excitation reaching above the disturbance observer's band, when it does
-        (:func:`~arcosim.identification.checks.verdict.excitation_above_band`).
+        The excitation reaching above the disturbance observer's band when something
+        may lie there (:func:`~arcosim.identification.checks.verdict.excitation_above_band`).
+    above_test : AboveBand or None
+        The test of the response above that band
+        (:func:`~arcosim.identification.checks.above_band.above_band_test`); None when
+        the excitation stays below it or the record cannot tell.
     step : float
         Mean sample step (s).
     step_spread : float
@@ -115,6 +124,7 @@ class LogDecision:
     warnings: list[str] = field(default_factory=list)
     plausibility: list[str] = field(default_factory=list)
     above_band: str | None = None
+    above_test: AboveBand | None = None
     step: float = 0.0
     step_spread: float = 0.0
     range_counts: float = 0.0
@@ -210,7 +220,7 @@ def decide_log(
     _excitation(decision, i_a)
     lowest = resolved_lowest(decision.spectrum, float(time[-1] - time[0]))
     decision.plausibility = plausibility_warnings(time, i_a, omega_m, theta_m, k_t, J_m, lowest)
-    decision.above_band = excitation_above_band(decision.spectrum, g_dist)
+    _above_band(decision, i_a, theta_m, g_dist)
     decision.warnings += decision.doubts
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0
     _motion(decision, theta_m, h, count, g_dist)
@@ -230,6 +240,18 @@ def decide_log(
         )
         _length_against_modes(decision, time)
     return decision
+
+
+def _above_band(decision: LogDecision, i_a: np.ndarray, theta_m: np.ndarray, g_dist: float) -> None:
+    """When the excitation reaches above 3·g_dist, whether a mode lies there
+    (:func:`~arcosim.identification.checks.above_band.above_band_test`), and the doubt
+    it leaves (``i_a`` A, ``theta_m`` rad, shape ``(N,)``; ``g_dist`` rad/s)."""
+    spectrum, top = decision.spectrum, dob_band(g_dist)
+    if spectrum is not None and spectrum.highest is not None and spectrum.highest > top:
+        decision.above_test = above_band_test(
+            i_a, theta_m, decision.step, top, spectrum.highest, spectrum.periods
+        )
+    decision.above_band = excitation_above_band(spectrum, g_dist, decision.above_test)
 
 
 def _length_against_modes(decision: LogDecision, time: np.ndarray) -> None:

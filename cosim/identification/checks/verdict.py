@@ -18,8 +18,11 @@ noise:
   more than :data:`~arcosim.identification.checks.noise_floor.FLOOR_FACTOR` × what the
   encoder's counts and the current's noise explain does not describe the drive;
 * **every mode where the record excites it**: a clamped mode of the final chain outside
-  the band the current excites (beyond one step of the excitation's own line grid) is
-  not resolved by the record. The fit puts one there when something the chain cannot
+  the band the current excites (beyond one step of the excitation's own line grid) and
+  with no current power above its noise level near it
+  (:func:`~arcosim.identification.excitation.band.driven_modes`: a closed loop's current
+  drives a wide band however few lines dominate it) is not resolved by the record. The
+  fit puts one there when something the chain cannot
   describe is left over: a k_t 10 % high or J_m 10 % low (an inertia on the motor, which
   a stiff extra mass above the band imitates: measured 248 rad/s under 150 rad/s of
   excitation), or a mode above the band;
@@ -28,7 +31,10 @@ noise:
   (the record does not move it), is not determined by the record;
 * **the excitation against the disturbance observer's band**: an excitation reaching
   above 3·g_dist drives modes that τ̂_reac, and so the fit, cannot see (a motor bench's
-  mode at 339 rad/s under the default g_dist of 100 rad/s).
+  mode at 339 rad/s under the default g_dist of 100 rad/s); it is a doubt when the
+  motor's response up there departs from a drive without a mode
+  (:func:`~arcosim.identification.checks.above_band.above_band_test`), or when the record
+  holds too little excitation above the band to tell.
 
 :func:`judge` collects them; :class:`Verdict` is what ``identify`` reports first, with
 exit status 3 when untrusted.
@@ -42,7 +48,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arcosim.identification.excitation.band import dob_band
+from arcosim.identification.checks.above_band import AboveBand
+from arcosim.identification.excitation.band import dob_band, driven_modes
 from arcosim.identification.excitation.spectrum import ExcitationSpectrum
 
 #: The verdict's two words.
@@ -116,9 +123,16 @@ def resolved_band(spectrum: ExcitationSpectrum | None) -> tuple[float, float] | 
     return float(max(low - step, 0.0)), float(high + step)
 
 
-def modes_outside(modes: Sequence[float], spectrum: ExcitationSpectrum | None) -> str | None:
+def modes_outside(
+    modes: Sequence[float],
+    spectrum: ExcitationSpectrum | None,
+    current: tuple[np.ndarray, float] | None = None,
+) -> str | None:
     """A reason when a clamped mode (rad/s) of the final chain lies outside the band the
-    excitation resolves (:func:`resolved_band`); None when every mode lies inside.
+    excitation resolves (:func:`resolved_band`) and, given the current (A, shape
+    ``(N,)``) and its step (s), the current does not drive it either
+    (:func:`~arcosim.identification.excitation.band.driven_modes`: its power stands
+    above its noise level near the mode); None when every mode is resolved.
 
     Examples
     --------
@@ -133,6 +147,9 @@ def modes_outside(modes: Sequence[float], spectrum: ExcitationSpectrum | None) -
     if band is None:
         return None
     outside = [w for w in modes if not band[0] <= w <= band[1]]
+    if outside and current is not None:
+        driven = driven_modes(current[0], current[1], np.array(outside))
+        outside = [w for w, d in zip(outside, driven) if not d]
     if not outside:
         return None
     listed = ", ".join(f"{w:.3g}" for w in outside)
@@ -190,11 +207,18 @@ def unresolved(parameters: dict[str, float], std: dict[str, float]) -> str | Non
     )
 
 
-def excitation_above_band(spectrum: ExcitationSpectrum | None, g_dist: float) -> str | None:
+def excitation_above_band(
+    spectrum: ExcitationSpectrum | None, g_dist: float, test: AboveBand | None = None
+) -> str | None:
     """A reason when the excitation reaches above the band the disturbance observer
-    passes, 3·g_dist (rad/s; :func:`~arcosim.identification.excitation.band.dob_band`): the modes
-    there are driven, but τ̂_reac holds too little of them for the fit to see, and the
-    chain below takes up their response.
+    passes, 3·g_dist (rad/s; :func:`~arcosim.identification.excitation.band.dob_band`),
+    and something may lie there: the modes there are driven, but τ̂_reac holds too
+    little of them for the fit to see, and the chain below takes up their response.
+
+    ``test`` (:func:`~arcosim.identification.checks.above_band.above_band_test`) says
+    whether the motor's response above the band departs from a drive without a mode
+    there: a reason when it does, none when it does not; without it (too little
+    excitation above the band to tell) the reach alone is the reason.
 
     The sample rate's limit of the band, 0.3/h, is not judged here: what lies above it
     is beyond the discrete model's accuracy, not hidden by the user's settings.
@@ -207,16 +231,33 @@ def excitation_above_band(spectrum: ExcitationSpectrum | None, g_dist: float) ->
     True
     >>> excitation_above_band(spectrum, 100.0)[:44]
     'the excitation reaches 1.57e+03 rad/s, above'
+    >>> smooth = AboveBand(210.0, 200, 0.3, 103, 300.0)
+    >>> excitation_above_band(spectrum, 100.0, smooth) is None
+    True
+    >>> excitation_above_band(spectrum, 100.0, AboveBand(9e5, 400, 0.0, 203, 300.0))[:41]
+    "the motor's response above the 300 rad/s "
     """
     top = dob_band(g_dist)
     if spectrum is None or spectrum.highest is None or spectrum.highest <= top:
         return None
+    if test is not None and not test.mode:
+        return None
+    remedy = (
+        "raise the observer's bandwidth "
+        f"(--set g_dist={math.ceil(spectrum.highest / 3.0):g} or more) or excite only below it"
+    )
+    if test is not None:
+        return (
+            f"the motor's response above the {top:.3g} rad/s the disturbance observer "
+            f"passes (3·g_dist) departs from a drive without a mode there ({test.text()}): "
+            "a mode lies above the band, unseen by the fit, and "
+            f"the chain below takes up its response; {remedy}"
+        )
     return (
         f"the excitation reaches {spectrum.highest:.3g} rad/s, above the {top:.3g} rad/s "
-        "the disturbance observer passes (3·g_dist): a mode there goes unseen and the "
-        "chain below takes up its response; raise the observer's bandwidth "
-        f"(--set g_dist={math.ceil(spectrum.highest / 3.0):g} or more) or excite only below "
-        "it"
+        "the disturbance observer passes (3·g_dist), with too little response there to "
+        "tell whether a mode lies above the band: one would go unseen and the chain below "
+        f"take up its response; {remedy}"
     )
 
 
@@ -226,6 +267,7 @@ def judge(
     resolution: str | None,
     modes: Sequence[float],
     spectrum: ExcitationSpectrum | None,
+    current: tuple[np.ndarray, float] | None = None,
 ) -> Verdict:
     """The verdict on a final model from the evidence the structure choice did not use.
 
@@ -245,6 +287,9 @@ def judge(
         The final chain's clamped modes (rad/s); empty for a rigid drive.
     spectrum : ExcitationSpectrum or None
         What the current's spectrum shows.
+    current : tuple of (ndarray, float), optional
+        The current (A, shape ``(N,)``) and its step (s): a mode outside the lines'
+        band it drives is resolved (:func:`modes_outside`).
 
     Returns
     -------
@@ -259,7 +304,7 @@ def judge(
     ("check the current's scale (--scale i_a=…)",)
     """
     found = [*doubts, *floor]
-    for reason in (resolution, modes_outside(modes, spectrum)):
+    for reason in (resolution, modes_outside(modes, spectrum, current)):
         if reason is not None:
             found.append(reason)
     return Verdict(tuple(dict.fromkeys(found)))

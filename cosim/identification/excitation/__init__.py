@@ -10,6 +10,7 @@ periodic        -- a record of whole periods: the period, its harmonics over the
 harmonics       -- lines that are harmonics of one fundamental (a periodic reference)
 line_prominence -- which found lines are lines: the prominence again on their fitted
                    amplitudes, over the noise and the detrend's remnant
-band            -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band)
+band            -- the band a log shows modes in: min(3·g_dist, 0.3/h) (search_band);
+                   the modes the current drives (driven_modes)
 design          -- the multi-sine to play on a drive (design_excitation, LINE_T)
 """
