@@ -56,3 +56,25 @@ def test_the_sigma_of_every_J_and_k_covers_the_truth_as_claimed() -> None:
     least = fewest_within(len(runs), len(names))
     assert np.all(within >= least), dict(zip(names, within.tolist())) | {"least": least}
     assert all(r["verdict"] == "trusted" for r in runs)
+
+
+#: Seeds of the 4 kHz row on which the fit is quickest (about 12 s each).
+FOUR_KHZ_SEEDS = (3, 7)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="at 4 kHz the smoothed friction sign settles biased: k_1 +0.03 … +0.045 % with "
+    "σ 0.013 % (z +2.1 … +2.8 on seeds 1–7), which one more smoothing round does not move",
+)
+def test_k_1_at_4_khz_is_covered_as_claimed() -> None:
+    """Pins the bias the sign's shift leaves (design record "The friction sign"): with
+    f_c = 0 or the true sign k_1 comes out right. Passes, and so fails the mark, once
+    the sign (or a term for it) covers k_1 at 4 kHz."""
+    row = ROWS["three-mass, 4 kHz"]
+    runs = [run_row(row, seed) for seed in FOUR_KHZ_SEEDS]
+    assert all(r["n"] == row.drive.n for r in runs), [r.get("n") for r in runs]
+    z = [r["k"][0] / r["k_std"][0] for r in runs]
+    within = sum(abs(x) <= 2.0 for x in z)
+    assert within >= fewest_within(len(runs), 1), z
