@@ -6,7 +6,7 @@ the test fails when a count falls below what honest σ reach but with a small
 probability. On the PI speed loop with a constant load (2000-count encoder, Coulomb
 friction given) the friction's sign from the smoother errs at the reversals and the fit
 takes the misplaced torque for inertia: every J_i, k_i came out about +0.06 % with a σ
-of 0.03 % (J_3 and k_1 within 2σ on 4 of these 8 seeds), until the σ counted how far
+of 0.03 % (four of the six within 2σ on 4 of these 8 seeds), until the σ counted how far
 one more smoothing of the sign moves them
 (:func:`arcosim.identification.fit.structure_choice.with_sign_shift`).
 """
