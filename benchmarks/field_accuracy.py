@@ -419,6 +419,7 @@ def summary(results: list[dict], row: Row) -> dict:
         "friction_covered": friction_covered(right),
         "J_inside_2_sigma": inside("J"),
         "k_inside_2_sigma": inside("k"),
+        "J_k_z": z_scores(right, row.drive.n),
         "median_abs_B_error_percent": float(np.median([abs(e) for r in right for e in r["B"]]))
         if right
         else float("nan"),
@@ -427,6 +428,28 @@ def summary(results: list[dict], row: Row) -> dict:
         "cpu_seconds_median": float(np.median([r["cpu_seconds"] for r in results])),
         "stuck_fraction_median": float(np.median([r["stuck_fraction"] for r in results])),
     }
+
+
+def z_scores(right: list[dict], n: int) -> dict[str, dict[str, float]]:
+    """Per J_i, k_i over the seeds ``right``: the mean and standard deviation of its
+    z-score (error / σ, dimensionless). With honest σ they are 0 and 1; a mean away from
+    0 is a bias the σ leave out, a spread above 1 a σ too small.
+
+    Examples
+    --------
+    >>> runs = [{"J": [0.1], "J_std": [0.1], "k": [-0.2], "k_std": [0.1]},
+    ...         {"J": [0.3], "J_std": [0.1], "k": [0.0], "k_std": [0.1]}]
+    >>> z_scores(runs, 1)["J[1]"]
+    {'mean': 2.0, 'sd': 1.414}
+    """
+    out = {}
+    for key in "Jk":
+        for i in range(n):
+            z = [r[key][i] / r[key + "_std"][i] for r in right if r[key + "_std"][i] > 0]
+            mean = float(np.mean(z)) if z else float("nan")
+            sd = float(np.std(z, ddof=1)) if len(z) > 1 else float("nan")
+            out[f"{key}[{i + 1}]"] = {"mean": round(mean, 3), "sd": round(sd, 3)}
+    return out
 
 
 def friction_covered(right: list[dict]) -> tuple[int, int]:

@@ -64,6 +64,7 @@ from arcosim.identification.fit.structure_choice import (
     friction_form,
     load_choice,
     scores,
+    with_sign_shift,
 )
 from arcosim.identification.fit.weak_modes import without_weak_modes
 from arcosim.identification.modes.detection import (
@@ -316,6 +317,7 @@ def identify_whole_chain(
         )
         if kept(response, encoder, n, before, result, "the load torque chosen") is before:
             result, encoder = before, unloaded
+        result = with_sign_shift(encoder, n, result)
     result.extra["selection"] = selection
     result.extra.update(
         detected_modes_rad_s=[float(w) for w in detected.frequency],
