@@ -37,13 +37,15 @@ is capped at the prior's. Dampers and frictions are kept ≥ 0, stiffnesses with
 :data:`STIFFNESS_RANGE` of their scale.
 ``F``, ``Γ`` and their derivatives (central differences of the exact discretization) are
 designed at a point ``p_d`` and redesigned when a chain parameter has moved
-:data:`REDESIGN_STEP` from it; in between the predictor uses the first-order expansion
+:data:`REDESIGN_STEP` from it, one discretization a step (a design's 4n + 1 spread over
+as many steps); in between the predictor uses the first-order expansion
 ``F(p) ≈ F(p_d) + Σ ∂F/∂p_j (p_j − p_d,j)``. The Kalman gain stays the commissioning
 chain's: the gradient neglects ∂K/∂p, which is then exact (a gain redesigned with the
 parameters took the two-mass chain's k_1 to 1.10 of its true value, 1.03 with it held).
 
-Each step costs a fixed number of operations (one redesign at most, of fixed size), and
-the state is a fixed set of numbers: constant memory, bounded cost.
+Each step costs a fixed number of operations (one discretization, a matrix exponential of
+the chain's size, at most), and the state is a fixed set of numbers: constant memory,
+bounded cost.
 
 What it reports:
 
@@ -322,6 +324,15 @@ class ChainTracker:
         self.dF: list[Matrix] = []
         self.dGamma: list[Matrix] = []
         self.K: list[float] = []
+        # a design under way (:meth:`redesign`): its point, its next part (−1: none), the
+        # parts done, and the upper side of the parameter being differenced
+        self.next_p = self.p_d
+        self.part = -1
+        self.next_F: Matrix = []
+        self.next_Gamma: Matrix = []
+        self.next_dF: list[Matrix] = []
+        self.next_dGamma: list[Matrix] = []
+        self.upper: list[Matrix] = []
 
     def chain(self, p: Sequence[float]) -> tuple[list[float], list[float]]:
         """Stiffnesses (N·m/rad) and dampings (N·m·s/rad) of ``p``, shape ``(n,)`` each."""
@@ -332,32 +343,64 @@ class ChainTracker:
         )
 
     def design(self, h: float) -> None:
-        """Discretize at the present parameters for step ``h`` (s): ``F``, ``Γ`` and their
-        derivatives by each chain parameter (central differences); for a new step, the
-        Kalman gain, at the commissioning chain."""
-        n = self.n
+        """Discretize at the present parameters for step ``h`` (s), all at once: ``F``,
+        ``Γ`` and their derivatives by each chain parameter (central differences); for
+        a new step, the Kalman gain, at the commissioning chain. Any redesign under way
+        (:meth:`redesign`) is dropped."""
         if not self.K or not same_step(h, self.h_d):
             k, B = self.chain(self.p0)
             self.K = step_model(self.J, k, B, self.g_dist, self.noise, h).K
-        p_d = self.p[: 2 * n]
-        self.F, self.Gamma = filtered_chain(self.J, *self.chain(p_d), self.g_dist, h)
-        self.dF, self.dGamma = [], []
-        for j in range(2 * n):
-            delta = DIFFERENCE_STEP * max(p_d[j], 1.0)
-            sides = []
-            for sign in (1.0, -1.0):
-                q = p_d[:]
-                q[j] += sign * delta
-                sides.append(filtered_chain(self.J, *self.chain(q), self.g_dist, h))
-            (Fp, Gp), (Fm, Gm) = sides
-            self.dF.append(
-                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Fp, Fm)]
-            )
-            self.dGamma.append(
-                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Gp, Gm)]
-            )
         self.h_d = h
-        self.p_d = p_d
+        self.begin()
+        while self.part >= 0:
+            self.advance()
+
+    def begin(self) -> None:
+        """Start a design at the present chain parameters (for the design's step)."""
+        n = self.n
+        self.next_p = self.p[: 2 * n]
+        self.part = 0
+
+    def redesign(self) -> None:
+        """One part of a design under way, or the start of one once a chain parameter has
+        moved :data:`REDESIGN_STEP` from the design point: a step pays for one
+        discretization at most, and the design, 4n + 1 of them, is in use 4n + 1 steps
+        after it began (21 ms at 1 ms for n = 5, against the parameters' drift over
+        ``tracking_time``); the first-order expansion about the last design serves
+        meanwhile."""
+        if self.part < 0 and any(abs(a - b) > REDESIGN_STEP for a, b in zip(self.p, self.p_d)):
+            self.begin()
+        if self.part >= 0:
+            self.advance()
+
+    def advance(self) -> None:
+        """The design's next discretization: part 0 the design point itself, parts
+        2j + 1 and 2j + 2 the chain parameter j stepped up and down (its derivative, by
+        central difference, once both are in); after the last part the design replaces
+        the one in use."""
+        n, h, q, part = self.n, self.h_d, self.next_p[:], self.part
+        j, side = divmod(part - 1, 2)
+        delta = DIFFERENCE_STEP * max(q[j], 1.0) if part else 0.0
+        if part:
+            q[j] += delta if side == 0 else -delta
+        F, Gamma = filtered_chain(self.J, *self.chain(q), self.g_dist, h)
+        if part == 0:
+            self.next_F, self.next_Gamma = F, Gamma
+            if not self.next_dF:  # the first design: the slots its successors fill in place
+                self.next_dF, self.next_dGamma = [F] * (2 * n), [Gamma] * (2 * n)
+        elif side == 0:
+            self.upper = [F, Gamma]
+        else:
+            (Fp, Gp), d = self.upper, 2.0 * delta
+            self.next_dF[j] = [[(a - b) / d for a, b in zip(ra, rb)] for ra, rb in zip(Fp, F)]
+            self.next_dGamma[j] = [
+                [(a - b) / d for a, b in zip(ra, rb)] for ra, rb in zip(Gp, Gamma)
+            ]
+        self.part = part + 1
+        if self.part == 4 * n + 1:  # in use; copies of the lists, whose slots the next fills
+            self.F, self.Gamma = self.next_F, self.next_Gamma
+            self.dF, self.dGamma = self.next_dF[:], self.next_dGamma[:]
+            self.p_d, self.part = self.next_p, -1
 
     def step(
         self,
@@ -386,10 +429,10 @@ class ChainTracker:
         friction_sign = self.edges.sliding(defaults.SLIDING_INTERVAL)
         sticking = friction_sign == 0.0
         theta_m += self.edges.half_count
-        if not same_step(h, self.h_d) or any(
-            abs(a - b) > REDESIGN_STEP for a, b in zip(self.p, self.p_d)
-        ):
+        if not same_step(h, self.h_d):
             self.design(h)
+        else:
+            self.redesign()
         p, sc = self.p, self.scale
         F, Gamma, K = self.F, self.Gamma, self.K
         u = theta_m - self.theta0
