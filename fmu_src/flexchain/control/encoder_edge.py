@@ -125,7 +125,9 @@ class CrossedEdge:
             How much later than the last interval the next edge may come and the motor
             still be taken as sliding (s, ≥ 0; default 0). The samples see each edge up
             to a step after it is crossed, so at a constant speed the intervals they
-            read differ by up to two steps: ``late = 2 h`` keeps a steady slide sliding.
+            read differ by a step, and a time since equal to the interval may fall
+            either side of it by the steps' last bits: ``late = 2 h`` keeps a steady or
+            slowing slide sliding.
 
         Returns
         -------
