@@ -199,6 +199,25 @@ def test_no_alarm_while_friction_is_not_taught():
     assert not tr.valid and not tr.alarm
 
 
+def test_a_small_viscous_friction_drifts_against_its_floor() -> None:
+    """D_m of 2e-5 N·m·s/rad sits below its floor (f_c's scale / VISCOUS_SPEED, 2e-4):
+    resolved to a thousandth of the floor, a change of twice the threshold of its value
+    is a tenth of the threshold of the floor, no drift; twice the threshold of the
+    floor is."""
+    tr = tracker(drive(f_c=defaults.F_C, D_m=defaults.D_M))
+    m = 2 * len(K2) + 1  # D_m's index
+    assert tr.p0[m] < 1.0  # the commissioning value under its floor
+    for i in (0, 1, 4, m):
+        tr.P[i][i] = 1e-6
+    tr.learnt = tr.tracking_time
+    tr.p[m] = tr.p0[m] * (1.0 + 2.0 * tr.drift_threshold)
+    tr.judge()
+    assert tr.valid and not tr.alarm
+    tr.p[m] = tr.p0[m] + 2.0 * tr.drift_threshold
+    tr.judge()
+    assert tr.alarm
+
+
 def sigma_k1(rho: float, steps: int = 8000) -> float:
     """σ of k_1 (in units of its scale) after ``steps`` least-squares steps on a constant
     regressor and an AR(1) error of unit variance and lag-one correlation ``rho``, with a

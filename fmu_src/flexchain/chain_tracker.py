@@ -73,8 +73,10 @@ What it reports:
   is the load's; at rest nothing is;
 * ``alarm``: while ``valid``, some stiffness or the Coulomb friction, or a damper or
   the viscous friction resolved to ``3 σ_j`` within ``drift_threshold``, differs from
-  its commissioning value by more than ``drift_threshold`` of it and by more than
-  3 σ_j. A damper the operation does not resolve that finely raises no alarm: a damper
+  its commissioning value by more than ``drift_threshold`` of its scale (the value, or
+  the floor where the value is smaller: a drift of a value near zero is taken against
+  the floor, as its resolution is) and by more than 3 σ_j. A damper the operation does
+  not resolve that finely raises no alarm: a damper
   of a lightly damped chain is seldom resolved in ordinary operation, and with σ capped
   at the prior its estimate would otherwise alarm on any model error. The alarm also waits
   until the memory is full (``tracking_time`` after the start: before, the first
@@ -654,7 +656,7 @@ class ChainTracker:
         filled = self.learnt >= self.tracking_time
         self.alarm = (filled and self.valid) and any(
             (watched[i] or 3.0 * sigma[i] <= threshold)
-            and abs(self.p[i] - self.p0[i]) > max(threshold * abs(self.p0[i]), 3.0 * sigma[i])
+            and abs(self.p[i] - self.p0[i]) > max(threshold, 3.0 * sigma[i])  # in scales
             for i in range(size)
         )
 
