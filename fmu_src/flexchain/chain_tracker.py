@@ -548,6 +548,11 @@ class ChainTracker:
             Px = [fsum_dot(row, x) for row in P]
             denominator = lam + fsum_dot(x, Px)
             gain = [q / denominator for q in Px]
+            if any(P[i][i] - g * q <= 0.0 for i, (g, q) in enumerate(zip(gain, Px))):
+                # a variance this sample would take to 0 or below is rounding, not
+                # information (P spans the loose τ_0 prior to the well-taught
+                # stiffnesses): the step forgets only
+                gain, Px, e_n = [0.0] * size, [0.0] * size, 0.0
             self.block_score = [g + q * e_n for g, q in zip(self.block_score, x)]
         self.block_steps += 1
         self.block_time += h
@@ -560,10 +565,22 @@ class ChainTracker:
         offset = [(1.0 - lam) * (a - b) / v for a, b, v in zip(self.p0, p, prior)]
         for i in range(size):
             p[i] += gain[i] * e_n + fsum_dot(P[i], offset)
+        self.downdate(gain, Px, lam)
+        self.project()
+
+    def downdate(self, gain: list[float], Px: list[float], lam: float) -> None:
+        """``P ← (P − gain Pxᵀ) / λ``, kept symmetric and its diagonal capped at the
+        prior's; ``gain`` and ``Px`` (per scale, shape ``(2n + 3,)``) from :meth:`learn`,
+        ``lam`` the step's forgetting factor (dimensionless)."""
+        P, prior, size = self.P, self.prior, len(self.P)
         for i in range(size):
             row, gi = P[i], gain[i]
             for j in range(size):
                 row[j] = (row[j] - gi * Px[j]) / lam
+        for i in range(size):  # symmetric, as in exact arithmetic (rounding parts the halves)
+            row = P[i]
+            for j in range(i + 1, size):
+                row[j] = P[j][i] = 0.5 * (row[j] + P[j][i])
         shrink = [
             min(1.0, math.sqrt(v / P[i][i])) if P[i][i] > v else 1.0 for i, v in enumerate(prior)
         ]
@@ -574,7 +591,6 @@ class ChainTracker:
                     row[j] *= fi * shrink[j]
                 if fi < 1.0:
                     row[i] = prior[i]  # exactly: at rest P stays the prior
-        self.project()
 
     def project(self) -> None:
         """Keep every parameter in its physical range (:data:`STIFFNESS_RANGE`,
@@ -601,7 +617,7 @@ class ChainTracker:
         self.block_time, self.block_steps = 0.0, 0
         P = self.P
         v = self.variances(lam)
-        self.ratio = [v[i] / P[i][i] for i in range(len(self.ratio))]
+        self.ratio = [v[i] / P[i][i] if P[i][i] > 0.0 else 1.0 for i in range(len(self.ratio))]
 
     def variances(self, lam: float) -> list[float]:
         """The tracked parameters' variances in units of their scales squared, shape
@@ -648,7 +664,8 @@ class ChainTracker:
         # persistence of excitation: the motion has taught more than the prior knew
         least = 1.0 / (EXCITED_SHARE * PRIOR_STD) ** 2
         taught = [
-            1.0 / self.P[i][i] - (self.anchor if self.anchored[i] else 0.0) >= least
+            self.P[i][i] > 0.0
+            and 1.0 / self.P[i][i] - (self.anchor if self.anchored[i] else 0.0) >= least
             for i in range(size)
         ]
         watched = [*taught[:n], *([False] * n), taught[2 * n], False]
