@@ -64,6 +64,23 @@ def test_a_motor_crossing_edges_one_way_slides_until_the_next_edge_is_due() -> N
     assert _slides(counts, within=5 * H) == [0.0] * 3 + [1.0] * 7 + [0.0]
 
 
+def test_a_slide_whose_steps_differ_in_their_last_bits_slides_when_late_allows() -> None:
+    """Edges 2, 3, … steps apart, the third interval's steps an ulp longer than the
+    second's (a log's time column read back): by the edge's own rule the motor is stuck
+    on the step where the time since equals the last interval but for that ulp; allowed
+    two steps late, it slides throughout."""
+    longer = math.nextafter(H, 1.0)
+    counts = [0, 1, 1, 2, 2, 2, 3, 3]
+    steps = [H, H, H, longer, longer, H, H]
+    edge, strict, late = CrossedEdge(0.0, COUNT / 2), [], []
+    for r, h in zip(counts[1:], steps):
+        edge.step(h, r * COUNT)
+        strict.append(edge.sliding(5 * H))
+        late.append(edge.sliding(5 * H, 2 * H))
+    assert strict == [0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0]
+    assert late == [0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+
+
 def test_falling_edges_slide_down() -> None:
     assert _slides([5, 4, 3, 2], within=H)[1:] == [-1.0, -1.0]
 

@@ -33,17 +33,22 @@ at the same rate
 (stabilized forgetting, Kulhavý 1987): ``p ← p + (1 − λ) P P₀⁻¹ (p₀ − p)`` each step,
 so a parameter the operation does not resolve returns to its commissioning value over
 ``tracking_time`` instead of wandering on the errors of the others, and ``P``'s diagonal
-is capped at the prior's. Dampers and frictions are kept ≥ 0, stiffnesses within
+is capped at the prior's. ``P`` starts tighter than the prior for the stiffnesses and the
+Coulomb friction (:data:`INITIAL_STD`, the commissioning identification's certainty), so
+the first moves cannot carry them out of the region where the predictor leads back.
+Dampers and frictions are kept ≥ 0, stiffnesses within
 :data:`STIFFNESS_RANGE` of their scale.
 ``F``, ``Γ`` and their derivatives (central differences of the exact discretization) are
 designed at a point ``p_d`` and redesigned when a chain parameter has moved
-:data:`REDESIGN_STEP` from it; in between the predictor uses the first-order expansion
+:data:`REDESIGN_STEP` from it, one discretization a step (a design's 4n + 1 spread over
+as many steps); in between the predictor uses the first-order expansion
 ``F(p) ≈ F(p_d) + Σ ∂F/∂p_j (p_j − p_d,j)``. The Kalman gain stays the commissioning
 chain's: the gradient neglects ∂K/∂p, which is then exact (a gain redesigned with the
 parameters took the two-mass chain's k_1 to 1.10 of its true value, 1.03 with it held).
 
-Each step costs a fixed number of operations (one redesign at most, of fixed size), and
-the state is a fixed set of numbers: constant memory, bounded cost.
+Each step costs a fixed number of operations (one discretization, a matrix exponential of
+the chain's size, at most), and the state is a fixed set of numbers: constant memory,
+bounded cost.
 
 What it reports:
 
@@ -57,8 +62,10 @@ What it reports:
   innovations, counts each sample as new. The cubic-cost sandwich is formed once a
   block; between, σ_j² is ``P_jj`` times its ratio to it then;
 * ``valid``: the motion is persistently exciting for every stiffness and the Coulomb
-  friction: each one's ``P_jj`` is at most ``(EXCITED_SHARE · PRIOR_STD)²``, so
-  what the motion taught about it outweighs the prior (:data:`EXCITED_SHARE`). ``P_jj``
+  friction: each one's information ``1 / P_jj``, less what is left of the start's
+  beyond the prior (:data:`INITIAL_STD`, forgotten as the data), is at least
+  ``1 / (EXCITED_SHARE · PRIOR_STD)²``, so what the motion taught about it outweighs
+  the prior (:data:`EXCITED_SHARE`). ``P_jj``
   is the marginal variance, what remains after the others, τ_0 among them, are
   accounted for; τ_0's prior is loose (:data:`OFFSET_PRIOR_STD`), so a constant load
   can stand in for any constant torque. At constant speed ``sgn θ̇_m`` and ``θ̇_m``
@@ -66,8 +73,10 @@ What it reports:
   is the load's; at rest nothing is;
 * ``alarm``: while ``valid``, some stiffness or the Coulomb friction, or a damper or
   the viscous friction resolved to ``3 σ_j`` within ``drift_threshold``, differs from
-  its commissioning value by more than ``drift_threshold`` of it and by more than
-  3 σ_j. A damper the operation does not resolve that finely raises no alarm: a damper
+  its commissioning value by more than ``drift_threshold`` of its scale (the value, or
+  the floor where the value is smaller: a drift of a value near zero is taken against
+  the floor, as its resolution is) and by more than 3 σ_j. A damper the operation does
+  not resolve that finely raises no alarm: a damper
   of a lightly damped chain is seldom resolved in ordinary operation, and with σ capped
   at the prior its estimate would otherwise alarm on any model error. The alarm also waits
   until the memory is full (``tracking_time`` after the start: before, the first
@@ -78,7 +87,9 @@ What it reports:
 Which way the motor slides comes from the encoder's edges
 (:meth:`~arcosim.fmu.flexchain.control.encoder_edge.CrossedEdge.sliding`): below a count per step
 its backward difference reads 0 on most steps, and a move of 1 rad in 1 s on 2000 counts
-at 1 ms is mostly there. While the edges show no slide the motor may stand still, and
+at 1 ms is mostly there; the next edge may come up to :data:`EDGE_LATENESS` steps later
+than the last interval (the samples' rounding of each edge's time). While the edges
+show no slide the motor may stand still, and
 static friction (unknown within ±f_c) acts; the G-filtered measurement remembers it for
 :data:`SETTLE` / g_dist s. Over such a step the friction input is the one that makes
 the step's torque the predictor's, clamped to the band (as
@@ -107,6 +118,19 @@ from .model_observer import NoiseModel, filtered_chain, step_model
 #: and no information (the motor at rest), ``P`` grows as λ^−t; capped there, the
 #: estimator never becomes less certain than before it had seen any data.
 PRIOR_STD = 0.1
+#: The stiffnesses' and the Coulomb friction's standard deviation at the start, in units
+#: of their scales (dimensionless): the commissioning identification's, which resolves
+#: them to well under 1 % (the whole-chain fit of 40 s of moves: k within 0.2 %, σ 0.1 %),
+#: taken at 1 %, inside the region where the prediction error leads back to the truth
+#: (on the two-mass chain's 20 s of moves with the 2000-count encoder, the error at fixed
+#: stiffnesses rises from the truth to each point ±7 % off in k_1 and k_2, and is no
+#: longer monotonic at ±15 %). Started at :data:`PRIOR_STD` instead, the first move's
+#: samples, whose quantization error is systematic while the speed sweeps through
+#: fractions of a count per step, took k_1 20 % high within a second, out of that region,
+#: where it stayed (false alarms on every healthy run's full memory). The information
+#: beyond the prior's is forgotten as the data's, so after a few memories the estimate
+#: is the data's; ``valid`` counts the data's information only.
+INITIAL_STD = 0.01
 #: The prior's standard deviation of τ_0, the constant torque through the chain, in units of
 #: its scale (the torque noise's σ): a load the drive carries is not part of the
 #: commissioning chain, so its prior must teach nothing: 1e3 noise levels, a millionth
@@ -144,6 +168,17 @@ DIFFERENCE_STEP = 1e-4
 #: and the predictor's input speed share (errors in variables: without it the two-mass
 #: chain's k_1 crept to 1.04 in 60 s of moves and f_c to 1.06; with it both within 0.5 %).
 PREFILTER_RATIO = 0.5
+#: How many steps later than the last interval between two edges the next may come while
+#: the motor is still taken as sliding: a sample sees an edge up to a step after the motor
+#: crosses it, so the intervals the samples read at a steady speed differ by a step; two
+#: allow that and as much again for a slide that slows. The edge's own rule (the next
+#: edge no later than the last interval) compares two sums of steps, and where they held
+#: the same number of steps, a log's steps, a few ulps apart, put the time since on
+#: either side of the interval: the motor was taken as stuck at random within a slide,
+#: and each stuck step stops the learning for :data:`SETTLE` / g_dist. The tracker
+#: followed those last bits (the two-mass healthy run's k_1 ended 0.5 % off with every
+#: step exactly 1 ms, 10 % off with the steps of the log's time column).
+EDGE_LATENESS = 2.0
 #: Steps that differ by less than this (relative) share a design: a log's time column
 #: read back gives steps a few ulps apart, and the discrete model differs by as little.
 STEP_TOLERANCE = 1e-9
@@ -289,7 +324,13 @@ class ChainTracker:
         size = 2 * n + 3
         self.p = self.p0[:]
         self.prior = [*([PRIOR_STD**2] * (size - 1)), OFFSET_PRIOR_STD**2]  # P₀'s diagonal
-        self.P = [[self.prior[i] if i == j else 0.0 for j in range(size)] for i in range(size)]
+        # the start: the stiffnesses and the Coulomb friction as certain as commissioning
+        # identified them (INITIAL_STD), the rest as the prior; the information beyond the
+        # prior's is forgotten as the data's (``anchor``, per those parameters)
+        self.anchored = [*([True] * n), *([False] * n), True, False, False]
+        start = [INITIAL_STD**2 if a else v for a, v in zip(self.anchored, self.prior)]
+        self.P = [[start[i] if i == j else 0.0 for j in range(size)] for i in range(size)]
+        self.anchor = 1.0 / INITIAL_STD**2 - 1.0 / PRIOR_STD**2
         m = 2 * n + 1
         self.s = [0.0] * m  # chain state [θ, ω] relative to theta0, and its filtered torque
         self.S = [[0.0] * m for _ in range(size)]  # ∂s/∂p_j
@@ -322,6 +363,15 @@ class ChainTracker:
         self.dF: list[Matrix] = []
         self.dGamma: list[Matrix] = []
         self.K: list[float] = []
+        # a design under way (:meth:`redesign`): its point, its next part (−1: none), the
+        # parts done, and the upper side of the parameter being differenced
+        self.next_p = self.p_d
+        self.part = -1
+        self.next_F: Matrix = []
+        self.next_Gamma: Matrix = []
+        self.next_dF: list[Matrix] = []
+        self.next_dGamma: list[Matrix] = []
+        self.upper: list[Matrix] = []
 
     def chain(self, p: Sequence[float]) -> tuple[list[float], list[float]]:
         """Stiffnesses (N·m/rad) and dampings (N·m·s/rad) of ``p``, shape ``(n,)`` each."""
@@ -332,32 +382,64 @@ class ChainTracker:
         )
 
     def design(self, h: float) -> None:
-        """Discretize at the present parameters for step ``h`` (s): ``F``, ``Γ`` and their
-        derivatives by each chain parameter (central differences); for a new step, the
-        Kalman gain, at the commissioning chain."""
-        n = self.n
+        """Discretize at the present parameters for step ``h`` (s), all at once: ``F``,
+        ``Γ`` and their derivatives by each chain parameter (central differences); for
+        a new step, the Kalman gain, at the commissioning chain. Any redesign under way
+        (:meth:`redesign`) is dropped."""
         if not self.K or not same_step(h, self.h_d):
             k, B = self.chain(self.p0)
             self.K = step_model(self.J, k, B, self.g_dist, self.noise, h).K
-        p_d = self.p[: 2 * n]
-        self.F, self.Gamma = filtered_chain(self.J, *self.chain(p_d), self.g_dist, h)
-        self.dF, self.dGamma = [], []
-        for j in range(2 * n):
-            delta = DIFFERENCE_STEP * max(p_d[j], 1.0)
-            sides = []
-            for sign in (1.0, -1.0):
-                q = p_d[:]
-                q[j] += sign * delta
-                sides.append(filtered_chain(self.J, *self.chain(q), self.g_dist, h))
-            (Fp, Gp), (Fm, Gm) = sides
-            self.dF.append(
-                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Fp, Fm)]
-            )
-            self.dGamma.append(
-                [[(a - b) / (2 * delta) for a, b in zip(ra, rb)] for ra, rb in zip(Gp, Gm)]
-            )
         self.h_d = h
-        self.p_d = p_d
+        self.begin()
+        while self.part >= 0:
+            self.advance()
+
+    def begin(self) -> None:
+        """Start a design at the present chain parameters (for the design's step)."""
+        n = self.n
+        self.next_p = self.p[: 2 * n]
+        self.part = 0
+
+    def redesign(self) -> None:
+        """One part of a design under way, or the start of one once a chain parameter has
+        moved :data:`REDESIGN_STEP` from the design point: a step pays for one
+        discretization at most, and the design, 4n + 1 of them, is in use 4n + 1 steps
+        after it began (21 ms at 1 ms for n = 5, against the parameters' drift over
+        ``tracking_time``); the first-order expansion about the last design serves
+        meanwhile."""
+        if self.part < 0 and any(abs(a - b) > REDESIGN_STEP for a, b in zip(self.p, self.p_d)):
+            self.begin()
+        if self.part >= 0:
+            self.advance()
+
+    def advance(self) -> None:
+        """The design's next discretization: part 0 the design point itself, parts
+        2j + 1 and 2j + 2 the chain parameter j stepped up and down (its derivative, by
+        central difference, once both are in); after the last part the design replaces
+        the one in use."""
+        n, h, q, part = self.n, self.h_d, self.next_p[:], self.part
+        j, side = divmod(part - 1, 2)
+        delta = DIFFERENCE_STEP * max(q[j], 1.0) if part else 0.0
+        if part:
+            q[j] += delta if side == 0 else -delta
+        F, Gamma = filtered_chain(self.J, *self.chain(q), self.g_dist, h)
+        if part == 0:
+            self.next_F, self.next_Gamma = F, Gamma
+            if not self.next_dF:  # the first design: the slots its successors fill in place
+                self.next_dF, self.next_dGamma = [F] * (2 * n), [Gamma] * (2 * n)
+        elif side == 0:
+            self.upper = [F, Gamma]
+        else:
+            (Fp, Gp), d = self.upper, 2.0 * delta
+            self.next_dF[j] = [[(a - b) / d for a, b in zip(ra, rb)] for ra, rb in zip(Fp, F)]
+            self.next_dGamma[j] = [
+                [(a - b) / d for a, b in zip(ra, rb)] for ra, rb in zip(Gp, Gamma)
+            ]
+        self.part = part + 1
+        if self.part == 4 * n + 1:  # in use; copies of the lists, whose slots the next fills
+            self.F, self.Gamma = self.next_F, self.next_Gamma
+            self.dF, self.dGamma = self.next_dF[:], self.next_dGamma[:]
+            self.p_d, self.part = self.next_p, -1
 
     def step(
         self,
@@ -383,13 +465,13 @@ class ChainTracker:
         self.times = times = [*self.times[1:], h]
         span = math.fsum(times)
         speed = (readings[-1] - readings[0]) / span if times[0] > 0.0 else 0.0
-        friction_sign = self.edges.sliding(defaults.SLIDING_INTERVAL)
+        friction_sign = self.edges.sliding(defaults.SLIDING_INTERVAL, EDGE_LATENESS * h)
         sticking = friction_sign == 0.0
         theta_m += self.edges.half_count
-        if not same_step(h, self.h_d) or any(
-            abs(a - b) > REDESIGN_STEP for a, b in zip(self.p, self.p_d)
-        ):
+        if not same_step(h, self.h_d):
             self.design(h)
+        else:
+            self.redesign()
         p, sc = self.p, self.scale
         F, Gamma, K = self.F, self.Gamma, self.K
         u = theta_m - self.theta0
@@ -454,6 +536,7 @@ class ChainTracker:
         step without a sample (forgetting and the prior's renewal only)."""
         lam = 1.0 - h / self.tracking_time
         self.learnt = min(self.tracking_time, self.learnt + h)
+        self.anchor *= lam
         P = self.P
         size = len(P)
         gain, Px, e_n = [0.0] * size, [0.0] * size, 0.0
@@ -465,6 +548,11 @@ class ChainTracker:
             Px = [fsum_dot(row, x) for row in P]
             denominator = lam + fsum_dot(x, Px)
             gain = [q / denominator for q in Px]
+            if any(P[i][i] - g * q <= 0.0 for i, (g, q) in enumerate(zip(gain, Px))):
+                # a variance this sample would take to 0 or below is rounding, not
+                # information (P spans the loose τ_0 prior to the well-taught
+                # stiffnesses): the step forgets only
+                gain, Px, e_n = [0.0] * size, [0.0] * size, 0.0
             self.block_score = [g + q * e_n for g, q in zip(self.block_score, x)]
         self.block_steps += 1
         self.block_time += h
@@ -477,10 +565,22 @@ class ChainTracker:
         offset = [(1.0 - lam) * (a - b) / v for a, b, v in zip(self.p0, p, prior)]
         for i in range(size):
             p[i] += gain[i] * e_n + fsum_dot(P[i], offset)
+        self.downdate(gain, Px, lam)
+        self.project()
+
+    def downdate(self, gain: list[float], Px: list[float], lam: float) -> None:
+        """``P ← (P − gain Pxᵀ) / λ``, kept symmetric and its diagonal capped at the
+        prior's; ``gain`` and ``Px`` (per scale, shape ``(2n + 3,)``) from :meth:`learn`,
+        ``lam`` the step's forgetting factor (dimensionless)."""
+        P, prior, size = self.P, self.prior, len(self.P)
         for i in range(size):
             row, gi = P[i], gain[i]
             for j in range(size):
                 row[j] = (row[j] - gi * Px[j]) / lam
+        for i in range(size):  # symmetric, as in exact arithmetic (rounding parts the halves)
+            row = P[i]
+            for j in range(i + 1, size):
+                row[j] = P[j][i] = 0.5 * (row[j] + P[j][i])
         shrink = [
             min(1.0, math.sqrt(v / P[i][i])) if P[i][i] > v else 1.0 for i, v in enumerate(prior)
         ]
@@ -491,7 +591,6 @@ class ChainTracker:
                     row[j] *= fi * shrink[j]
                 if fi < 1.0:
                     row[i] = prior[i]  # exactly: at rest P stays the prior
-        self.project()
 
     def project(self) -> None:
         """Keep every parameter in its physical range (:data:`STIFFNESS_RANGE`,
@@ -518,7 +617,7 @@ class ChainTracker:
         self.block_time, self.block_steps = 0.0, 0
         P = self.P
         v = self.variances(lam)
-        self.ratio = [v[i] / P[i][i] for i in range(len(self.ratio))]
+        self.ratio = [v[i] / P[i][i] if P[i][i] > 0.0 else 1.0 for i in range(len(self.ratio))]
 
     def variances(self, lam: float) -> list[float]:
         """The tracked parameters' variances in units of their scales squared, shape
@@ -563,13 +662,18 @@ class ChainTracker:
         size = 2 * n + 2
         sigma = [math.sqrt(v) for v in self.sigma2()]
         # persistence of excitation: the motion has taught more than the prior knew
-        taught = [self.P[i][i] <= (EXCITED_SHARE * PRIOR_STD) ** 2 for i in range(size)]
+        least = 1.0 / (EXCITED_SHARE * PRIOR_STD) ** 2
+        taught = [
+            self.P[i][i] > 0.0
+            and 1.0 / self.P[i][i] - (self.anchor if self.anchored[i] else 0.0) >= least
+            for i in range(size)
+        ]
         watched = [*taught[:n], *([False] * n), taught[2 * n], False]
         self.valid = all(taught[:n]) and taught[2 * n]
         filled = self.learnt >= self.tracking_time
         self.alarm = (filled and self.valid) and any(
             (watched[i] or 3.0 * sigma[i] <= threshold)
-            and abs(self.p[i] - self.p0[i]) > max(threshold * abs(self.p0[i]), 3.0 * sigma[i])
+            and abs(self.p[i] - self.p0[i]) > max(threshold, 3.0 * sigma[i])  # in scales
             for i in range(size)
         )
 

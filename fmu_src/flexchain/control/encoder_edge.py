@@ -109,17 +109,25 @@ class CrossedEdge:
         self.reading, self.edge = theta_m, edge
         return velocity
 
-    def sliding(self, within: float) -> float:
+    def sliding(self, within: float, late: float = 0.0) -> float:
         """The way the motor slides (+1 or −1), or 0 when the edges do not show it.
 
         It slides the way the edge last moved when that move followed one the same way
-        at most ``within`` earlier, until as long again has passed without another.
+        at most ``within`` earlier, until as long again, and ``late`` more, has passed
+        without another.
 
         Parameters
         ----------
         within : float
             The longest time between two edges of a slide (s); a count over it is the
             slowest speed taken as sliding.
+        late : float
+            How much later than the last interval the next edge may come and the motor
+            still be taken as sliding (s, ≥ 0; default 0). The samples see each edge up
+            to a step after it is crossed, so at a constant speed the intervals they
+            read differ by a step, and a time since equal to the interval may fall
+            either side of it by the steps' last bits: ``late = 2 h`` keeps a steady or
+            slowing slide sliding.
 
         Returns
         -------
@@ -132,7 +140,8 @@ class CrossedEdge:
         >>> [(e.step(1.0, reading), e.sliding(2.0)) for reading in (1.0, 2.0, 2.0, 2.0)]
         [(0.5, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
         """
-        if 0.0 < self.interval and _within(self.interval, within) and self.since <= self.interval:
+        since = self.since
+        if 0.0 < self.interval and _within(self.interval, within) and since <= self.interval + late:
             return self.direction
         return 0.0
 
