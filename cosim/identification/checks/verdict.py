@@ -250,7 +250,8 @@ def excitation_above_band(
         return (
             f"the motor's response above the {top:.3g} rad/s the disturbance observer "
             f"passes (3·g_dist) departs from a drive without a mode there ({test.text()}): "
-            "a mode lies above the band, unseen by the fit, and "
+            "a mode lies above the band (or a lag no chain has: the current loop's, a "
+            "delay), unseen by the fit, and "
             f"the chain below takes up its response; {remedy}"
         )
     return (
