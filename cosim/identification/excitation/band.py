@@ -19,6 +19,7 @@ from arcosim.identification.excitation.periodic import (
     detection_threshold,
     noise_level,
 )
+from arcosim.identification.excitation.spectrum import hann_power
 
 #: Highest clamped frequency sought, in units of g_dist (dimensionless).
 BAND_PER_G = 3.0
@@ -139,7 +140,7 @@ def driven_modes(x: np.ndarray, h: float, modes: np.ndarray) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     t = np.arange(len(x)) * h
     x = x - np.polyval(np.polyfit(t, x, 1), t)
-    power = np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
+    power = hann_power(x)
     ratio = power[1:] / noise_level(power[1:])
     w = np.arange(1, len(power)) * 2.0 * np.pi / (len(x) * h)
     q = detection_threshold(len(ratio), 1.0 / PERIOD_RECORDS)

@@ -396,8 +396,16 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
 DECIMATE_MARGIN = 2.5
 
 
-def _peaks_power(x: np.ndarray) -> np.ndarray:
-    """The Hann-windowed periodogram of ``x`` (its unit squared), shape ``(N//2 + 1,)``."""
+def hann_power(x: np.ndarray) -> np.ndarray:
+    """The Hann-windowed periodogram of ``x`` (shape ``(N,)``; its unit squared), shape
+    ``(N//2 + 1,)``: bin k at k·2π/(N·h) rad/s for a step h.
+
+    Examples
+    --------
+    >>> x = np.sin(2 * np.pi * 10 * np.arange(1000) / 1000)   # 10 periods in 1000 samples
+    >>> int(np.argmax(hann_power(x)))
+    10
+    """
     return np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
 
 
@@ -407,7 +415,7 @@ def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
     peak, q the χ² threshold over the periodogram's bins; with the periodogram, the
     noise level at each bin (its local lower quartile over ln(4/3),
     :func:`~arcosim.identification.excitation.periodic.noise_level`) and q."""
-    power = _peaks_power(x)
+    power = hann_power(x)
     level = np.concatenate([[np.inf], noise_level(power[1:])])
     q = detection_threshold(len(power) - 1)
     peak = np.zeros(len(power), dtype=bool)
