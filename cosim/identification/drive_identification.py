@@ -116,15 +116,16 @@ class DriveIdentification:
 
     @property
     def units(self) -> dict[str, str]:
-        """The SI unit of every parameter of the result (:attr:`parameters` and the
-        friction), by name.
+        """The SI unit of every parameter of the result (:attr:`parameters`, the
+        friction, and the terms the fit bounds instead: the report's ``bounds``), by name.
 
         Examples
         --------
         >>> DriveIdentification(1, {"J[1]": 1e-3, "k[1]": 0.5}, {}, {}).units
         {'J[1]': 'kg·m²', 'k[1]': 'N·m/rad'}
         """
-        names = dict.fromkeys([*self.parameters, *self.friction])
+        bounded = self.choice.fit.extra.get("bounds", {}) if self.choice is not None else {}
+        names = dict.fromkeys([*self.parameters, *self.friction, *bounded])
         return {name: FIT_UNITS.get(name) or Chain.unit(name) for name in names}
 
     def observer_parameters(self) -> dict[str, float]:

@@ -9,7 +9,7 @@ import argparse
 import json
 import sys
 
-from arcosim import Chain, DriveIdentification, DriveLog, identify_drive, tool_keys
+from arcosim import DriveIdentification, DriveLog, identify_drive, tool_keys
 from arcosim.cli.identify.options import EXIT_UNTRUSTED, write_report
 from arcosim.cli.identify.plot import write_plot
 from arcosim.cli.parameters import actuator_of, defaults_note, set_names
@@ -106,7 +106,7 @@ def _print_report(
         print(f"  reason: {reason}")
     print(f"{samples} samples, whole-chain fit ({result.masses} masses):")
     bounds = report.get("bounds", {})
-    units = {**result.units, **{key: Chain.unit(key) for key in bounds if key not in result.units}}
+    units = result.units
     for key, value in result.parameters.items():
         if key in bounds:
             print(
