@@ -137,33 +137,13 @@ def stuck_aware_sign(record: EncoderRecord, drive: Drive, states: np.ndarray) ->
     turned the friction before the motor did (J_load −0.2 % on a ball-screw axis).
     That torque test is made for the rigid drive (n = 0) only: on a three-mass chain
     (``tests/test_field_identification.py``) it tipped the friction form to Coulomb
-    only (B_1 +120 %), the torque then leaving out the chain's own inertia; open.
-
-    On a chain (n ≥ 1) the torque also takes out the motor's inertia, (J_m + J_rigid)·α
-    (kg·m² · rad/s²), so that a motor passing quickly through 0 is not read as held
-    (without it k_1 came out +0.04 %, z +2.7, at 4 kHz). α is the smoothed motor
-    velocity's central difference (ω_{k+1} − ω_{k−1})/2h: the acceleration at the
-    instant k whose states give the spring, damper and D_m ω torques beside it. The
-    backward difference, the mean over the step that u_k is held, lags them by h/2
-    and overcorrects (k_1 −0.012 % at 4 kHz, z −0.9; Coulomb-only motor −0.016 %,
-    z −1.2). The rigid drive's rule is left as it was measured.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> omega = np.array([0.0, 1.0, 4.0, 9.0])
-    >>> np.gradient(omega, 0.5)  # α (rad/s²) for h = 0.5 s, as used here
-    array([ 2.,  4.,  8., 10.])
-    """
+    only (B_1 +120 %), the torque then leaving out the chain's own inertia; open."""
     n = len(drive.J)
     m = n + 1
     omega = states[:, m]
     K, C = drive.coupling(drive.k)[0], drive.coupling(drive.B)[0]
     spring = states[:, :m] @ K + states[:, m : 2 * m] @ C  # the springs' torque on the motor
     other = record.drive - drive.D_m * omega - spring
-    if n:  # the motor's inertia times its mean acceleration over the step
-        alpha = np.gradient(omega, record.h)
-        other = other - (record.J_m + drive.J_rigid) * alpha
     sign = mean_sign(omega)
     slow = np.abs(omega) < STUCK_VELOCITY_COUNTS * record.count
     if n == 0:  # a torque above f_c moves it through 0 (see the docstring)
