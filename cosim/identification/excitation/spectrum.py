@@ -47,7 +47,11 @@ from arcosim.identification.excitation.harmonics import (
     harmonic_fundamental,
     on_harmonics,
 )
-from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
+from arcosim.identification.excitation.line_prominence import (
+    noise_amplitude,
+    prominent_lines,
+    unresolved_lines,
+)
 from arcosim.identification.excitation.periodic import (
     detection_threshold,
     harmonic_lines,
@@ -112,6 +116,11 @@ class ExcitationSpectrum:
     periods : int
         Whole periods the record holds (a count); 0 when it is not read as whole
         periods.
+    unresolved : ndarray
+        Where more lines lie than were told apart (rad/s), shape ``(U,)``: lines under
+        two bins (4π/T) apart that the Hann window merged, found in what the fitted
+        lines leave (:func:`~arcosim.identification.excitation.line_prominence.unresolved_lines`);
+        ``lines`` then holds a least count. Empty when every line was told apart.
     """
 
     kind: str
@@ -122,6 +131,7 @@ class ExcitationSpectrum:
     line_share: float = 0.0
     resolution: float = 0.0
     periods: int = 0
+    unresolved: np.ndarray = field(default_factory=lambda: np.empty(0))
 
     @property
     def lowest(self) -> float | None:
@@ -149,7 +159,7 @@ class ExcitationSpectrum:
         low, high = self.band
         span = f"{low:.3g} … {high:.4g} rad/s"
         if self.kind == "lines":
-            return f"multi-sine: {len(self.lines)} lines, {span}"
+            return f"multi-sine: {len(self.lines)} lines, {span}{self._unresolved_text()}"
         if self.kind == "periodic":
             period = 2 * np.pi / self.fundamental
             whole = f", {self.periods} whole periods in the record" if self.periods else ""
@@ -160,6 +170,18 @@ class ExcitationSpectrum:
         if self.kind == "broadband":
             return f"broadband: {span} (the Welch spectrum within 10 dB of its peak)"
         return "no excitation found"
+
+    def _unresolved_text(self) -> str:
+        """The clause on lines not told apart, or ``""``."""
+        if not len(self.unresolved):
+            return ""
+        near = ", ".join(f"{w:.3g}" for w in self.unresolved)
+        record = 2.0 * np.pi / self.resolution
+        return (
+            f"; more lines near {near} rad/s, not told apart (lines under two bins, "
+            f"{2 * self.resolution:.3g} rad/s, apart merge in a {record:.3g} s record: "
+            "a longer record tells them apart)"
+        )
 
 
 def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
@@ -188,8 +210,9 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
 
     Examples
     --------
-    A multi-sine of 40 lines off the record's grid counts as lines, not as their leakage
-    (the lines under about 6 rad/s, under two bins apart, merge in the window: 34):
+    A multi-sine of 40 lines off the record's grid counts as lines, not as their leakage;
+    the lines under about 6 rad/s, under two bins apart, merge in the window (34 told
+    apart), and what the fitted lines leave says where more lie:
 
     >>> t = np.arange(20001) * 1e-3
     >>> lines = np.geomspace(3.0, 150.0, 40)
@@ -198,6 +221,8 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     >>> found = excitation_spectrum(current, 1e-3)
     >>> found.kind, len(found.lines), round(found.band[1], 1)
     ('lines', 34, 150.0)
+    >>> found.text()[:60]
+    'multi-sine: 34 lines, 3.15 … 150 rad/s; more lines near 3.45'
 
     The same lines moved onto the record's grid: each in its own bin, all 40:
 
@@ -219,17 +244,21 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     x = x - np.polyval(np.polyfit(t, x, 1), t)
     if not np.any(x):
         return ExcitationSpectrum("none", resolution=resolution)
-    lines, amplitudes, share = spectral_lines(x, h)
+    lines, amplitudes, share, unresolved = spectral_lines(x, h)
     if len(lines) and share >= LINE_SHARE and on_grid(lines, resolution):
         # on the grid, no window: each line in its bin, lines a bin apart apart
         bins, amplitudes, _ = harmonic_lines(centred, 1)
         played = played_lines(amplitudes)
         lines, amplitudes = bins[played] * resolution, amplitudes[played]
+        unresolved = np.empty(0)
     if len(lines) and share >= LINE_SHARE:
         fundamental = harmonic_fundamental(lines, resolution)
         kind = "periodic" if fundamental else "lines"
         band = (float(lines[0]), float(lines[-1]))
-        return ExcitationSpectrum(kind, lines, amplitudes, band, fundamental, share, resolution)
+        unresolved = unresolved if kind == "lines" else np.empty(0)
+        return ExcitationSpectrum(
+            kind, lines, amplitudes, band, fundamental, share, resolution, 0, unresolved
+        )
     band = broadband_band(x, h)
     if band is None:
         return ExcitationSpectrum("none", line_share=share, resolution=resolution)
@@ -311,7 +340,7 @@ def played_lines(amplitudes: np.ndarray) -> np.ndarray:
     return played
 
 
-def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, float]:
+def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
     """The lines of a detrended signal, leakage-aware.
 
     Peaks of the Hann-windowed periodogram that stand over its noise level (its local
@@ -322,7 +351,9 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     squares (:func:`refine_lines`) on the signal decimated to the lines' band, each
     held to the same threshold on its fitted amplitude
     (:func:`~arcosim.identification.excitation.line_prominence.prominent_lines`), and
-    the lines played kept (:func:`played_lines`).
+    the lines played kept (:func:`played_lines`); where the fit leaves a played line's
+    worth of signal near a line, the window merged more lines there
+    (:func:`~arcosim.identification.excitation.line_prominence.unresolved_lines`).
 
     Parameters
     ----------
@@ -339,18 +370,22 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
         Amplitudes (the signal's unit), shape ``(L,)``.
     share : float
         Share of the signal's power in the lines (dimensionless).
+    unresolved : ndarray
+        Where more lines lie than were told apart (rad/s), shape ``(U,)``; empty when
+        none, or when the lines were not refined.
 
     Examples
     --------
     >>> t = np.arange(4000) * 1e-3
-    >>> lines, amplitudes, share = spectral_lines(np.sin(10.3 * t) + 0.5 * np.sin(40.1 * t), 1e-3)
-    >>> np.round(lines, 2), np.round(amplitudes, 2), round(share, 2)
-    (array([10.29, 40.08]), array([1. , 0.5]), 1.0)
+    >>> x = np.sin(10.3 * t) + 0.5 * np.sin(40.1 * t)
+    >>> lines, amplitudes, share, unresolved = spectral_lines(x, 1e-3)
+    >>> np.round(lines, 2), np.round(amplitudes, 2), round(share, 2), len(unresolved)
+    (array([10.29, 40.08]), array([1. , 0.5]), 1.0, 0)
     """
     n = len(x)
     bins, power, level, q = _peaks(x)
     if not len(bins):
-        return np.empty(0), np.empty(0), 0.0
+        return np.empty(0), np.empty(0), 0.0, np.empty(0)
     # the lines' power: over each peak's main lobe (two bins either side), and every
     # bin above the threshold between the first and the last peak, so that lines a
     # window merges count whole (a step's 1/k decay from its one peak does not)
@@ -362,13 +397,13 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     near |= inside & (power > q * level)
     share = float(power[near].sum() / max(power[1:].sum(), 1e-300))
     if share < LINE_SHARE or len(bins) > MAX_LINES:
-        return np.empty(0), np.empty(0), share
+        return np.empty(0), np.empty(0), share, np.empty(0)
     resolution = 2.0 * np.pi / (n * h)
     amplitude = 2.0 * np.sqrt(power[bins]) / np.sum(np.hanning(n))
     position = _interpolated(power, bins)
     keep = position >= LEAST_LINE_PERIODS  # under one period in the record: a trend
     if not np.any(keep):
-        return np.empty(0), np.empty(0), share
+        return np.empty(0), np.empty(0), share, np.empty(0)
     coarse = position[keep] * resolution
     amplitude = amplitude[keep]
     # a periodic reference's harmonics, all of them (in a position loop its current
@@ -376,19 +411,23 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     w0 = harmonic_fundamental(coarse, resolution, amplitude)
     if w0:
         on = on_harmonics(coarse, w0, resolution)
-        return np.rint(coarse[on] / w0) * w0, amplitude[on], share
+        return np.rint(coarse[on] / w0) * w0, amplitude[on], share, np.empty(0)
     played = played_lines(amplitude)
     coarse, amplitude = coarse[played], amplitude[played]
     if len(coarse) > REFINE_LIMIT:  # no multi-sine plays that many: not worth the fit
-        return coarse, amplitude, share
+        return coarse, amplitude, share, np.empty(0)
     q_decimate = max(int(np.pi / (h * DECIMATE_MARGIN * coarse[-1])), 1)
     y = sp_signal.resample_poly(x, 1, q_decimate) if q_decimate > 1 else x
-    lines, amplitudes, _ = refine_lines(y, q_decimate * h, coarse)
+    lines, amplitudes, residual = refine_lines(y, q_decimate * h, coarse)
     at = np.clip(np.rint(lines / resolution).astype(int), 1, len(level) - 1)
     noise = noise_amplitude(level[at], n)
     prominent = prominent_lines(y, q_decimate * h, lines, noise, q)
     order = np.argsort(lines[prominent])
-    return lines[prominent][order], amplitudes[prominent][order], share
+    lines, amplitudes = lines[prominent][order], amplitudes[prominent][order]
+    if not len(lines):
+        return lines, amplitudes, share, np.empty(0)
+    least = float(amplitudes.min()) / DISTORTION_GAP  # a played line, not the drive's
+    return lines, amplitudes, share, unresolved_lines(residual, q_decimate * h, lines, least)
 
 
 #: The lines' refinement decimates the signal to this many times their top frequency's
