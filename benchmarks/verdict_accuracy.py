@@ -11,9 +11,9 @@ noise). Each log is identified with :func:`arcosim.identify_drive` as a user wou
 Rows:
 
 * **clean** (a two-mass and the paper's three-mass chain): expected ``trusted``, n right;
-* **k_t ±10 %, J_m ±10 %, time in ms, current in A read as mA** (the two-mass chain):
-  expected ``untrusted``, with a reason naming the cause's option (``k_to``/``J_mo``,
-  ``--scale``);
+* **k_t ±10 %, J_m ±10 %, time in ms, current in A read as mA, the current's sign
+  turned** (the two-mass chain): expected ``untrusted``, with a reason naming the
+  cause's option (``k_to``/``J_mo``, ``--scale``; ``--scale i_a=-1`` for the sign);
 * **a slow load torque** (5 % of the rated 3 A torque, constant plus a 0.7 rad/s sine,
   on the last mass) and **a 2¹⁷-count encoder with stick-slip friction three times the
   bench's**: expected n right, or ``untrusted``.
@@ -84,6 +84,7 @@ ROWS = {
     "J_m given 10 % low": Row(TWO, "untrusted", {"J_m": 0.9}, cause="J_mo"),
     "time in ms": Row(TWO, "untrusted", {"time": 1e3}, cause="--scale"),
     "current in A read as mA": Row(TWO, "untrusted", {"i_a": 1e-3}, cause="--scale"),
+    "current's sign turned": Row(TWO, "untrusted", {"i_a": -1.0}, cause="--scale i_a=-1"),
     "slow load torque": Row(
         TWO,
         "right or untrusted",

@@ -64,6 +64,35 @@ def test_current_scaled_by_1000_too_little_names_the_current_scale() -> None:
     assert len(balance) == 1 and "--scale i_a" in balance[0] and "k_to" in balance[0]
 
 
+def test_a_current_of_the_wrong_sign_names_the_sign() -> None:
+    """The current logged with the sign opposite to the encoder's count (a motor wired or
+    configured the other way): the balance's inertia is the total turned negative, and
+    the warning says to turn one of them, not to look at units."""
+    report = check_log(*sample(i_a=-1e-3), **MOTOR)
+    balance = [w for w in report.warnings if w.startswith("the torque balance")]
+    assert len(balance) == 1 and "--scale i_a=-1" in balance[0], report.warnings
+    assert "A or mA" not in balance[0]
+
+
+@pytest.mark.parametrize(
+    "scales, cpr, named",
+    [
+        ({"theta_m": 1.0, "omega_m": 1.0}, 2000, "in counts? --scale theta_m=0.00314159"),
+        ({"theta_m": COUNT * 180 / np.pi, "omega_m": COUNT * 180 / np.pi}, 2000, "degrees"),
+        ({}, 8192, "--set encoder_cpr=2000"),
+        ({}, 500, "--set encoder_cpr=2000"),
+    ],
+)
+def test_the_angle_s_steps_name_its_unit_or_the_encoder_s_count(scales, cpr, named) -> None:
+    """The README's sample (2000 counts) read with the angle in counts or degrees, or
+    with another encoder's count given: the angle's whole steps are not the count, and
+    the warning names the unit or the count; with its own count, nothing."""
+    motor = {**MOTOR, "encoder_cpr": cpr}
+    found = [w for w in log_plausibility(*sample(**scales), **motor) if "whole steps" in w]
+    assert len(found) == 1 and named in found[0], found
+    assert not [w for w in log_plausibility(*sample(), **MOTOR) if "whole steps" in w]
+
+
 def test_a_short_record_names_its_length() -> None:
     """3 s of the README's excitation: its lines under 4.2 rad/s (two periods) are not
     resolved from the record's trend, the lowest resolved one holds 3.7 periods, and the

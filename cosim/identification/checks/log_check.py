@@ -271,6 +271,7 @@ def log_plausibility(
     theta_m: np.ndarray,
     k_t: float,
     J_m: float,
+    encoder_cpr: int = 0,
 ) -> list[str]:
     """The log's plausibility warnings
     (:func:`~arcosim.identification.checks.plausibility.plausibility_warnings`) with the lowest
@@ -284,7 +285,7 @@ def log_plausibility(
     spectrum = excitation_spectrum(i_a, float(np.mean(np.diff(time))))
     lowest = resolved_lowest(spectrum, float(time[-1] - time[0]))
     args = (np.asarray(omega_m, dtype=float), np.asarray(theta_m, dtype=float))
-    return plausibility_warnings(time, i_a, *args, k_t, J_m, lowest)
+    return plausibility_warnings(time, i_a, *args, k_t, J_m, lowest, encoder_cpr)
 
 
 def line_visibility(theta: np.ndarray, h: float, lines: np.ndarray, count: float) -> list[float]:

@@ -219,7 +219,9 @@ def decide_log(
     decision.spectrum = excitation_spectrum(i_a, h)
     _excitation(decision, i_a)
     lowest = resolved_lowest(decision.spectrum, float(time[-1] - time[0]))
-    decision.plausibility = plausibility_warnings(time, i_a, omega_m, theta_m, k_t, J_m, lowest)
+    decision.plausibility = plausibility_warnings(
+        time, i_a, omega_m, theta_m, k_t, J_m, lowest, encoder_cpr
+    )
     _above_band(decision, i_a, theta_m, g_dist)
     decision.warnings += decision.doubts
     count = 2.0 * np.pi / encoder_cpr if encoder_cpr > 0 else 0.0

@@ -21,6 +21,10 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
   the window merges with it bound its error by a factor (:func:`merged_line_factor`).
 - :func:`record_length`: fewer than :data:`LEAST_PERIODS` periods of the lowest line the
   current shows.
+- :func:`angle_steps`: an encoder's angle moves by whole counts; when the logged angle
+  moves by whole multiples of a step other than the count 2π/``encoder_cpr`` given
+  (or assumed), the angle's unit (degrees, counts) or the encoder's count is wrong, and
+  with it the noise floor the verdict judges the fit against.
 
 Both read the lowest line the record resolves (:func:`resolved_lowest`): one holding at
 least :data:`RESOLVED_PERIODS` periods, so that it is told from the record's mean and
@@ -51,6 +55,18 @@ INERTIA_LOW = 0.5
 #: 1000 times the motor's inertia is outside any servo's inertia-ratio range (10–30
 #: usual, a few hundred at most).
 INERTIA_HIGH = 1e3
+#: The logged angle counts as an encoder's whole counts when this share of its nonzero
+#: steps lie within :data:`WHOLE_COUNT` of a whole multiple of the smallest
+#: (dimensionless): an encoder's angle does on every step, a continuous angle on about
+#: 2·WHOLE_COUNT of them, a decimal print of varying magnitude seldom.
+QUANTIZED_SHARE = 0.99
+#: How far from a whole multiple of the step a quantized angle's step may lie, in steps
+#: (dimensionless): a CSV's rounding of the angle is far below it.
+WHOLE_COUNT = 0.05
+#: The angle's step and the count given are the same when they agree to this ratio
+#: (dimensionless): a count is exact, so only the log's rounding separates them; a
+#: quadrature factor is 4, degrees 57.3.
+COUNT_AGREEMENT = 1.01
 #: Least number of periods (a count) of the lowest excitation line a record should
 #: hold: the line's frequency is then resolved to a third of itself, and the fits' start
 #: transients (a few periods of the slowest motion) leave part of the record.
@@ -178,6 +194,8 @@ def torque_balance(
     True
     >>> torque_balance(t, current * 1e-3, theta, 0.04, 1e-4, 2.0)[:28]
     'the torque balance k_t·i = J'
+    >>> torque_balance(t, -current, theta, 0.04, 1e-4, 2.0).split("): ")[1][:43]
+    'the current and the encoder count opposite '
     """
     found = balance_inertia(time, i_a, theta_m, k_t, lowest, with_error=True)
     if found is None:
@@ -186,16 +204,28 @@ def torque_balance(
     # implausible only beyond the balance's own uncertainty: the noise near the line
     # (BALANCE_SIGMAS standard errors), and the lines a window merges with it
     merged = merged_line_factor(float(time[-1] - time[0]), lowest)
-    if (
-        INERTIA_LOW * J_m / merged - BALANCE_SIGMAS * sigma
-        <= J
-        <= INERTIA_HIGH * J_m * merged + BALANCE_SIGMAS * sigma
-    ):
+
+    def plausible(inertia: float) -> bool:
+        return (
+            INERTIA_LOW * J_m / merged - BALANCE_SIGMAS * sigma
+            <= inertia
+            <= INERTIA_HIGH * J_m * merged + BALANCE_SIGMAS * sigma
+        )
+
+    if plausible(J):
         return None
-    return (
+    asks = (
         f"the torque balance k_t·i = J·α at {lowest:.3g} rad/s asks for a total inertia "
         f"J = {J:.3g} kg·m² = {J / J_m:.3g} × J_m (plausible: {INERTIA_LOW:g} … "
-        f"{INERTIA_HIGH:g} × J_m): check the current's scale (--scale i_a=…; A or mA?), "
+        f"{INERTIA_HIGH:g} × J_m)"
+    )
+    if plausible(-J):  # a plausible inertia, turned: the current pushes against the count
+        return (
+            f"{asks}: the current and the encoder count opposite ways; turn the current "
+            "(--scale i_a=-1) or the angle (--scale theta_m=-1 --scale omega_m=-1)"
+        )
+    return (
+        f"{asks}: check the current's scale (--scale i_a=…; A or mA?), "
         "k_t (--set k_to=…) and the time column's unit (--scale time=…)"
     )
 
@@ -381,6 +411,87 @@ def mode_record_length(time: np.ndarray, lowest_mode: float | None) -> str | Non
     )
 
 
+def angle_step(theta_m: np.ndarray) -> float | None:
+    """The step an encoder's angle moves by (the angle's unit), or None when the angle
+    does not move by whole multiples of one step (:data:`QUANTIZED_SHARE` of its
+    nonzero steps within :data:`WHOLE_COUNT` of one).
+
+    Examples
+    --------
+    >>> count = 2 * np.pi / 2000
+    >>> theta = np.floor(np.sin(np.arange(5000) * 1e-3) / count) * count
+    >>> round(2 * np.pi / angle_step(theta), 6)
+    2000.0
+    >>> angle_step(np.sin(np.arange(5000) * 1e-3)) is None
+    True
+    """
+    theta = np.asarray(theta_m, dtype=float)
+    steps = np.abs(np.diff(theta))
+    steps = steps[steps > 1e-9 * max(float(np.max(np.abs(theta), initial=0.0)), 1e-300)]
+    if len(steps) < 16:
+        return None
+    multiples = steps / steps.min()
+    whole = np.abs(multiples - np.rint(multiples)) <= WHOLE_COUNT
+    if whole.mean() < QUANTIZED_SHARE:
+        return None
+    return float(steps[whole].sum() / np.rint(multiples[whole]).sum())
+
+
+def angle_steps(theta_m: np.ndarray, encoder_cpr: int) -> str | None:
+    """The logged angle's step against the encoder's count 2π/``encoder_cpr``.
+
+    An incremental encoder's angle moves by whole counts. When the logged angle moves by
+    whole multiples of one step (:func:`angle_step`) that is not the count given, the
+    angle is in another unit (degrees, counts) or the encoder has another count (a
+    quadrature factor of 4, a default taken for the drive's); the fits' noise floor, the
+    count's Δ²/12, is then wrong too.
+
+    Parameters
+    ----------
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+    encoder_cpr : int
+        Encoder counts per revolution given or assumed (a count); 0: not checked.
+
+    Returns
+    -------
+    str or None
+        The step found, the count given and what to set; None when they agree, when the
+        angle is not quantized, or without a count.
+
+    Examples
+    --------
+    >>> count = 2 * np.pi / 2000
+    >>> theta = np.floor(np.sin(np.arange(5000) * 1e-3) / count) * count
+    >>> angle_steps(theta, 2000) is None
+    True
+    >>> angle_steps(np.degrees(theta), 2000)[-64:]
+    'is `theta_m` in degrees? --scale theta_m=0.0174533 (and omega_m)'
+    >>> angle_steps(theta, 500)[-36:]
+    'the encoder has 2000 counts per turn'
+    """
+    if encoder_cpr <= 0:
+        return None
+    step = angle_step(theta_m)
+    count = 2.0 * np.pi / encoder_cpr
+    if step is None or 1.0 / COUNT_AGREEMENT <= step / count <= COUNT_AGREEMENT:
+        return None
+    said = (
+        f"the angle moves by whole steps of {step:.4g}, not of the count 2π/{encoder_cpr} = "
+        f"{count:.4g} rad given for the encoder"
+    )
+    if 1.0 / COUNT_AGREEMENT <= step <= COUNT_AGREEMENT:
+        return f"{said}: is `theta_m` in counts? --scale theta_m={count:.6g} (and omega_m)"
+    degree = np.pi / 180.0
+    if 1.0 / COUNT_AGREEMENT <= step * degree / count <= COUNT_AGREEMENT:
+        return f"{said}: is `theta_m` in degrees? --scale theta_m={degree:.6g} (and omega_m)"
+    turns = 2.0 * np.pi / step
+    return (
+        f"{said}: --set encoder_cpr={turns:.0f} if `theta_m` is in rad and "
+        f"the encoder has {turns:.0f} counts per turn"
+    )
+
+
 def plausibility_warnings(
     time: np.ndarray,
     i_a: np.ndarray,
@@ -389,9 +500,10 @@ def plausibility_warnings(
     k_t: float,
     J_m: float,
     lowest: float | None,
+    encoder_cpr: int = 0,
 ) -> list[str]:
     """Every plausibility check's finding, in order: the step against the motion, the
-    torque balance, the record's length.
+    angle's steps against the encoder's count, the torque balance, the record's length.
 
     Parameters
     ----------
@@ -405,6 +517,8 @@ def plausibility_warnings(
     lowest : float or None
         The lowest excitation line the current shows that the record resolves (rad/s,
         :func:`resolved_lowest`); None: none found.
+    encoder_cpr : int
+        Encoder counts per revolution (a count); 0: the angle's steps are not checked.
 
     Returns
     -------
@@ -422,6 +536,7 @@ def plausibility_warnings(
     """
     found = [
         step_against_motion(time, omega_m, theta_m),
+        angle_steps(theta_m, encoder_cpr),
         torque_balance(time, i_a, theta_m, k_t, J_m, lowest),
         record_length(time, lowest),
     ]
