@@ -233,8 +233,8 @@ def _column_index(path: Path, header: list[str] | None) -> dict[str, int]:
 
 def check_scales_against_units(path: Path, scales: Mapping[str, float]) -> None:
     """Refuse ``--scale`` factors the log's units sidecar (:func:`read_units`) contradicts:
-    a factor other than 1 for a column it says is in SI units already, and no factor for
-    a column it says is in another unit.
+    a factor other than ±1 for a column it says is in SI units already (−1 turns a
+    column's sign, its unit stays), and no factor for a column it says is in another unit.
 
     Raises
     ------
@@ -245,7 +245,7 @@ def check_scales_against_units(path: Path, scales: Mapping[str, float]) -> None:
     units = read_units(path)
     for column in LOG_COLUMNS:
         unit, si, factor = units.get(column, ""), COLUMN_UNITS[column], scales.get(column)
-        if unit == si and factor not in (None, 1.0):
+        if unit == si and factor is not None and abs(factor) != 1.0:
             raise UserError(
                 f"--scale {column}={factor:g} contradicts {units_path(path)}, which says "
                 f"{column} is in {unit!r} (SI) already: drop --scale {column}, or fix the "

@@ -554,6 +554,8 @@ def test_a_scale_of_one_or_on_a_log_without_a_sidecar_is_taken(tmp_path) -> None
     (tmp_path / "drive.units.json").write_text(json.dumps({"i_a": "A"}))
     assert read_log(log, {"i_a": 1.0}).columns["i_a"][1] == pytest.approx(0.1)
     assert read_log(log, {"theta_m": 2.0}).columns["theta_m"][1] == pytest.approx(2e-5)
+    # a sign is no unit: the current turned against the encoder, as the torque balance asks
+    assert read_log(log, {"i_a": -1.0}).columns["i_a"][1] == pytest.approx(-0.1)
 
 
 def test_a_sidecar_that_is_not_json_is_named(capsys, tmp_path) -> None:
