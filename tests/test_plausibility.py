@@ -93,6 +93,21 @@ def test_the_angle_s_steps_name_its_unit_or_the_encoder_s_count(scales, cpr, nam
     assert not [w for w in log_plausibility(*sample(), **MOTOR) if "whole steps" in w]
 
 
+@pytest.mark.parametrize(
+    "period, named",
+    [(2 * np.pi, "numpy.unwrap(theta_m))"), (2**16 * COUNT, "period=205.887")],
+)
+def test_a_wrapped_angle_is_named_and_not_taken_for_a_unit(period, named) -> None:
+    """The README's sample with its angle wrapped at one turn (a single-turn encoder's
+    angle) or at a 16-bit counter's range: the wrap is named with the unwrap to apply, and
+    the jumps are not read as a speed unit's error."""
+    time, i_a, omega_m, theta_m = sample()
+    wrapped = np.mod(theta_m + period - 1.0, period)
+    found = log_plausibility(time, i_a, omega_m, wrapped, **MOTOR)
+    assert len(found) == 1 and "the angle jumps by" in found[0] and named in found[0], found
+    assert not [w for w in log_plausibility(*sample(), **MOTOR) if "jumps" in w]
+
+
 def test_a_short_record_names_its_length() -> None:
     """3 s of the README's excitation: its lines under 4.2 rad/s (two periods) are not
     resolved from the record's trend, the lowest resolved one holds 3.7 periods, and the

@@ -8,9 +8,12 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
 :func:`~arcosim.identification.drive_identification.identify_drive` call it, so ``check`` and
 ``identify`` warn alike.
 
+- :func:`angle_wraps`: steps where the angle jumps by half a turn more than the steps
+  beside it, which no drive does between two samples: a single-turn angle wrapping at
+  2π, or a counter overflowing.
 - :func:`step_against_motion`: the speed the angle's differences give over the step
-  against the logged ω_m; off by more than :data:`SPEED_RATIO_LIMIT` (a time in ms
-  gives 1000).
+  (its jumps left out) against the logged ω_m; off by more than
+  :data:`SPEED_RATIO_LIMIT` (a time in ms gives 1000).
 - :func:`torque_balance`: the low-frequency balance k_t·i = J·α + D·ω at the lowest
   excitation line (least squares of the current and angle there); J outside
   [:data:`INERTIA_LOW`, :data:`INERTIA_HIGH`]·J_m by more than :data:`BALANCE_SIGMAS`
@@ -67,6 +70,10 @@ WHOLE_COUNT = 0.05
 #: (dimensionless): a count is exact, so only the log's rounding separates them; a
 #: quadrature factor is 4, degrees 57.3.
 COUNT_AGREEMENT = 1.01
+#: The angle's jumps are one wrap's when their sizes, less the motion beside them, agree
+#: to this share (dimensionless): a wrap's period is exact, and the motion's change over
+#: a step is far below a turn; jumps of many sizes have no period.
+WRAP_AGREEMENT = 0.01
 #: Least number of periods (a count) of the lowest excitation line a record should
 #: hold: the line's frequency is then resolved to a third of itself, and the fits' start
 #: transients (a few periods of the slowest motion) leave part of the record.
@@ -93,6 +100,86 @@ RESOLVED_PERIODS = MAIN_LOBE
 #: logs of the benchmarks hold 36–45 periods of their lowest mode; 3 s of the README's
 #: excitation holds 5.3 of the three-mass chain's 11.2 rad/s.
 LEAST_MODE_PERIODS = 10.0
+
+
+def angle_jumps(theta_m: np.ndarray) -> np.ndarray:
+    """Which of the angle's steps jump: each step exceeding the mean of its two
+    neighbours' by more than half a turn (π rad).
+
+    A drive's step changes between samples by its acceleration times h², and half a turn
+    in one sample (π/h² rad/s², 3·10⁶ at 1 kHz) lies beyond any motor; a wrapped angle
+    changes it by a whole turn, a counter's overflow by its range.
+
+    Parameters
+    ----------
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+
+    Returns
+    -------
+    ndarray
+        Boolean, shape ``(N − 1,)``: the steps that jump.
+
+    Examples
+    --------
+    >>> theta = np.mod(np.arange(1000) * 0.01, 2 * np.pi)   # wraps at one turn
+    >>> np.flatnonzero(angle_jumps(theta)).tolist()
+    [628]
+    >>> bool(np.any(angle_jumps(np.arange(1000) * 6.28)))   # fast, steady: no jump
+    False
+    """
+    steps = np.abs(np.diff(np.asarray(theta_m, dtype=float)))
+    if len(steps) < 3:
+        return np.zeros(len(steps), dtype=bool)
+    padded = np.concatenate([[steps[0]], steps, [steps[-1]]])
+    beside = 0.5 * (padded[:-2] + padded[2:])
+    jumps = steps - beside > np.pi
+    # a jump's neighbours hold it in their own "beside": only the step itself exceeds them
+    return jumps & (steps >= padded[:-2]) & (steps >= padded[2:])
+
+
+def angle_wraps(theta_m: np.ndarray) -> str | None:
+    """A wrapped angle: steps that jump by a turn (or a counter's range) between samples
+    (:func:`angle_jumps`).
+
+    Parameters
+    ----------
+    theta_m : ndarray
+        Motor angle (rad), shape ``(N,)``.
+
+    Returns
+    -------
+    str or None
+        How often and by how much it jumps, and how to unwrap it; None without jumps.
+
+    Examples
+    --------
+    >>> angle_wraps(np.mod(np.arange(3000) * 0.01, 2 * np.pi))[:40]
+    'the angle jumps by 6.28 rad 4 times betw'
+    >>> angle_wraps(np.arange(3000) * 0.01) is None
+    True
+    """
+    theta = np.asarray(theta_m, dtype=float)
+    jumps = angle_jumps(theta)
+    if not np.any(jumps):
+        return None
+    steps = np.diff(theta)
+    padded = np.concatenate([[steps[0]], steps, [steps[-1]]])
+    beyond = steps - 0.5 * (padded[:-2] + padded[2:])  # the jump less the motion beside it
+    sizes = np.abs(beyond[jumps])
+    size = float(np.median(sizes))
+    if np.any(np.abs(sizes / size - 1.0) > WRAP_AGREEMENT):
+        return None  # jumps of many sizes: no period, not a wrap (the other checks speak)
+    if abs(size / (2.0 * np.pi) - 1.0) <= WRAP_AGREEMENT:
+        what, unwrap = "a single-turn angle wrapping at 2π", "numpy.unwrap(theta_m)"
+    else:
+        what = "an angle wrapping at a counter's range"
+        unwrap = f"numpy.unwrap(theta_m, period={size:.6g})"
+    return (
+        f"the angle jumps by {size:.3g} rad {int(jumps.sum())} times between samples, "
+        f"beyond any drive's motion in one step: {what}; unwrap it first ({unwrap}), "
+        "and take omega_m from the unwrapped angle if it came from the wrapped one"
+    )
 
 
 def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
@@ -123,7 +210,9 @@ def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarr
     'the sample step is 1 s:'
     """
     h = float(np.mean(np.diff(time)))
-    from_angle = float(np.sqrt(np.mean((np.diff(theta_m) / h) ** 2)))
+    steps = np.diff(np.asarray(theta_m, dtype=float))
+    steps = steps[~angle_jumps(theta_m)]  # a wrap is no motion (angle_wraps names it)
+    from_angle = float(np.sqrt(np.mean((steps / h) ** 2))) if len(steps) else 0.0
     logged = float(np.sqrt(np.mean(np.asarray(omega_m, float)[1:] ** 2)))
     if not (from_angle > 0 and logged > 0):
         return None
@@ -502,8 +591,10 @@ def plausibility_warnings(
     lowest: float | None,
     encoder_cpr: int = 0,
 ) -> list[str]:
-    """Every plausibility check's finding, in order: the step against the motion, the
-    angle's steps against the encoder's count, the torque balance, the record's length.
+    """Every plausibility check's finding, in order: the angle's wraps, the step against
+    the motion, the angle's steps against the encoder's count, the torque balance, the
+    record's length. A wrapped angle's jumps are no motion, so with them found only the
+    record's length is judged besides.
 
     Parameters
     ----------
@@ -534,10 +625,14 @@ def plausibility_warnings(
     >>> plausibility_warnings(t, current, np.gradient(theta, t), theta, 0.04, 1e-4, 3.0)
     []
     """
-    found = [
-        step_against_motion(time, omega_m, theta_m),
-        angle_steps(theta_m, encoder_cpr),
-        torque_balance(time, i_a, theta_m, k_t, J_m, lowest),
-        record_length(time, lowest),
-    ]
+    wraps = angle_wraps(theta_m)
+    if wraps:  # the jumps are no motion: the checks that read the motion wait for the unwrap
+        found = [wraps, record_length(time, lowest)]
+    else:
+        found = [
+            step_against_motion(time, omega_m, theta_m),
+            angle_steps(theta_m, encoder_cpr),
+            torque_balance(time, i_a, theta_m, k_t, J_m, lowest),
+            record_length(time, lowest),
+        ]
     return [text for text in found if text]
