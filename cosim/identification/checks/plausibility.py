@@ -131,11 +131,16 @@ def angle_jumps(theta_m: np.ndarray) -> np.ndarray:
     steps = np.abs(np.diff(np.asarray(theta_m, dtype=float)))
     if len(steps) < 3:
         return np.zeros(len(steps), dtype=bool)
-    padded = np.concatenate([[steps[0]], steps, [steps[-1]]])
-    beside = 0.5 * (padded[:-2] + padded[2:])
-    jumps = steps - beside > np.pi
+    before, after = _neighbours(steps)
+    jumps = steps - 0.5 * (before + after) > np.pi
     # a jump's neighbours hold it in their own "beside": only the step itself exceeds them
-    return jumps & (steps >= padded[:-2]) & (steps >= padded[2:])
+    return jumps & (steps >= before) & (steps >= after)
+
+
+def _neighbours(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each element's neighbour before and after (the ends repeat themselves)."""
+    padded = np.concatenate([[x[0]], x, [x[-1]]])
+    return padded[:-2], padded[2:]
 
 
 def angle_wraps(theta_m: np.ndarray) -> str | None:
@@ -164,8 +169,8 @@ def angle_wraps(theta_m: np.ndarray) -> str | None:
     if not np.any(jumps):
         return None
     steps = np.diff(theta)
-    padded = np.concatenate([[steps[0]], steps, [steps[-1]]])
-    beyond = steps - 0.5 * (padded[:-2] + padded[2:])  # the jump less the motion beside it
+    before, after = _neighbours(steps)
+    beyond = steps - 0.5 * (before + after)  # the jump less the motion beside it
     sizes = np.abs(beyond[jumps])
     size = float(np.median(sizes))
     if np.any(np.abs(sizes / size - 1.0) > WRAP_AGREEMENT):
