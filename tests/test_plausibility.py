@@ -108,6 +108,18 @@ def test_a_wrapped_angle_is_named_and_not_taken_for_a_unit(period, named) -> Non
     assert not [w for w in log_plausibility(*sample(), **MOTOR) if "jumps" in w]
 
 
+def test_a_clock_s_absolute_time_names_its_rounding() -> None:
+    """The README's sample with its time as a clock's seconds since 1970: a 1 ms step is
+    held to 2.4e-7 s only, so the step varies by 2.4e-4 of itself; the refusal says why and
+    how to write the time, and a step that truly varies is refused as before."""
+    time, i_a, omega_m, theta_m = sample()
+    report = check_log(time + 1.7e9, i_a, omega_m, theta_m, **MOTOR)
+    assert not report.ok and any("times themselves are rounded" in p for p in report.problems)
+    jitter = time + np.where(np.arange(len(time)) % 2, 2e-5, 0.0)
+    report = check_log(jitter, i_a, omega_m, theta_m, **MOTOR)
+    assert not report.ok and not any("rounded" in p for p in report.problems), report.problems
+
+
 def test_a_short_record_names_its_length() -> None:
     """3 s of the README's excitation: its lines under 4.2 rad/s (two periods) are not
     resolved from the record's trend, the lowest resolved one holds 3.7 periods, and the

@@ -214,7 +214,7 @@ def decide_log(
     if len(steps) < 16 or np.any(steps <= 0):
         decision.problems.append("the log needs increasing times and at least 16 samples")
         return decision
-    h = _step(decision, steps)
+    h = _step(decision, steps, float(np.max(np.abs(time))))
     decision.band = search_band(g_dist, h)
     decision.spectrum = excitation_spectrum(i_a, h)
     _excitation(decision, i_a)
@@ -273,11 +273,23 @@ def _length_against_modes(decision: LogDecision, time: np.ndarray) -> None:
         decision.warnings.insert(len(decision.plausibility) - 1, found)
 
 
-def _step(decision: LogDecision, steps: np.ndarray) -> float:
-    """The mean step (s) and its spread; a problem above :data:`STEP_TOLERANCE`."""
+def _step(decision: LogDecision, steps: np.ndarray, latest: float) -> float:
+    """The mean step (s) and its spread; a problem above :data:`STEP_TOLERANCE`, naming
+    the times' own rounding when it explains the spread (``latest``: the largest |time|,
+    s; a clock's absolute time holds a 1 ms step to a few 1e-7 s only)."""
     decision.step = h = float(np.mean(steps))
     decision.step_spread = float((steps.max() - steps.min()) / h)
-    if decision.step_spread > STEP_TOLERANCE:
+    if decision.step_spread <= STEP_TOLERANCE:
+        return h
+    rounding = float(np.spacing(latest))  # the resolution of the times as written (s)
+    if decision.step_spread * h <= 4.0 * rounding:  # a difference of two rounded times
+        decision.problems.append(
+            f"the sample step varies by {decision.step_spread:.1e} of its mean, as the times "
+            f"themselves are rounded ({latest:.3g} s from zero hold {rounding:.1e} s): if the "
+            f"drive samples at a fixed rate, write the time from the log's start as k·h "
+            f"(h = {h:.6g} s), or resample the log"
+        )
+    else:
         decision.problems.append(
             f"the sample step varies by {decision.step_spread:.1e} of its mean: the fits "
             "need a constant step (resample the log, or log at a fixed rate)"
