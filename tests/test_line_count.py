@@ -98,6 +98,17 @@ def test_lines_the_window_merges_are_said_to_be_there(duration, seed, noise) -> 
     assert "not told apart" in found.text() and "a longer record" in found.text()
 
 
+def test_check_reports_where_lines_merged(tmp_path) -> None:
+    """`check`'s report (its JSON) carries the places beside the least count."""
+    from arcosim.identification.checks.log_check import check_log
+
+    t = np.arange(round(20.0 / H) + 1) * H
+    current = multisine(off_grid(20.0), 20.0, 1, NOISE)
+    theta = np.cumsum(np.cumsum(current)) * H * H * 0.04 / 1e-3  # a rigid 1e-3 kg·m²
+    report = check_log(t, current, np.gradient(theta, H), theta, 0.04, 1e-4, 0)
+    assert len(report.lines) < 40 and report.unresolved_lines, report.excitation
+
+
 @pytest.mark.data(PUBLIC)
 def test_the_motor_bench_reads_its_240_lines() -> None:
     """FdiTools' ``MultisineTypeA.mat``: 240 lines on the harmonics 11 … 250 of a 1 s

@@ -57,6 +57,10 @@ class CheckReport:
     lines : list of float
         The lines played (rad/s): a multi-sine's lines or a periodic reference's
         harmonics; empty for a broadband excitation.
+    unresolved_lines : list of float
+        Where more lines lie than were told apart (rad/s): lines the Hann window merged
+        (:attr:`~arcosim.identification.excitation.spectrum.ExcitationSpectrum.unresolved`);
+        ``lines`` then holds a least count. Empty when every line was told apart.
     line_t : list of float
         Per line below the band, the encoder angle's amplitude there over its standard
         error (the counts' noise), dimensionless: how well the encoder sees the line.
@@ -87,6 +91,7 @@ class CheckReport:
     stuck_fraction: float = 0.0
     excitation: str = ""
     lines: list[float] = field(default_factory=list)
+    unresolved_lines: list[float] = field(default_factory=list)
     line_t: list[float] = field(default_factory=list)
     band: float = 0.0
     modes: list[float] = field(default_factory=list)
@@ -251,6 +256,7 @@ def report_of(decision: LogDecision, theta: np.ndarray, encoder_cpr: int) -> Che
     if spectrum is not None:
         report.excitation = spectrum.text()
         report.lines = [float(w) for w in spectrum.lines]
+        report.unresolved_lines = [float(w) for w in spectrum.unresolved]
         shown = np.array([w for w in report.lines if w <= decision.band])
         if len(shown) and encoder_cpr > 0:
             report.line_t = line_visibility(theta, decision.step, shown, 2 * np.pi / encoder_cpr)
