@@ -108,6 +108,14 @@ def test_a_wrapped_angle_is_named_and_not_taken_for_a_unit(period, named) -> Non
     assert not [w for w in log_plausibility(*sample(), **MOTOR) if "jumps" in w]
 
 
+def test_speed_and_angle_columns_swapped_are_named() -> None:
+    """The README's sample with omega_m and theta_m named the wrong way round: the one
+    finding names the swap, not a time unit or an encoder count."""
+    time, i_a, omega_m, theta_m = sample()
+    found = log_plausibility(time, i_a, theta_m, omega_m, **MOTOR)
+    assert len(found) == 1 and "omega_m and theta_m are swapped" in found[0], found
+
+
 def test_a_clock_s_absolute_time_names_its_rounding() -> None:
     """The README's sample with its time as a clock's seconds since 1970: a 1 ms step is
     held to 2.4e-7 s only, so the step varies by 2.4e-4 of itself; the refusal says why and

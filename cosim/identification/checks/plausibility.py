@@ -11,6 +11,8 @@ problem and its fix) or ``None``; :func:`plausibility_warnings` runs them all, a
 - :func:`angle_wraps`: steps where the angle jumps by half a turn more than the steps
   beside it, which no drive does between two samples: a single-turn angle wrapping at
   2π, or a counter overflowing.
+- :func:`columns_swapped`: the speed column's differences give the angle column (and
+  not the other way round): ``omega_m`` and ``theta_m`` named the wrong way.
 - :func:`step_against_motion`: the speed the angle's differences give over the step
   (its jumps left out) against the logged ω_m; off by more than
   :data:`SPEED_RATIO_LIMIT` (a time in ms gives 1000).
@@ -70,6 +72,12 @@ WHOLE_COUNT = 0.05
 #: (dimensionless): a count is exact, so only the log's rounding separates them; a
 #: quadrature factor is 4, degrees 57.3.
 COUNT_AGREEMENT = 1.01
+#: The least correlation (dimensionless) of the speed an angle's differences give with a
+#: logged speed for the two to be one motion: the encoder's counts and a backward
+#: difference leave the RMS within a few % (:data:`SPEED_RATIO_LIMIT`), and an
+#: acceleration against its speed (the columns the right way round) correlates
+#: negatively or about 0 over any oscillating motion.
+SWAP_CORRELATION = 0.9
 #: The angle's jumps are one wrap's when their sizes, less the motion beside them, agree
 #: to this share (dimensionless): a wrap's period is exact, and the motion's change over
 #: a step is far below a turn; jumps of many sizes have no period.
@@ -185,6 +193,56 @@ def angle_wraps(theta_m: np.ndarray) -> str | None:
         f"beyond any drive's motion in one step: {what}; unwrap it first ({unwrap}), "
         "and take omega_m from the unwrapped angle if it came from the wrapped one"
     )
+
+
+def columns_swapped(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
+    """``omega_m`` and ``theta_m`` named the wrong way round: the logged speed's
+    differences over the step give the logged angle (the same motion within
+    :data:`SPEED_RATIO_LIMIT` in RMS, correlated by at least :data:`SWAP_CORRELATION`),
+    while the angle's differences do not give the speed.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s), shape ``(N,)``.
+    omega_m, theta_m : ndarray
+        The logged speed and angle columns, shape ``(N,)``.
+
+    Returns
+    -------
+    str or None
+        The finding and the fix; None when the columns are the right way round or
+        neither way fits.
+
+    Examples
+    --------
+    >>> t = np.arange(4000) * 1e-3
+    >>> theta, omega = np.sin(3 * t), 3 * np.cos(3 * t)
+    >>> columns_swapped(t, omega, theta) is None
+    True
+    >>> columns_swapped(t, theta, omega)[:40]
+    'the speed column omega_m changes as the '
+    """
+    if _motion_agrees(time, omega_m, theta_m) or not _motion_agrees(time, theta_m, omega_m):
+        return None
+    return (
+        "the speed column omega_m changes as the angle column theta_m should, and the "
+        "angle's changes do not give the speed: omega_m and theta_m are swapped; name "
+        "the columns the other way round"
+    )
+
+
+def _motion_agrees(time: np.ndarray, speed: np.ndarray, angle: np.ndarray) -> bool:
+    """Whether ``angle``'s differences over the step give ``speed`` (RMS within
+    :data:`SPEED_RATIO_LIMIT`, correlation at least :data:`SWAP_CORRELATION`)."""
+    h = float(np.mean(np.diff(time)))
+    steps = np.diff(np.asarray(angle, dtype=float))
+    keep = ~angle_jumps(angle)
+    from_angle, logged = steps[keep] / h, np.asarray(speed, dtype=float)[1:][keep]
+    a, b = float(np.sqrt(np.mean(from_angle**2))), float(np.sqrt(np.mean(logged**2)))
+    if not (a > 0 and b > 0 and 1 / SPEED_RATIO_LIMIT <= a / b <= SPEED_RATIO_LIMIT):
+        return False
+    return float(np.corrcoef(from_angle, logged)[0, 1]) >= SWAP_CORRELATION
 
 
 def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
@@ -596,9 +654,10 @@ def plausibility_warnings(
     lowest: float | None,
     encoder_cpr: int = 0,
 ) -> list[str]:
-    """Every plausibility check's finding, in order: the angle's wraps, the step against
-    the motion, the angle's steps against the encoder's count, the torque balance, the
-    record's length. A wrapped angle's jumps are no motion, so with them found only the
+    """Every plausibility check's finding, in order: the angle's wraps, the speed and
+    angle columns swapped, the step against the motion, the angle's steps against the
+    encoder's count, the torque balance, the record's length. A wrapped angle's jumps
+    are no motion, and swapped columns give none of it, so with either found only the
     record's length is judged besides.
 
     Parameters
@@ -631,8 +690,9 @@ def plausibility_warnings(
     []
     """
     wraps = angle_wraps(theta_m)
-    if wraps:  # the jumps are no motion: the checks that read the motion wait for the unwrap
-        found = [wraps, record_length(time, lowest)]
+    swapped = None if wraps else columns_swapped(time, omega_m, theta_m)
+    if wraps or swapped:  # the checks that read the motion wait for the angle to be right
+        found = [wraps or swapped, record_length(time, lowest)]
     else:
         found = [
             step_against_motion(time, omega_m, theta_m),
