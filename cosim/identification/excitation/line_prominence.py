@@ -169,9 +169,7 @@ def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: f
     resolution = 2.0 * np.pi / (n * h)
     frequency = np.arange(len(power)) * resolution
     near = np.zeros(len(power), dtype=bool)
-    if len(lines):
-        near = np.min(np.abs(frequency[:, None] - np.asarray(lines)[None, :]), axis=1) <= (
-            2.0 * resolution
-        )
+    for w in np.asarray(lines, dtype=float):  # each line's main lobe, without an N × L table
+        near[max(int(np.ceil(w / resolution - 2.0)), 0) : int(w / resolution + 2.0) + 1] = True
     line = peak & near & (power > q * level) & (noise_amplitude(power, n) >= least)
     return frequency[line]
