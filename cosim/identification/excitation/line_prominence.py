@@ -11,20 +11,11 @@ Hann spectrum peaks one to two bins above 0, where the periodogram then finds a 
 which fed the torque balance and the record-length check false warnings. Once the lines
 are fitted that remnant is known: :func:`prominent_lines` asks each line to pass the
 same threshold over the noise and it.
-
-The same fit tells where lines are missing. The Hann window merges lines under two bins
-(4π/T, its main lobe) apart into one peak, and the fit then puts one line where two or
-more were played. What it leaves at that peak is a line's worth of signal: the residual's
-periodogram stands there over its own noise level, at a played line's amplitude.
-:func:`unresolved_lines` names those places, so a count of lines told apart is reported
-as a least count where the record is too short to tell every line from its neighbour.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from arcosim.identification.excitation.periodic import detection_threshold, noise_level
 
 
 def noise_amplitude(floor: float | np.ndarray, n: int) -> float | np.ndarray:
@@ -118,58 +109,3 @@ def prominent_lines(
         a_rem = float(np.hypot(*np.linalg.lstsq(pair, remnant, rcond=None)[0]))
         keep[i] = np.hypot(c[i], s[i]) ** 2 >= prominence * (noise[i] ** 2 + a_rem**2)
     return keep
-
-
-def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: float) -> np.ndarray:
-    """Where the lines fitted leave a line of the signal unexplained: lines the Hann
-    window merged with a neighbour.
-
-    A bin of the residual's Hann periodogram counts when it is a peak that stands over
-    the residual's own noise level by the χ² threshold
-    (:func:`~arcosim.identification.excitation.periodic.detection_threshold`), lies
-    within the window's main lobe (two bins) of a line fitted (where a merged line
-    hides) and has at least the amplitude ``least`` (a played line's; what a drive adds
-    lies beneath it).
-
-    Parameters
-    ----------
-    residual : ndarray
-        The signal less the fitted lines, shape ``(N,)``, step ``h`` (s).
-    h : float
-        Its sample step (s).
-    lines : ndarray
-        The lines fitted (rad/s), shape ``(L,)``.
-    least : float
-        The least amplitude of a played line (the signal's unit).
-
-    Returns
-    -------
-    ndarray
-        Frequencies (rad/s) of the residual's peaks that are lines, ascending; empty
-        when every line played was told apart.
-
-    Examples
-    --------
-    Two lines 1.5 bins apart in 20 s (a bin 0.314 rad/s), fitted as one:
-
-    >>> t = np.arange(2000) * 1e-2
-    >>> x = np.sin(5.0 * t) + np.sin(5.47 * t + 1.0)
-    >>> rest = x - np.sin(5.2 * t + 0.4) * 1.6
-    >>> np.round(unresolved_lines(rest, 1e-2, np.array([5.2]), 0.5), 2)
-    array([5.34])
-    >>> unresolved_lines(np.sin(5.2 * t) * 1e-4, 1e-2, np.array([5.2]), 0.5)
-    array([], dtype=float64)
-    """
-    n = len(residual)
-    power = np.abs(np.fft.rfft(residual * np.hanning(n))) ** 2
-    level = np.concatenate([[np.inf], noise_level(power[1:])])
-    q = detection_threshold(len(power) - 1)
-    peak = np.zeros(len(power), dtype=bool)
-    peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
-    resolution = 2.0 * np.pi / (n * h)
-    frequency = np.arange(len(power)) * resolution
-    near = np.zeros(len(power), dtype=bool)
-    for w in np.asarray(lines, dtype=float):  # each line's main lobe, without an N × L table
-        near[max(int(np.ceil(w / resolution - 2.0)), 0) : int(w / resolution + 2.0) + 1] = True
-    line = peak & near & (power > q * level) & (noise_amplitude(power, n) >= least)
-    return frequency[line]

@@ -25,7 +25,9 @@ band on average (:func:`~arcosim.identification.excitation.periodic.detection_th
   a weak line one to two bins above 0); lines that sit on whole multiples of one
   fundamental whose first harmonics are present (a periodic reference over a record of
   no whole number of periods) read as **periodic**
-  (:func:`~arcosim.identification.excitation.harmonics.harmonic_fundamental`);
+  (:func:`~arcosim.identification.excitation.harmonics.harmonic_fundamental`); where
+  the fitted lines leave a line's worth of signal, the window merged lines closer than
+  two bins, and the count is a least count (:func:`unresolved_lines`);
 - in both, the lines the drive adds beneath the played ones (friction's and the current
   loop's harmonics, in a measured current) are not played lines (:func:`played_lines`);
 - **broadband** (PRBS, noise, steps): lines that carry less than
@@ -47,11 +49,7 @@ from arcosim.identification.excitation.harmonics import (
     harmonic_fundamental,
     on_harmonics,
 )
-from arcosim.identification.excitation.line_prominence import (
-    noise_amplitude,
-    prominent_lines,
-    unresolved_lines,
-)
+from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
 from arcosim.identification.excitation.periodic import (
     detection_threshold,
     harmonic_lines,
@@ -119,7 +117,7 @@ class ExcitationSpectrum:
     unresolved : ndarray
         Where more lines lie than were told apart (rad/s), shape ``(U,)``: lines under
         two bins (4π/T) apart that the Hann window merged, found in what the fitted
-        lines leave (:func:`~arcosim.identification.excitation.line_prominence.unresolved_lines`);
+        lines leave (:func:`unresolved_lines`);
         ``lines`` then holds a least count. Empty when every line was told apart.
     """
 
@@ -353,7 +351,7 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     (:func:`~arcosim.identification.excitation.line_prominence.prominent_lines`), and
     the lines played kept (:func:`played_lines`); where the fit leaves a played line's
     worth of signal near a line, the window merged more lines there
-    (:func:`~arcosim.identification.excitation.line_prominence.unresolved_lines`).
+    (:func:`unresolved_lines`).
 
     Parameters
     ----------
@@ -454,11 +452,7 @@ def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
     peak, q the χ² threshold over the periodogram's bins; with the periodogram, the
     noise level at each bin (its local lower quartile over ln(4/3),
     :func:`~arcosim.identification.excitation.periodic.noise_level`) and q."""
-    power = hann_power(x)
-    level = np.concatenate([[np.inf], noise_level(power[1:])])
-    q = detection_threshold(len(power) - 1)
-    peak = np.zeros(len(power), dtype=bool)
-    peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
+    power, level, q, peak = _hann_peaks(x)
     candidates = np.flatnonzero(peak & (power > q * level))
     accepted: list[int] = []
     leak = np.zeros(len(power))
@@ -471,6 +465,72 @@ def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
         near = (j + reach >= 0) & (j + reach < len(power))
         leak[j + reach[near]] += power[j] * envelope[near]
     return np.sort(np.array(accepted, dtype=int)), power, level, q
+
+
+def _hann_peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    """The Hann periodogram of ``x`` (shape ``(N,)``), its noise level at each bin (its
+    local lower quartile over ln(4/3),
+    :func:`~arcosim.identification.excitation.periodic.noise_level`; infinite at 0), the
+    χ² threshold q over its bins and which bins are its local peaks (boolean, shape
+    ``(N//2 + 1,)``)."""
+    power = hann_power(x)
+    level = np.concatenate([[np.inf], noise_level(power[1:])])
+    q = detection_threshold(len(power) - 1)
+    peak = np.zeros(len(power), dtype=bool)
+    peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
+    return power, level, q, peak
+
+
+def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: float) -> np.ndarray:
+    """Where the lines fitted leave a line of the signal unexplained: lines the Hann
+    window merged with a neighbour.
+
+    The fit puts one line where the window merged two or more, and what it leaves at
+    that peak is a line's worth of signal. A bin of the residual's Hann periodogram
+    counts when it is a peak that stands over the residual's own noise level by the χ²
+    threshold (:func:`_hann_peaks`, the test the lines found pass), lies within the
+    window's main lobe (two bins) of a line fitted (where a merged line hides) and has
+    at least the amplitude ``least`` (a played line's; what a drive adds lies beneath
+    it).
+
+    Parameters
+    ----------
+    residual : ndarray
+        The signal less the fitted lines, shape ``(N,)``, step ``h`` (s).
+    h : float
+        Its sample step (s).
+    lines : ndarray
+        The lines fitted (rad/s), shape ``(L,)``.
+    least : float
+        The least amplitude of a played line (the signal's unit).
+
+    Returns
+    -------
+    ndarray
+        Frequencies (rad/s) of the residual's peaks that are lines, ascending; empty
+        when every line played was told apart.
+
+    Examples
+    --------
+    Two lines 1.5 bins apart in 20 s (a bin 0.314 rad/s), fitted as one:
+
+    >>> t = np.arange(2000) * 1e-2
+    >>> x = np.sin(5.0 * t) + np.sin(5.47 * t + 1.0)
+    >>> rest = x - np.sin(5.2 * t + 0.4) * 1.6
+    >>> np.round(unresolved_lines(rest, 1e-2, np.array([5.2]), 0.5), 2)
+    array([5.34])
+    >>> unresolved_lines(np.sin(5.2 * t) * 1e-4, 1e-2, np.array([5.2]), 0.5)
+    array([], dtype=float64)
+    """
+    n = len(residual)
+    power, level, q, peak = _hann_peaks(residual)
+    resolution = 2.0 * np.pi / (n * h)
+    frequency = np.arange(len(power)) * resolution
+    near = np.zeros(len(power), dtype=bool)
+    for w in np.asarray(lines, dtype=float):  # each line's main lobe, without an N × L table
+        near[max(int(np.ceil(w / resolution - 2.0)), 0) : int(w / resolution + 2.0) + 1] = True
+    line = peak & near & (power > q * level) & (noise_amplitude(power, n) >= least)
+    return frequency[line]
 
 
 def leakage_envelope(distance: np.ndarray) -> np.ndarray:
