@@ -235,14 +235,21 @@ def columns_swapped(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) 
 def _motion_agrees(time: np.ndarray, speed: np.ndarray, angle: np.ndarray) -> bool:
     """Whether ``angle``'s differences over the step give ``speed`` (RMS within
     :data:`SPEED_RATIO_LIMIT`, correlation at least :data:`SWAP_CORRELATION`)."""
-    h = float(np.mean(np.diff(time)))
-    steps = np.diff(np.asarray(angle, dtype=float))
-    keep = ~angle_jumps(angle)
-    from_angle, logged = steps[keep] / h, np.asarray(speed, dtype=float)[1:][keep]
+    from_angle, keep = _angle_speed(time, angle)
+    logged = np.asarray(speed, dtype=float)[1:][keep]
     a, b = float(np.sqrt(np.mean(from_angle**2))), float(np.sqrt(np.mean(logged**2)))
     if not (a > 0 and b > 0 and 1 / SPEED_RATIO_LIMIT <= a / b <= SPEED_RATIO_LIMIT):
         return False
     return float(np.corrcoef(from_angle, logged)[0, 1]) >= SWAP_CORRELATION
+
+
+def _angle_speed(time: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The speed (rad/s) ``angle``'s differences give over the mean step, its jumps
+    (:func:`angle_jumps`: a wrap is no motion) left out, and which steps were kept
+    (boolean, shape ``(N − 1,)``)."""
+    h = float(np.mean(np.diff(time)))
+    keep = ~angle_jumps(angle)
+    return np.diff(np.asarray(angle, dtype=float))[keep] / h, keep
 
 
 def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarray) -> str | None:
@@ -273,9 +280,8 @@ def step_against_motion(time: np.ndarray, omega_m: np.ndarray, theta_m: np.ndarr
     'the sample step is 1 s:'
     """
     h = float(np.mean(np.diff(time)))
-    steps = np.diff(np.asarray(theta_m, dtype=float))
-    steps = steps[~angle_jumps(theta_m)]  # a wrap is no motion (angle_wraps names it)
-    from_angle = float(np.sqrt(np.mean((steps / h) ** 2))) if len(steps) else 0.0
+    speed = _angle_speed(time, theta_m)[0]  # a wrap is no motion (angle_wraps names it)
+    from_angle = float(np.sqrt(np.mean(speed**2))) if len(speed) else 0.0
     logged = float(np.sqrt(np.mean(np.asarray(omega_m, float)[1:] ** 2)))
     if not (from_angle > 0 and logged > 0):
         return None
