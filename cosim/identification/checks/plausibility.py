@@ -76,11 +76,15 @@ COUNT_AGREEMENT = 1.01
 #: logged speed for the two to be one motion: the encoder's counts and a backward
 #: difference leave the RMS within a few % (:data:`SPEED_RATIO_LIMIT`), and an
 #: acceleration against its speed (the columns the right way round) correlates
-#: negatively or about 0 over any oscillating motion.
+#: negatively or about 0 over any oscillating motion. Measured without it (the RMS
+#: alone): the README's sample log with its time in ms, and a 30 rad/s sine with its
+#: time in ms, read as swapped.
 SWAP_CORRELATION = 0.9
 #: The angle's jumps are one wrap's when their sizes, less the motion beside them, agree
 #: to this share (dimensionless): a wrap's period is exact, and the motion's change over
-#: a step is far below a turn; jumps of many sizes have no period.
+#: a step is far below a turn; jumps of many sizes have no period. Measured without
+#: the agreement: the swapped columns' "angle" (a speed in steps of count/h) read as a
+#: wrap.
 WRAP_AGREEMENT = 0.01
 #: Least number of periods (a count) of the lowest excitation line a record should
 #: hold: the line's frequency is then resolved to a third of itself, and the fits' start
