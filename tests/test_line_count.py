@@ -68,7 +68,8 @@ def test_forty_lines_three_bins_apart_read_as_forty(noise, grid) -> None:
 @pytest.mark.xfail(
     strict=True,
     reason="off-grid lines under the Hann main lobe (two bins) apart merge: 34–35 lines in "
-    "20 s (docs/design/reverted-choices.md: a subspace count, a joint fit per cluster)",
+    "20 s (docs/design/reverted-choices.md: a subspace count, a joint fit per cluster, "
+    "a global search per line)",
 )
 @pytest.mark.parametrize("noise", [NOISE, 0.0])
 @pytest.mark.parametrize("seed", [1, 2])
