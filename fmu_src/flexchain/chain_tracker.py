@@ -95,17 +95,6 @@ static friction (unknown within ±f_c) acts; the G-filtered measurement remember
 the step's torque the predictor's, clamped to the band (as
 :func:`~arcosim.fmu.flexchain.dob.settle_sticking`), and neither the parameters nor the
 states are corrected until the memory has passed.
-
-Where the edges show no slide (a dwell, a turn), the motor still creeps within its count
-(on the three-mass chain's position-loop dwells, up to 0.94 count and back over 140 ms)
-and no edge shows it; the count's middle, as the predictor's input, is then off by up to
-half a count for as long, and the predictor's correction (slowest time constant 4.3 s on
-that chain) carries the error into the next move. There the predictor takes the angle of
-the motor's own model inside the count instead (:meth:`ChainTracker.motor`): the motor's
-inertia driven by ``k_t i``, less the predictor's chain torque, τ_0 and the tracked
-friction, restarted at each edge and kept within the count the encoder reads. In the
-slides the count's middle stays the input (the model's angle on every step raised false
-alarms on the two-mass chain's healthy run).
 """
 
 from __future__ import annotations
@@ -284,10 +273,6 @@ class ChainTracker:
         The memory's time constant (s), > 0.
     drift_threshold : float
         The relative change that counts as drift (dimensionless), > 0.
-    J_m : float
-        The motor's inertia (kg·m²): > 0 (with ``half_count`` > 0), the predictor takes
-        the angle of the motor's model inside its count where the edges show no slide
-        (:meth:`motor`); 0 (default), the count's middle throughout.
 
     Attributes
     ----------
@@ -324,7 +309,6 @@ class ChainTracker:
         half_count: float,
         tracking_time: float,
         drift_threshold: float,
-        J_m: float = 0.0,
     ) -> None:
         n = len(J)
         self.n = n
@@ -368,15 +352,6 @@ class ChainTracker:
         self.learnt = 0.0  # s since start, up to tracking_time (then the memory is full)
         self.theta = [self.theta0] * n
         self.omega = [0.0] * n
-        # the motor inside its count (:meth:`motor`; J_m > 0): its model's angle (rad) and
-        # speed (rad/s), the speed the model gained since the last edge (rad/s), the
-        # chain's torque on the motor over the last step (N·m), the last reading (rad)
-        self.J_m = J_m if half_count > 0.0 else 0.0
-        self.m_theta = self.theta0
-        self.m_omega = 0.0
-        self.m_gain = 0.0
-        self.chain_torque = 0.0
-        self.last_reading = theta0
         self.valid = False
         self.alarm = False
         self.ratio = [1.0] * (2 * n + 2)  # σ_j² / P_jj for [k…, B…, f_c, D_m], per block
@@ -471,7 +446,6 @@ class ChainTracker:
         h: float,
         torque: float,
         theta_m: float,
-        drive: float = 0.0,
     ) -> None:
         """Take the sample that ends a step.
 
@@ -484,9 +458,6 @@ class ChainTracker:
             (N·m; the DOB's, unfiltered).
         theta_m : float
             The encoder's reading at the sample (rad).
-        drive : float
-            The motor's torque ``k_t i`` over the step (N·m), for the motor's model inside
-            its count (:meth:`motor`; used when ``J_m`` > 0).
         """
         n = self.n
         self.edges.step(h, theta_m)
@@ -496,12 +467,7 @@ class ChainTracker:
         speed = (readings[-1] - readings[0]) / span if times[0] > 0.0 else 0.0
         friction_sign = self.edges.sliding(defaults.SLIDING_INTERVAL, EDGE_LATENESS * h)
         sticking = friction_sign == 0.0
-        if self.J_m > 0.0:
-            self.motor(h, theta_m, drive)
-        if self.J_m > 0.0 and sticking:  # no slide shows: the motor's model inside the count
-            theta_m = self.m_theta
-        else:
-            theta_m += self.edges.half_count
+        theta_m += self.edges.half_count
         if not same_step(h, self.h_d):
             self.design(h)
         else:
@@ -524,9 +490,8 @@ class ChainTracker:
         a = lowpass_pole(self.g_dist, h)
         b = 1.0 - a
         f_c, D_m, tau_0 = (p[i] * sc[i] for i in range(2 * n, 2 * n + 3))
-        chain_torque = (pred[-1] - a * s[-1]) / b
-        self.chain_torque = chain_torque
         if sticking:  # static friction: the value that agrees with the predictor, in band
+            chain_torque = (pred[-1] - a * s[-1]) / b
             rest = torque - D_m * speed - tau_0 - chain_torque
             friction_sign = max(-1.0, min(1.0, rest / f_c)) if f_c > 0.0 else 0.0
             self.quiet = SETTLE / self.g_dist
@@ -564,66 +529,6 @@ class ChainTracker:
         self.theta = [t0 + x for x in self.s[:n]]
         self.omega = self.s[n : 2 * n]
         self.judge()
-
-    def motor(self, h: float, reading: float, drive: float) -> None:
-        """Advance the motor's model inside the encoder's count over a step.
-
-        ``J_m ω̇ = drive − τ_chain − τ_0 − D_m ω − f_c sgn ω``: the chain's torque the
-        predictor's over the last step, τ_0, D_m and f_c the tracked ones, the Coulomb
-        term implicit (at rest while the rest of the torque is within ±f_c; a speed that
-        would change sign stops). At each edge the model restarts on it: the reading
-        changed within the step, so the motor crossed the edge on average half a step
-        before the sample; its speed, on a slide (the edge after one the same way), the
-        count over the interval between them (the mean speed, at the interval's middle)
-        advanced half an interval by the speed the model gained over it; at any other
-        edge the model's own, held at 0 if it pointed the other way. The angle stays in
-        the count the encoder reads (the motor is known to be there); the model rests
-        where it reaches the count's bound.
-
-        Parameters
-        ----------
-        h : float
-            Time since the previous sample (s), > 0.
-        reading : float
-            The encoder's reading at the sample (rad, its lower edge).
-        drive : float
-            ``k_t i`` over the step (N·m).
-        """
-        count = 2.0 * self.edges.half_count
-        last = self.last_reading
-        self.last_reading = reading
-        sc, p = self.scale, self.p
-        n = self.n
-        f_c, D_m = p[2 * n] * sc[2 * n], p[2 * n + 1] * sc[2 * n + 1]
-        tau_0 = p[2 * n + 2] * sc[2 * n + 2]
-        w = self.m_omega
-        if reading != last:  # an edge: the motor was on it, on average half a step ago
-            d = 1.0 if reading > last else -1.0
-            edge = reading if d > 0.0 else reading + count
-            interval = self.edges.interval
-            if interval > 0.0 and self.edges.direction == d:
-                w = d * count / interval + 0.5 * self.m_gain
-            elif w * d < 0.0:
-                w = 0.0
-            theta = edge + 0.5 * h * w
-            self.m_gain = 0.0
-        else:
-            force = drive - self.chain_torque - tau_0 - D_m * w
-            if w == 0.0 and abs(force) <= f_c:
-                w_new = 0.0
-            else:
-                way = (w > 0.0) - (w < 0.0) if w != 0.0 else (force > 0.0) - (force < 0.0)
-                w_new = w + h * (force - f_c * way) / self.J_m
-                if w_new * way < 0.0:
-                    w_new = 0.0
-            theta = self.m_theta + 0.5 * h * (w + w_new)
-            self.m_gain += w_new - w
-            w = w_new
-        if theta < reading:
-            theta, w = reading, 0.0
-        elif theta > reading + count:
-            theta, w = reading + count, 0.0
-        self.m_theta, self.m_omega = theta, w
 
     def learn(self, h: float, e: float, psi: list[float] | None) -> None:
         """One recursive least-squares step with forgetting on the innovation ``e`` (N·m)

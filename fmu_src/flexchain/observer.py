@@ -452,7 +452,6 @@ class Observer:
                 self.offset,
                 s.tracking_time,
                 s.drift_threshold,
-                s.actuator.J_mo + s.actuator.dJm,
             )
         elif s.estimator == Estimator.MODEL_BASED and s.load_mass > 0:
             self.estimator = LoadTorqueObserver(
@@ -488,13 +487,7 @@ class Observer:
         dob.step(h, i_a, omega, theta)
         estimator = self.estimator
         if self.settings.tracking:  # the torque before friction; the tracker has its own
-            motor = self.settings.actuator
-            estimator.step(
-                h,
-                dob.drive + motor.D_m * dob.velocity,
-                theta,
-                (motor.k_to + motor.dkt) * i_a,
-            )
+            estimator.step(h, dob.drive + self.settings.actuator.D_m * dob.velocity, theta)
         elif estimator is not None:  # mode 2, the one that runs in control loops: test it first
             tau = dob.tau_reac_hat - self.rigid * dob.alpha_hat if self.rigid else dob.tau_reac_hat
             estimator.step(h, tau, theta + self.offset)
