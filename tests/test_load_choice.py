@@ -5,15 +5,11 @@ independent simulator (:mod:`benchmarks.simulators.field_sim`) writes the log.""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from arcosim.identification.drive_identification import identify_drive
 from arcosim.identification.fit.output_error import ParameterFit
 from arcosim.identification.fit.structure_choice import LOAD_MARGIN, choose, load_candidate
-from arcosim.logs import read_log
 from benchmarks.field_accuracy import ROWS
 from tests.field_runs import identify_log
 
@@ -76,33 +72,3 @@ def test_a_load_the_user_gives_as_none_is_kept_and_only_warned(slow_load_log) ->
     assert "tau_load" not in result.parameters
     assert result.report()["selection"]["load"]["given"] == "none"
     assert any("--load slow" in w for w in result.warnings), result.warnings
-
-
-SAMPLE = Path(__file__).parents[1] / "examples" / "data" / "belt_drive.csv"
-COUNT = 2.0 * np.pi / 2000  # the README's scales: the sample's angle in counts, current in mA
-SCALES = {"i_a": 1e-3, "theta_m": COUNT, "omega_m": COUNT}
-MOTOR = dict(k_t=0.0406, J_m=2.09e-5, encoder_cpr=2000)
-
-
-@pytest.mark.parametrize("offset", [0.2, -0.2])
-def test_a_torque_held_from_the_first_sample_is_a_constant_load(offset) -> None:
-    """A current sensor's offset, or a load held from before the log began (one and the
-    same to the motor's signals): ±0.2 A, 8 mN·m, four times the motor's Coulomb
-    friction, on the README's belt sample. The chain starts twisted by it and the DOB's
-    τ̂ rises to it over its first 5/g_dist; the rule takes a constant load of offset·k_t,
-    says so, chooses the friction again with it, and the chain and the friction come out
-    as from the log without it, each within 3σ, the fit trusted. (Without the twisted
-    start, the DOB's rise left out of the floor and the friction chosen again, the
-    residual stood 4.6 × the floor, the friction moved into the dampers.)"""
-    columns = read_log(SAMPLE, SCALES).columns
-    log = [columns[c] for c in ("time", "i_a", "omega_m", "theta_m")]
-    clean = identify_drive(*log, **MOTOR)
-    held = identify_drive(*log[:1], log[1] + offset, *log[2:], **MOTOR)
-    assert held.verdict.trusted, held.verdict.reasons
-    assert held.masses == clean.masses == 2
-    assert held.report()["selection"]["load"]["chosen"] == "constant"
-    assert any("chosen by the selection rule" in w for w in held.warnings), held.warnings
-    torque = offset * MOTOR["k_t"]
-    assert abs(held.parameters["tau_load"] - torque) <= 3 * held.std["tau_load"]
-    for name, value in clean.parameters.items():
-        assert abs(held.parameters[name] - value) <= 3 * held.std[name], name

@@ -31,11 +31,6 @@ G_LPF = 100.0  #: bandwidth of the filter on the recursion's later stages (rad/s
 #: Offline, the motor velocity is the angle's derivative smoothed without lag at this
 #: many times g_dist (G(s) has removed most of what it cuts there).
 VELOCITY_SMOOTHING = 4.0
-#: The DOB's filter settles in this many time constants 1/g_dist (dimensionless): e^−5,
-#: under 1 %, of what it started from is left. Its state starts at zero, so a torque
-#: that acts from a log's first sample (a load held, a current sensor's offset) reaches
-#: τ̂ only after DOB_SETTLE / g_dist s.
-DOB_SETTLE = 5.0
 MODE = Mode.STATE_ESTIMATION  #: what the observer FMU runs unless told otherwise
 ESTIMATOR = Estimator.RECURSION  #: mode 2's estimator: the paper's recursion
 KAPPA_CORRECTION = True  #: mode 1 applies the multi-mass correction κ

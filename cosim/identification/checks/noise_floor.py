@@ -13,9 +13,7 @@ and control leave little). A residual above :data:`FLOOR_FACTOR` times the floor
 more than noise (:func:`floor_warning` names the likely causes). With a load torque
 modelled (``load`` "constant" or "slow") the τ̂ residual holds that torque, which the
 chain's prediction leaves out: it lies below the excitation, and the residual and the
-floor are compared without their content there, and without the log's first
-:data:`~arcosim.fmu.flexchain.defaults.DOB_SETTLE` / g_dist s, where the DOB's τ̂ rises
-from zero to a load that acted before the log began (:func:`load_removed`).
+floor are compared without their content there (:func:`load_removed`).
 """
 
 from __future__ import annotations
@@ -24,7 +22,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from arcosim.fmu.flexchain.defaults import DOB_SETTLE, VELOCITY_SMOOTHING
+from arcosim.fmu.flexchain.defaults import VELOCITY_SMOOTHING
 from arcosim.fmu.flexchain.dob import Actuator
 from arcosim.identification.fit.output_error import predict, rigid_predict, through_g
 from arcosim.identification.records.low_pass import low_passed
@@ -128,7 +126,7 @@ def noise_floor(
     record = motor_record(time, current, omega, theta, Actuator(J_m, k_t), g_dist)
     model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
     residual = model - record.tau_hat + smoothing_error(record, current, k_t, model)
-    return _rms(load_removed(residual, record.h, below, g_dist)), sigma_i
+    return _rms(load_removed(residual, record.h, below)), sigma_i
 
 
 def smoothing_error(
@@ -219,26 +217,17 @@ def tau_residual(
     """
     model = predict(record, *chain) if len(chain[0]) else rigid_predict(record, J_load)
     residual = model - record.tau_hat + smoothing_error(record, i_a, k_t, model)
-    return _rms(load_removed(residual, record.h, below, record.g_dist))
+    return _rms(load_removed(residual, record.h, below))
 
 
-def load_removed(
-    residual: np.ndarray, h: float, below: float | None, g_dist: float = 0.0
-) -> np.ndarray:
+def load_removed(residual: np.ndarray, h: float, below: float | None) -> np.ndarray:
     """``residual`` (N·m, shape ``(N,)``, step ``h`` in s) without what a modelled load
-    torque puts in it: its first :data:`~arcosim.fmu.flexchain.defaults.DOB_SETTLE` /
-    ``g_dist`` s (rad/s; 0: none left out), then its mean and its content below
-    ``below`` (rad/s; 0: the mean only); ``residual`` itself when ``below`` is None (no
-    load modelled).
+    torque puts in it: its mean and its content below ``below`` (rad/s; 0: the mean
+    only); ``residual`` itself when ``below`` is None (no load modelled).
 
     A load on the last mass slower than the chain's first mode reaches the motor whole,
     so it sits in the τ̂ residual below the excitation, where the chain's prediction has
-    nothing; the floor is taken through the same filter, so the two still compare. A load
-    that acted before the log began is in the current from its first sample, and the
-    DOB's τ̂, whose filter starts from zero, reaches it only after settling: that rise is
-    the log's start, not a misfit (left in, a 0.2 A offset on the three-mass reproduction log put
-    the residual of the right chain at 5.7 × the floor, the low-pass spreading the rise
-    over a second).
+    nothing; the floor is taken through the same filter, so the two still compare.
 
     Examples
     --------
@@ -250,8 +239,6 @@ def load_removed(
     """
     if below is None:
         return residual
-    if g_dist > 0:  # at most half the record: a record that short is judged whole
-        residual = residual[min(int(np.ceil(DOB_SETTLE / (g_dist * h))), len(residual) // 2) :]
     residual = residual - np.mean(residual)
     return residual - low_passed(residual, h, below) if below > 0 else residual
 

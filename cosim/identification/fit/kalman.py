@@ -124,45 +124,14 @@ class Kalman:
         return F
 
     def predicted_angle(self, record: EncoderRecord, drive: Drive) -> np.ndarray:
-        """H x⁻_k for k = 0 … N − 1 (relative to the first reading), shape (N,); x⁻_0
-        the chain at rest, twisted as far toward holding the constant load torque as
-        the record says (:meth:`held_start`)."""
+        """H x⁻_k for k = 0 … N − 1 (relative to the first reading), shape (N,)."""
         inputs, G = self._inputs(record, drive)
-        forced = output_recursion(self._F(), G, inputs)
-        start = self.held_start(record, drive, forced)
-        if start is None:
-            return forced
-        return forced + start[1]
+        return output_recursion(self._F(), G, inputs)
 
     def predicted(self, record: EncoderRecord, drive: Drive) -> np.ndarray:
         """x⁻_0 … x⁻_{N−1} (angles relative to the first reading), shape (N, S)."""
         inputs, G = self._inputs(record, drive)
-        start = self.held_start(record, drive, output_recursion(self._F(), G, inputs))
-        first = np.zeros(len(G)) if start is None else start[0]
-        return linear_recursion(self._F(), G, inputs, first).T
-
-    def held_start(
-        self, record: EncoderRecord, drive: Drive, forced: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray] | None:
-        """The predictor's first state when a constant load torque is modelled: the
-        chain at rest holding a torque α·τ_load, each spring twisted by α·τ_load/k_i,
-        α by least squares on the predictions' errors (``forced``, the predictions from
-        rest, shape (N,)), which are linear in it. A load acting on the log's first
-        sample was held before it (α = 1: a log started under a load, a current
-        sensor's offset) or was applied with it (α = 0: the chain starts untwisted); the
-        record tells which, and from the wrong start the chain's lightly damped modes
-        ring through it. Returns the state (shape (S,)) and its free response's angle
-        (shape (N,)); None without a constant load or a chain."""
-        n = len(drive.J)
-        if not (n and drive.tau_load):
-            return None
-        twist = np.zeros(len(self.A))
-        twist[1 : n + 1] = -np.cumsum(drive.tau_load / np.asarray(drive.k, dtype=float))
-        silent = np.zeros((1, len(forced) - 1))
-        free = linear_recursion(self._F(), np.zeros((len(twist), 1)), silent, twist)[0]
-        error = record.theta_m - record.theta_m[0] - forced
-        alpha = float(free @ error) / max(float(free @ free), 1e-300)
-        return alpha * twist, alpha * free
+        return linear_recursion(self._F(), G, inputs, np.zeros(len(G))).T
 
     def smoothed(self, record: EncoderRecord, drive: Drive) -> np.ndarray:
         """Rauch–Tung–Striebel smoothed states x_0 … x_{N−1} (angles absolute), (N, S)."""

@@ -248,10 +248,7 @@ def identify_whole_chain(
         The same log's current → encoder record (:func:`~arcosim.encoder_record`).
     choose_load : bool
         With ``encoder.load`` none: the load torque (none, constant, slow) chosen by the
-        rule and the chain refitted with it, then, the friction fitted, its form chosen
-        again with the load (the form chosen before, without it, is that of a misfit:
-        a torque held from the log's first sample moved the friction into the dampers);
-        False: none kept, the rule only warns.
+        rule and the chain refitted with it; False: none kept, the rule only warns.
     reading : tuple of (MotorRecord, EncoderRecord or None, DetectedModes), optional
         ``first_reading(record, masses, encoder)`` with these very arguments (not
         checked), when the caller has it (``identify_drive`` passes ``check``'s).
@@ -320,12 +317,6 @@ def identify_whole_chain(
         )
         if kept(response, encoder, n, before, result, "the load torque chosen") is before:
             result, encoder = before, unloaded
-        elif selection["load"].get("chosen", "none") != "none" and not encoder.friction_given:
-            said = result.extra.get("structure_warnings", [])
-            result, selection["friction"] = friction_form(
-                record, encoder, n, result, CONFIRM_SECONDS
-            )
-            result.extra["structure_warnings"] = said
         result = with_sign_shift(encoder, n, result)
     result.extra["selection"] = selection
     result.extra.update(
