@@ -6,10 +6,11 @@ motor bench's 240-line Schroeder multi-sine read from its own record.
 The lines are the README's, 40 log-spaced 3–150 rad/s (10.5 % apart), 0.075 A each
 (3 A peak), at 1 kHz. Off the grid the Hann periodogram merges lines under two bins
 (4π/T, its main lobe) apart: a 60 s record holds them three bins apart or more and reads
-all 40; a 20 s record holds the lowest eight one to two bins apart and counts fewer, and
-says where more lines lie, from what the fitted lines leave; its count of 40 is
-pinned as a strict expected failure: the count is what a fix must reach, and the test
-fails (XPASS) the day it does, so the mark goes.
+all 40 in one pass; a 20 s record holds the lowest eight one to two bins apart, above
+the Rayleigh limit (one bin), and the least-squares search of
+arcosim.identification.excitation.merged_lines tells them apart again; a 10 s record
+holds the lowest half a bin apart, under it, and counts fewer, saying where more lines
+lie.
 """
 
 from __future__ import annotations
@@ -65,29 +66,24 @@ def test_forty_lines_three_bins_apart_read_as_forty(noise, grid) -> None:
     assert_forty(60.0, lines, 1, noise)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="off-grid lines under the Hann main lobe (two bins) apart merge: 34–35 lines in "
-    "20 s (docs/design/reverted-choices.md: a subspace count, a joint fit per cluster, "
-    "a global search per line)",
-)
 @pytest.mark.parametrize("noise", [NOISE, 0.0])
-@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
 def test_forty_lines_one_to_two_bins_apart_read_as_forty(seed, noise) -> None:
-    """20 s: the lowest lines one to two bins apart, above the Rayleigh limit (one bin)
-    that a record of any window can resolve, so all 40. (In 10 s the lowest lie half a
-    bin apart, below it: not asked.)"""
+    """20 s: the lowest lines one to two bins apart, merged by the window but above the
+    Rayleigh limit (one bin) that a record of any window can resolve, so all 40, each
+    within a fifth of a bin. (In 10 s the lowest lie half a bin apart, below it: not
+    asked.)"""
     assert_forty(20.0, off_grid(20.0), seed, noise)
 
 
 @pytest.mark.parametrize("noise", [NOISE, 0.0])
 @pytest.mark.parametrize("seed", [1, 2, 3, 4])
-@pytest.mark.parametrize("duration", [20.0, 10.0])
-def test_lines_the_window_merges_are_said_to_be_there(duration, seed, noise) -> None:
-    """20 s and 10 s off the grid: the lines told apart are fewer than 40, and the
-    spectrum says where more lie, each place within the Hann main lobe (two bins) of a
-    line played and not told apart (none found within a fifth of a bin of it), and says
-    the record is too short."""
+def test_lines_under_the_rayleigh_limit_are_said_to_be_there(seed, noise) -> None:
+    """10 s off the grid, the lowest lines half a bin apart: the lines told apart are
+    fewer than 40, and the spectrum says where more lie, each place within the Hann main
+    lobe (two bins) of a line played and not told apart (none found within a fifth of a
+    bin of it), and says the record is too short."""
+    duration = 10.0
     lines = off_grid(duration)
     found = excitation_spectrum(multisine(lines, duration, seed, noise), H)
     grid = 2 * np.pi / (duration + H)
@@ -103,8 +99,8 @@ def test_check_reports_where_lines_merged(tmp_path) -> None:
     """`check`'s report (its JSON) carries the places beside the least count."""
     from arcosim.identification.checks.log_check import check_log
 
-    t = np.arange(round(20.0 / H) + 1) * H
-    current = multisine(off_grid(20.0), 20.0, 1, NOISE)
+    t = np.arange(round(10.0 / H) + 1) * H
+    current = multisine(off_grid(10.0), 10.0, 1, NOISE)
     theta = np.cumsum(np.cumsum(current)) * H * H * 0.04 / 1e-3  # a rigid 1e-3 kg·m²
     report = check_log(t, current, np.gradient(theta, H), theta, 0.04, 1e-4, 0)
     assert len(report.lines) < 40 and report.unresolved_lines, report.excitation

@@ -19,7 +19,7 @@ from arcosim.identification.excitation.periodic import (
     detection_threshold,
     noise_level,
 )
-from arcosim.identification.excitation.spectrum import hann_power
+from arcosim.identification.excitation.periodogram import hann_power
 
 #: Highest clamped frequency sought, in units of g_dist (dimensionless).
 BAND_PER_G = 3.0

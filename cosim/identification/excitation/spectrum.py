@@ -27,7 +27,10 @@ band on average (:func:`~arcosim.identification.excitation.periodic.detection_th
   no whole number of periods) read as **periodic**
   (:func:`~arcosim.identification.excitation.harmonics.harmonic_fundamental`); where
   the fitted lines leave a line's worth of signal, the window merged lines closer than
-  two bins, and the count is a least count (:func:`unresolved_lines`);
+  two bins (:func:`unresolved_lines`): a least-squares search tells them apart again
+  (:mod:`~arcosim.identification.excitation.merged_lines`), and where it cannot (lines
+  under the Rayleigh limit, one bin, apart) the count is a least count, with where more
+  lines lie;
 - in both, the lines the drive adds beneath the played ones (friction's and the current
   loop's harmonics, in a measured current) are not played lines (:func:`played_lines`);
 - **broadband** (PRBS, noise, steps): lines that carry less than
@@ -50,13 +53,13 @@ from arcosim.identification.excitation.harmonics import (
     on_harmonics,
 )
 from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
+from arcosim.identification.excitation.merged_lines import resolve_merged_lines
 from arcosim.identification.excitation.periodic import (
-    detection_threshold,
     harmonic_lines,
-    noise_level,
     on_grid,
     whole_periods,
 )
+from arcosim.identification.excitation.periodogram import hann_peaks, line_worth
 
 #: Share of the signal's power (dimensionless, 0 … 1) the lines must carry for the
 #: excitation to count as lines; below it, broadband.
@@ -115,9 +118,10 @@ class ExcitationSpectrum:
         Whole periods the record holds (a count); 0 when it is not read as whole
         periods.
     unresolved : ndarray
-        Where more lines lie than were told apart (rad/s), shape ``(U,)``: lines under
-        two bins (4π/T) apart that the Hann window merged, found in what the fitted
-        lines leave (:func:`unresolved_lines`);
+        Where more lines lie than were told apart (rad/s), shape ``(U,)``: lines that
+        the Hann window merged (under two bins, 4π/T, apart), found in what the fitted
+        lines leave (:func:`unresolved_lines`), and that the least-squares search of
+        :mod:`~arcosim.identification.excitation.merged_lines` did not tell apart;
         ``lines`` then holds a least count. Empty when every line was told apart.
     """
 
@@ -176,9 +180,10 @@ class ExcitationSpectrum:
         near = ", ".join(f"{w:.3g}" for w in self.unresolved)
         record = 2.0 * np.pi / self.resolution
         return (
-            f"; more lines near {near} rad/s, not told apart (lines under two bins, "
-            f"{2 * self.resolution:.3g} rad/s, apart merge in a {record:.3g} s record: "
-            "a longer record tells them apart)"
+            f"; more lines near {near} rad/s, not told apart (the window merges lines "
+            f"under two bins, {2 * self.resolution:.3g} rad/s, apart, and a {record:.3g} s "
+            f"record parts them only above one bin, {self.resolution:.3g} rad/s: a longer "
+            "record tells them apart)"
         )
 
 
@@ -209,8 +214,9 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     Examples
     --------
     A multi-sine of 40 lines off the record's grid counts as lines, not as their leakage;
-    the lines under about 6 rad/s, under two bins apart, merge in the window (34 told
-    apart), and what the fitted lines leave says where more lie:
+    in 20 s the lines under about 6 rad/s lie one to two bins apart and merge in the
+    window, and the search of :mod:`~arcosim.identification.excitation.merged_lines`
+    tells them apart again:
 
     >>> t = np.arange(20001) * 1e-3
     >>> lines = np.geomspace(3.0, 150.0, 40)
@@ -218,9 +224,14 @@ def excitation_spectrum(x: np.ndarray, h: float) -> ExcitationSpectrum:
     >>> current = np.sin(np.outer(t, lines) + phases).sum(axis=1) * 0.075
     >>> found = excitation_spectrum(current, 1e-3)
     >>> found.kind, len(found.lines), round(found.band[1], 1)
-    ('lines', 34, 150.0)
-    >>> found.text()[:60]
-    'multi-sine: 34 lines, 3.15 … 150 rad/s; more lines near 3.45'
+    ('lines', 40, 150.0)
+
+    In 10 s the lowest lie half a bin apart, under the Rayleigh limit: fewer are told
+    apart, and what the fitted lines leave says where more lie:
+
+    >>> found = excitation_spectrum(current[:10001], 1e-3)
+    >>> len(found.lines) < 40, found.text()[:47]
+    (True, 'multi-sine: 29 lines, 4.07 … 150 rad/s; more li')
 
     The same lines moved onto the record's grid: each in its own bin, all 40:
 
@@ -351,7 +362,9 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     (:func:`~arcosim.identification.excitation.line_prominence.prominent_lines`), and
     the lines played kept (:func:`played_lines`); where the fit leaves a played line's
     worth of signal near a line, the window merged more lines there
-    (:func:`unresolved_lines`).
+    (:func:`unresolved_lines`), and the search of
+    :func:`~arcosim.identification.excitation.merged_lines.resolve_merged_lines` tells
+    them apart where the record can.
 
     Parameters
     ----------
@@ -425,25 +438,17 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     if not len(lines):
         return lines, amplitudes, share, np.empty(0)
     least = float(amplitudes.min()) / DISTORTION_GAP  # a played line, not the drive's
-    return lines, amplitudes, share, unresolved_lines(residual, q_decimate * h, lines, least)
+    unresolved = unresolved_lines(residual, q_decimate * h, lines, least)
+    if len(unresolved):
+        told = resolve_merged_lines(y, q_decimate * h, lines, unresolved, least, resolution)
+        if told is not None:
+            return told[0], told[1], share, np.empty(0)
+    return lines, amplitudes, share, unresolved
 
 
 #: The lines' refinement decimates the signal to this many times their top frequency's
 #: share of the Nyquist band (dimensionless, > 1: the decimating filter's margin).
 DECIMATE_MARGIN = 2.5
-
-
-def hann_power(x: np.ndarray) -> np.ndarray:
-    """The Hann-windowed periodogram of ``x`` (shape ``(N,)``; its unit squared), shape
-    ``(N//2 + 1,)``: bin k at k·2π/(N·h) rad/s for a step h.
-
-    Examples
-    --------
-    >>> x = np.sin(2 * np.pi * 10 * np.arange(1000) / 1000)   # 10 periods in 1000 samples
-    >>> int(np.argmax(hann_power(x)))
-    10
-    """
-    return np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
 
 
 def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
@@ -452,7 +457,7 @@ def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
     peak, q the χ² threshold over the periodogram's bins; with the periodogram, the
     noise level at each bin (its local lower quartile over ln(4/3),
     :func:`~arcosim.identification.excitation.periodic.noise_level`) and q."""
-    power, level, q, peak = _hann_peaks(x)
+    power, level, q, peak = hann_peaks(x)
     candidates = np.flatnonzero(peak & (power > q * level))
     accepted: list[int] = []
     leak = np.zeros(len(power))
@@ -467,20 +472,6 @@ def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
     return np.sort(np.array(accepted, dtype=int)), power, level, q
 
 
-def _hann_peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
-    """The Hann periodogram of ``x`` (shape ``(N,)``), its noise level at each bin (its
-    local lower quartile over ln(4/3),
-    :func:`~arcosim.identification.excitation.periodic.noise_level`; infinite at 0), the
-    χ² threshold q over its bins and which bins are its local peaks (boolean, shape
-    ``(N//2 + 1,)``)."""
-    power = hann_power(x)
-    level = np.concatenate([[np.inf], noise_level(power[1:])])
-    q = detection_threshold(len(power) - 1)
-    peak = np.zeros(len(power), dtype=bool)
-    peak[1:-1] = (power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])
-    return power, level, q, peak
-
-
 def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: float) -> np.ndarray:
     """Where the lines fitted leave a line of the signal unexplained: lines the Hann
     window merged with a neighbour.
@@ -488,10 +479,10 @@ def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: f
     The fit puts one line where the window merged two or more, and what it leaves at
     that peak is a line's worth of signal. A bin of the residual's Hann periodogram
     counts when it is a peak that stands over the residual's own noise level by the χ²
-    threshold (:func:`_hann_peaks`, the test the lines found pass), lies within the
-    window's main lobe (two bins) of a line fitted (where a merged line hides) and has
-    at least the amplitude ``least`` (a played line's; what a drive adds lies beneath
-    it).
+    threshold (:func:`~arcosim.identification.excitation.periodogram.line_worth`, the
+    test the lines found pass), lies within the window's main lobe (two bins) of a line
+    fitted (where a merged line hides) and has at least the amplitude ``least`` (a
+    played line's; what a drive adds lies beneath it).
 
     Parameters
     ----------
@@ -523,14 +514,13 @@ def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: f
     array([], dtype=float64)
     """
     n = len(residual)
-    power, level, q, peak = _hann_peaks(residual)
+    _, _, _, peak = hann_peaks(residual)
     resolution = 2.0 * np.pi / (n * h)
-    frequency = np.arange(len(power)) * resolution
-    near = np.zeros(len(power), dtype=bool)
+    frequency = np.arange(len(peak)) * resolution
+    near = np.zeros(len(peak), dtype=bool)
     for w in np.asarray(lines, dtype=float):  # each line's main lobe, without an N × L table
         near[max(int(np.ceil(w / resolution - 2.0)), 0) : int(w / resolution + 2.0) + 1] = True
-    line = peak & near & (power > q * level) & (noise_amplitude(power, n) >= least)
-    return frequency[line]
+    return frequency[peak & near & line_worth(residual, least)]
 
 
 def leakage_envelope(distance: np.ndarray) -> np.ndarray:
