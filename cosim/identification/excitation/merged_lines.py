@@ -18,8 +18,9 @@ frequency is then refined together by Gauss–Newton on the whole record. The co
 grows while the new line is a played line: it lowers the sum of squares by more than
 noise would once in 1/:data:`FALSE_BAND` records (the χ² threshold over the band's
 bins), and every line in the band has a played line's amplitude. The count is taken
-only when its lines are told apart (each two at least the Rayleigh limit apart within
-three standard deviations of their separation, and that separation over three) and it
+only when its lines are told apart (each two, and the lowest and 0, at least the
+Rayleigh limit apart within three standard deviations of their separation, and that
+separation over three) and it
 explains the band (what it leaves there is noise: its power against the noise level
 outside the band, by the χ² law at :data:`FALSE_BAND`); otherwise the one-pass count
 stands, with where more lines lie.
@@ -29,10 +30,10 @@ seeds 1–8 in 20 s and 1–4 in 10 s, 5 mA of noise and none, ``tests/test_line
 seeds 1–3 of a drive's current, 1 mA steps, ``tests/test_excitation_reading.py``). With
 every check all 22 records of 20 s read 40 lines within 0.02 bin; in 10 s, where the
 lowest lines lie half a bin apart, all 8 fall back to the one-pass count with its
-places. Without the Rayleigh test, or without the noise test, three of those 10 s
-records read a confident wrong count; with the drop held at half a false line per band
-(the one-pass threshold) instead of :data:`FALSE_BAND`, one drive current of 20 s took
-a 41st and 42nd line and fell back to 36.
+places. Without the Rayleigh test two of those 10 s records, and without the noise test
+four, read a confident wrong count. The drop's level, :data:`FALSE_BAND` like the band
+test's, changes none of these records against the one-pass level (half a false line
+per band).
 """
 
 from __future__ import annotations
@@ -64,8 +65,11 @@ FALSE_BAND = 1e-3
 #: leaves: double-precision least squares over thousands of samples, and the
 #: decimator's filter, leave about this much.
 ROUNDING = 1e-9
-#: Gauss–Newton stops when a step lowers the sum of squares by less than this fraction.
-CONVERGED = 1e-10
+#: Gauss–Newton stops when a step lowers the sum of squares by less than this many noise
+#: variances (the sum over the samples' count), far below the χ² threshold a line must
+#: pass (2·ln(K/10⁻³), about 20 noise variances), or by less than :data:`ROUNDING` of
+#: it (a record without noise).
+CONVERGED = 0.01
 #: Samples ``scipy.signal.resample_poly`` leaves transient at each end of its output: its
 #: default filter spans ten output samples either side.
 DECIMATOR_TRANSIENT = 10
@@ -272,7 +276,7 @@ def _gauss_newton(
             break
         gain = cost - float(rt @ rt)
         w, c, s, r, cost, damping = trial, ct, st, rt, float(rt @ rt), max(damping / 10.0, 1e-12)
-        if gain <= CONVERGED * cost:
+        if gain <= max(CONVERGED * cost / len(y), ROUNDING * cost):
             break
     order = np.argsort(w)
     return w[order], np.hypot(c, s)[order], cost
@@ -298,14 +302,15 @@ def _explains_band(
 def _told_apart(
     y: np.ndarray, t: np.ndarray, w: np.ndarray, variance: float, rayleigh: float
 ) -> bool:
-    """Whether the lines ``w`` (rad/s) are told apart: each two at least the Rayleigh limit
-    (rad/s) apart within three standard deviations of their separation, and distinct
-    (the separation over three), the deviations from the fit's covariance with the
-    residual's ``variance``."""
+    """Whether the lines ``w`` (rad/s) are told apart: each two, and the lowest and 0 (the
+    constant and the ramp), at least the Rayleigh limit (rad/s) apart within three
+    standard deviations of their separation, and distinct (the separation over three),
+    the deviations from the fit's covariance with the residual's ``variance``."""
     c, s, _ = _amplitudes(y, t, w)
     J = _jacobian(t, w, c, s)
     covariance = variance * np.linalg.pinv(J.T @ J)[2 * len(w) + 2 :, 2 * len(w) + 2 :]
     d = np.diag(covariance)
     spread = np.sqrt(np.maximum(d[1:] + d[:-1] - 2 * np.diag(covariance, 1), 0.0))
-    apart = np.diff(w)
+    # the lowest from 0 as well: under one period in the record a line is the trend's
+    spread, apart = np.r_[np.sqrt(max(d[0], 0.0)), spread], np.r_[w[0], np.diff(w)]
     return bool(np.all((apart + 3.0 * spread >= rayleigh) & (apart > 3.0 * spread)))
