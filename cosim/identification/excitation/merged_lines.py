@@ -43,7 +43,7 @@ from scipy import signal as sp_signal
 from scipy.stats import chi2
 
 from arcosim.identification.excitation.periodic import detection_threshold
-from arcosim.identification.excitation.periodogram import hann_power, line_worth
+from arcosim.identification.excitation.periodogram import hann_peaks, hann_power, line_worth
 
 #: The Hann window's main lobe, half width (bins of 2π/T): lines closer than this to a
 #: merged place share its peak; the band searched reaches this far past its lines.
@@ -73,8 +73,9 @@ CONVERGED = 0.01
 #: Samples ``scipy.signal.resample_poly`` leaves transient at each end of its output: its
 #: default filter spans ten output samples either side.
 DECIMATOR_TRANSIENT = 10
-#: The search decimates to this many times the band's top frequency's share of the
-#: Nyquist band (dimensionless, > 1: the decimating filter's margin).
+#: The lines' refinement (:func:`~arcosim.identification.excitation.spectrum.spectral_lines`)
+#: and the search decimate to this many times the top frequency's share of the Nyquist
+#: band (dimensionless, > 1: the decimating filter's margin).
 DECIMATE_MARGIN = 2.5
 
 
@@ -154,7 +155,7 @@ def _band(residual: np.ndarray, h: float, places: np.ndarray, least: float) -> t
     every bin of the residual that holds a played line's worth of signal within a main
     lobe of the band (where the one-pass fit left merged lines, named or not), then a
     main lobe on either side."""
-    worth = np.flatnonzero(line_worth(residual, least))
+    worth = np.flatnonzero(line_worth(hann_peaks(residual), len(residual), least))
     grid_step = 2.0 * np.pi / (len(residual) * h)
     lo, hi = float(places.min()) / grid_step, float(places.max()) / grid_step
     while True:

@@ -44,15 +44,20 @@ def hann_peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, np.ndarray
     return power, level, q, peak
 
 
-def line_worth(residual: np.ndarray, least: float) -> np.ndarray:
-    """Which bins of the residual's Hann periodogram hold a played line's worth of
-    signal: over the residual's own noise level by the χ² threshold
-    (:func:`hann_peaks`) and of at least the amplitude ``least`` (the signal's unit).
+def line_worth(
+    peaks: tuple[np.ndarray, np.ndarray, float, np.ndarray], n: int, least: float
+) -> np.ndarray:
+    """Which bins of a residual's Hann periodogram hold a played line's worth of signal:
+    over the residual's own noise level by the χ² threshold and of at least the amplitude
+    ``least`` (the signal's unit).
 
     Parameters
     ----------
-    residual : ndarray
-        The signal less the fitted lines, shape ``(N,)``.
+    peaks : tuple
+        The residual's :func:`hann_peaks` (its periodogram, noise level, threshold and
+        peaks), the residual being the signal less the fitted lines.
+    n : int
+        Samples in the residual (a count).
     least : float
         The least amplitude of a played line (the signal's unit).
 
@@ -64,8 +69,8 @@ def line_worth(residual: np.ndarray, least: float) -> np.ndarray:
     Examples
     --------
     >>> t = np.arange(2000) * 1e-2
-    >>> np.flatnonzero(line_worth(np.sin(2 * np.pi * 0.5 * t), 0.5))
+    >>> np.flatnonzero(line_worth(hann_peaks(np.sin(2 * np.pi * 0.5 * t)), 2000, 0.5))
     array([ 9, 10, 11])
     """
-    power, level, q, _ = hann_peaks(residual)
-    return (power > q * level) & (noise_amplitude(power, len(residual)) >= least)
+    power, level, q, _ = peaks
+    return (power > q * level) & (noise_amplitude(power, n) >= least)

@@ -53,7 +53,7 @@ from arcosim.identification.excitation.harmonics import (
     on_harmonics,
 )
 from arcosim.identification.excitation.line_prominence import noise_amplitude, prominent_lines
-from arcosim.identification.excitation.merged_lines import resolve_merged_lines
+from arcosim.identification.excitation.merged_lines import DECIMATE_MARGIN, resolve_merged_lines
 from arcosim.identification.excitation.periodic import (
     harmonic_lines,
     on_grid,
@@ -446,11 +446,6 @@ def spectral_lines(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, flo
     return lines, amplitudes, share, unresolved
 
 
-#: The lines' refinement decimates the signal to this many times their top frequency's
-#: share of the Nyquist band (dimensionless, > 1: the decimating filter's margin).
-DECIMATE_MARGIN = 2.5
-
-
 def _peaks(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Bins of the lines in ``x`` (shape ``(N,)``): peaks of the Hann periodogram whose
     power exceeds q times the noise level plus the leakage envelope of every stronger
@@ -514,13 +509,14 @@ def unresolved_lines(residual: np.ndarray, h: float, lines: np.ndarray, least: f
     array([], dtype=float64)
     """
     n = len(residual)
-    _, _, _, peak = hann_peaks(residual)
+    peaks = hann_peaks(residual)
+    peak = peaks[3]
     resolution = 2.0 * np.pi / (n * h)
     frequency = np.arange(len(peak)) * resolution
     near = np.zeros(len(peak), dtype=bool)
     for w in np.asarray(lines, dtype=float):  # each line's main lobe, without an N × L table
         near[max(int(np.ceil(w / resolution - 2.0)), 0) : int(w / resolution + 2.0) + 1] = True
-    return frequency[peak & near & line_worth(residual, least)]
+    return frequency[peak & near & line_worth(peaks, n, least)]
 
 
 def leakage_envelope(distance: np.ndarray) -> np.ndarray:
